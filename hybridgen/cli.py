@@ -1,0 +1,87 @@
+"""Command line: ``hybridgen run CONFIG [ARGS...]``, ``hybridgen modules [NAME]``, ``hybridgen --version``.
+
+User errors (config, input, missing system libraries) print one line to stderr and exit with status 2;
+``--debug`` shows the traceback instead.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Any, Sequence
+
+from ._version import __version__
+from .errors import HybridgenError
+
+EXIT_USER_ERROR = 2
+
+
+def _progress_factory(enabled: bool) -> Any:
+    if not enabled:
+        return None
+
+    def make(total: int, what: str) -> Any:
+        from tqdm import tqdm
+
+        return tqdm(total=total, desc=what, unit="kp", file=sys.stderr, dynamic_ncols=True, leave=True)
+
+    return make
+
+
+def _cmd_run(ns: argparse.Namespace) -> int:
+    from .run.pipeline import run_config
+
+    summary = run_config(ns.config, ns.args, progress=_progress_factory(not ns.quiet))
+    outputs = ", ".join(str(p) for p in summary.outputs) or "(no output file)"
+    rate = summary.frames / summary.seconds if summary.seconds > 0 else 0.0
+    print(f"hybridgen: {summary.frames} keypoint(s) in {summary.seconds:.2f} s ({rate:.1f}/s) -> {outputs}")
+    return 0
+
+
+def _cmd_modules(ns: argparse.Namespace) -> int:
+    from .config.registry import all_modules, get_module
+
+    modules = {ns.name: get_module(ns.name)} if ns.name else all_modules()
+    for name, cls in modules.items():
+        doc = (cls.__doc__ or "").strip().splitlines()[0] if cls.__doc__ else ""
+        print(f"{name}: {doc}")
+        for param in cls.params:
+            print(f"    {param.describe()}")
+        print()
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="hybridgen", description=__doc__.splitlines()[0] if __doc__ else None)
+    parser.add_argument("--version", action="version", version=f"hybridgen {__version__}")
+    parser.add_argument("--debug", action="store_true", help="show tracebacks of errors")
+    sub = parser.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run", help="run a config: hybridgen run CONFIG [ARGS...] (ARGS fill <args:N>)")
+    run.add_argument("config", help="YAML config file")
+    run.add_argument("args", nargs="*", help="values for <args:0>, <args:1>, ...")
+    run.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
+    run.set_defaults(func=_cmd_run)
+    modules = sub.add_parser("modules", help="list modules and their parameters")
+    modules.add_argument("name", nargs="?", help="show one module")
+    modules.set_defaults(func=_cmd_modules)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    debug = "--debug" in argv
+    parser = build_parser()
+    ns = parser.parse_args(argv)
+    try:
+        return int(ns.func(ns))
+    except HybridgenError as exc:
+        if debug:
+            raise
+        print(f"hybridgen: error: {exc}", file=sys.stderr)
+        return EXIT_USER_ERROR
+    except KeyboardInterrupt:
+        print("hybridgen: interrupted; no output was committed for unfinished writers", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,78 @@
+"""Registry of config modules by their paper name (``loader.ObjLoader``).
+
+Built-ins register with :func:`register_module`; third-party packages declare modules in the
+``hybridgen.modules`` entry-point group (``"mypkg.MyModule" = "mypkg.modules:MyModule"``). A config only
+ever names a registered module: nothing in a config is imported as Python.
+"""
+from __future__ import annotations
+
+import importlib
+from importlib import metadata
+from typing import TYPE_CHECKING, Callable, TypeVar
+
+from ..errors import ConfigError
+from .schema import closest
+
+if TYPE_CHECKING:
+    from ..modules.base import Module
+
+ENTRY_POINT_GROUP = "hybridgen.modules"
+_BUILTIN_PACKAGES = (
+    "hybridgen.modules.main_initializer",
+    "hybridgen.modules.obj_loader",
+    "hybridgen.modules.primitive_loader",
+    "hybridgen.modules.camera_loader",
+    "hybridgen.modules.segmap_renderer",
+    "hybridgen.modules.hdf5_writer",
+)
+
+MODULES: dict[str, type["Module"]] = {}
+_loaded = False
+
+M = TypeVar("M", bound=type["Module"])
+
+
+def register_module(name: str) -> Callable[[M], M]:
+    """Class decorator: register a Module subclass under ``name`` (``family.Name``)."""
+
+    def decorate(cls: M) -> M:
+        if "." not in name:
+            raise ValueError(f"module names look like 'family.Name', got {name!r}")
+        existing = MODULES.get(name)
+        if existing is not None and existing is not cls:
+            raise ValueError(f"module name {name!r} registered twice ({existing.__module__}, {cls.__module__})")
+        cls.module_name = name
+        MODULES[name] = cls
+        return cls
+
+    return decorate
+
+
+def _load_all() -> None:
+    global _loaded
+    if _loaded:
+        return
+    _loaded = True
+    for package in _BUILTIN_PACKAGES:
+        importlib.import_module(package)
+    for entry in metadata.entry_points(group=ENTRY_POINT_GROUP):
+        if entry.name not in MODULES:
+            cls = entry.load()
+            register_module(entry.name)(cls)
+
+
+def all_modules() -> dict[str, type["Module"]]:
+    """Every registered module, built-ins and plugins, by name."""
+    _load_all()
+    return dict(sorted(MODULES.items()))
+
+
+def get_module(name: object) -> type["Module"]:
+    """The module class registered as ``name``; a ConfigError with the closest names otherwise."""
+    _load_all()
+    if not isinstance(name, str) or not name:
+        raise ConfigError(f"module 'name' must be a non-empty string, got {name!r}", key="name")
+    if name not in MODULES:
+        raise ConfigError(f"unknown module '{name}'{closest(name, MODULES)}; `hybridgen modules` lists them",
+                          key="name")
+    return MODULES[name]

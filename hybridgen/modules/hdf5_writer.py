@@ -1,0 +1,46 @@
+"""``writer.Hdf5Writer``: the run's outputs as one HDF5 file (SPEC section 4)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..config.registry import register_module
+from ..config.schema import Param
+from ..io.hdf5_single import COMPRESSIONS, Hdf5SingleFileWriter
+from ..run.context import RunContext
+from .base import Module
+
+
+def _file_name_check(value: str) -> str | None:
+    if "/" in value or value in ("", ".", ".."):
+        return f"must be a plain file name inside output_dir, got {value!r}"
+    return None if value.endswith((".hdf5", ".h5")) else f"must end in .hdf5 or .h5, got {value!r}"
+
+
+@register_module("writer.Hdf5Writer")
+class Hdf5Writer(Module):
+    """Collects every renderer's keypoints (streamed while they render) and commits the file at this step."""
+
+    params = (
+        Param("output_dir", "path", doc="folder of the output file (usually from global.all)"),
+        Param("file_name", "str", "data.hdf5", doc="file name inside output_dir", check=_file_name_check),
+        Param("layout", "str", "single", choices=("single",), doc="single: one file, keypoint axis first"),
+        Param("compression", "str", "gzip", choices=COMPRESSIONS, doc="dataset compression"),
+        Param("compression_level", "int", 4, doc="gzip level 0..9",
+              check=lambda v: None if 0 <= v <= 9 else f"must be in 0..9, got {v}"),
+    )
+
+    def prepare(self, context: RunContext) -> None:
+        self.writer = Hdf5SingleFileWriter(Path(self.config["output_dir"]) / self.config["file_name"],
+                                           compression=self.config["compression"],
+                                           compression_level=self.config["compression_level"])
+        context.sinks.append(self.writer)
+        context.cleanups.append(self.writer.abort)
+
+    def run(self, context: RunContext) -> None:
+        scene = context.scene
+        records = {"object_states": [o.state() for o in scene.objects],
+                   "light_states": [{"name": light.name, "type": light.type, "energy": light.energy,
+                                     "color": list(light.color), "local2world": light.local2world.tolist()}
+                                    for light in scene.lights]}
+        path = self.writer.finalize(records, context.run_attributes())
+        context.outputs.append(path)

@@ -1,0 +1,47 @@
+"""Label options shared by every renderer module (SPEC section 6), declared once."""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from ..config.schema import Param
+from ..render.label_request import LabelRequest, parse_map_by
+from ..render.raster import NORMAL_SPACES
+
+
+def _map_by_check(value: Any) -> str | None:
+    items = [value] if isinstance(value, str) else value
+    if not all(isinstance(v, str) and v for v in items):
+        return f"must be 'class', 'instance', an attribute name or a list of them, got {value!r}"
+    return None
+
+
+def _background_check(value: Any) -> str | None:
+    return None if isinstance(value, (int, float)) or value in ("inf", ".inf") else \
+        f"must be a number or inf, got {value!r}"
+
+
+def label_params(*, depth: bool, normals: bool, map_by: Any) -> tuple[Param, ...]:
+    """The label keys with this renderer's defaults."""
+    return (
+        Param("render_depth", "bool", depth, doc="write 'depth' (camera z, m)"),
+        Param("render_distance", "bool", False, doc="write 'distance' (Euclidean from the camera centre, m)"),
+        Param("render_normals", "bool", normals, doc="write 'normals' (unit, facing the camera)"),
+        Param("normals_space", "str", "camera", choices=NORMAL_SPACES, doc="axes of 'normals': camera (OpenCV) "
+              "or world"),
+        Param("map_by", "str|list|null", map_by, check=lambda v: None if v is None else _map_by_check(v),
+              doc="segmentation: class -> category_id_segmaps, instance -> instance_segmaps + "
+              "instance_attribute_maps, <attr> -> <attr>_segmaps; null: none"),
+        Param("depth_background", "float|str", math.inf, "m", "depth/distance of pixels that hit nothing",
+              check=_background_check),
+    )
+
+
+def label_request(config: dict[str, Any]) -> LabelRequest:
+    """The LabelRequest a renderer module's validated config asks for."""
+    background = config["depth_background"]
+    return LabelRequest(
+        depth=config["render_depth"], distance=config["render_distance"], normals=config["render_normals"],
+        map_by=[] if config["map_by"] is None else parse_map_by(config["map_by"]),
+        depth_background=math.inf if isinstance(background, str) else float(background),
+        normals_space=config["normals_space"])

@@ -1,0 +1,34 @@
+"""Parameters every object loader shares (name, labels, pose) and their use."""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..config.schema import Param
+from ..io.mesh_loader import object_pose
+
+
+def _scale_check(value: Any) -> str | None:
+    if isinstance(value, list):
+        if len(value) != 3 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+            return f"must be a number or a list of 3 numbers, got {value!r}"
+        values = value
+    else:
+        values = [value]
+    return None if all(v != 0 for v in values) else f"must be non-zero, got {value!r}"
+
+
+PLACEMENT_PARAMS: tuple[Param, ...] = (
+    Param("name", "str|null", None, doc="object name (several parts of one file get '<name>.<part>')"),
+    Param("category_id", "int|null", None, doc="class label written to category_id_segmaps"),
+    Param("attributes", "dict", {}, doc="custom attributes (numeric ones can be segmap keys via map_by)"),
+    Param("location", "vec3", [0.0, 0.0, 0.0], "m", "position in world coordinates"),
+    Param("rotation", "vec3", [0.0, 0.0, 0.0], "rad", "Euler XYZ angles, as in Blender"),
+    Param("scale", "float|list", 1.0, "", "uniform scale or [sx, sy, sz]", check=_scale_check),
+)
+
+
+def placement_pose(config: dict[str, Any]) -> np.ndarray:
+    """local2world 4x4 from a loader's location, rotation and scale."""
+    return object_pose(config["location"], config["rotation"], config["scale"])

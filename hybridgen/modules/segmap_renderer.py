@@ -1,0 +1,20 @@
+"""``renderer.SegMapRenderer``: the labels-only renderer (depth, distance, normals, segmentation)."""
+from __future__ import annotations
+
+from ..config.registry import register_module
+from ..render.render_labels import render_labels
+from ..run.context import RunContext
+from .base import Module
+from .label_params import label_params, label_request
+
+
+@register_module("renderer.SegMapRenderer")
+class SegMapRenderer(Module):
+    """Rasterizes the selected label passes of every keypoint and streams them to the writers."""
+
+    params = label_params(depth=True, normals=True, map_by=["class", "instance"])
+
+    def run(self, context: RunContext) -> None:
+        context.frames_rendered += render_labels(context.scene, context.sinks, label_request(self.config),
+                                                 default_category_id=context.default_category_id,
+                                                 progress=context.progress)

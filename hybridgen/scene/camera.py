@@ -1,0 +1,110 @@
+"""The pinhole camera shared by the rasterizer and the path tracer (SPEC section 2).
+
+Pixel (u, v) has its centre at integer coordinates; (0, 0) is the centre of the top-left pixel,
+u grows right, v down. Poses (keypoints) are ``cam2world`` 4x4 matrices in OpenCV camera axes
+(x right, y down, z forward), metres.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError
+
+DEFAULT_RESOLUTION = (512, 512)
+DEFAULT_FOV = 0.691111  # rad, horizontal
+DEFAULT_CLIP = (0.1, 1000.0)  # m
+MAX_PIXELS = 16384 * 16384
+
+
+@dataclass(frozen=True)
+class Intrinsics:
+    """Pinhole intrinsics: ``K`` (3x3, pixels), image size in pixels and clip range in metres."""
+
+    K: np.ndarray
+    width: int
+    height: int
+    clip_start: float = DEFAULT_CLIP[0]
+    clip_end: float = DEFAULT_CLIP[1]
+
+    def __post_init__(self) -> None:
+        K = np.array(self.K, dtype=np.float64).reshape(3, 3)
+        object.__setattr__(self, "K", K)
+        object.__setattr__(self, "width", int(self.width))
+        object.__setattr__(self, "height", int(self.height))
+        if self.width <= 0 or self.height <= 0:
+            raise InputError(f"resolution must be positive, got {self.width}x{self.height}")
+        if self.width * self.height > MAX_PIXELS or max(self.width, self.height) > 16384:
+            raise InputError(f"resolution {self.width}x{self.height} is absurd (at most 16384 per side)")
+        if not np.all(np.isfinite(K)) or K[0, 0] <= 0 or K[1, 1] <= 0:
+            raise InputError(f"cam_K must be finite with positive fx, fy, got {K.ravel().tolist()}")
+        if K[0, 1] != 0 or K[1, 0] != 0 or tuple(K[2]) != (0.0, 0.0, 1.0):
+            raise InputError(f"cam_K must be [[fx,0,cx],[0,fy,cy],[0,0,1]] (no skew), got {K.ravel().tolist()}")
+        if not (0 < self.clip_start < self.clip_end and math.isfinite(self.clip_end)):
+            raise InputError(f"clip range must satisfy 0 < start < end < inf, got {self.clip_start}..{self.clip_end}")
+
+    @classmethod
+    def from_fov(cls, fov: float, width: int = DEFAULT_RESOLUTION[0], height: int = DEFAULT_RESOLUTION[1],
+                 axis: str = "horizontal", clip_start: float = DEFAULT_CLIP[0],
+                 clip_end: float = DEFAULT_CLIP[1]) -> "Intrinsics":
+        """Square-pixel intrinsics from a field of view (radians) along ``axis`` and a centred principal point."""
+        if not (0 < fov < math.pi):
+            raise InputError(f"fov must be in (0, pi) radians, got {fov}")
+        if width <= 0 or height <= 0:
+            raise InputError(f"resolution must be positive, got {width}x{height}")
+        size = {"horizontal": width, "vertical": height}.get(axis)
+        if size is None:
+            raise InputError(f"fov axis must be 'horizontal' or 'vertical', got {axis!r}")
+        f = size / (2.0 * math.tan(fov / 2.0))
+        K = np.array([[f, 0, (width - 1) / 2.0], [0, f, (height - 1) / 2.0], [0, 0, 1.0]])
+        return cls(K, width, height, clip_start, clip_end)
+
+    @classmethod
+    def default(cls) -> "Intrinsics":
+        """SPEC defaults: 512 x 512, horizontal fov 0.691111 rad, clip 0.1..1000 m."""
+        return cls.from_fov(DEFAULT_FOV)
+
+    @property
+    def resolution(self) -> tuple[int, int]:
+        """(width, height) in pixels."""
+        return self.width, self.height
+
+    def pixel_rays(self) -> np.ndarray:
+        """(H, W, 3) float64 camera-frame directions through every pixel centre, with z = 1."""
+        u, v = np.meshgrid(np.arange(self.width, dtype=np.float64), np.arange(self.height, dtype=np.float64))
+        fx, fy, cx, cy = self.K[0, 0], self.K[1, 1], self.K[0, 2], self.K[1, 2]
+        return np.stack([(u - cx) / fx, (v - cy) / fy, np.ones_like(u)], axis=-1)
+
+
+@dataclass
+class Camera:
+    """Intrinsics plus an ordered list of keypoints (OpenCV-axes ``cam2world`` 4x4, metres)."""
+
+    intrinsics: Intrinsics = field(default_factory=Intrinsics.default)
+    keypoints: list[np.ndarray] = field(default_factory=list)
+
+    def add_keypoint(self, cam2world: np.ndarray) -> int:
+        """Append a pose (OpenCV axes) and return its keypoint index."""
+        pose = np.array(cam2world, dtype=np.float64)
+        if pose.shape != (4, 4) or not np.all(np.isfinite(pose)):
+            raise InputError(f"cam2world must be a finite 4x4 matrix, got shape {pose.shape}")
+        rot = pose[:3, :3]
+        if not np.allclose(rot @ rot.T, np.eye(3), atol=1e-5) or np.linalg.det(rot) < 0:
+            raise InputError("cam2world rotation must be orthonormal and right-handed (no scale, no mirror)")
+        if not np.allclose(pose[3], [0, 0, 0, 1]):
+            raise InputError("cam2world last row must be [0, 0, 0, 1]")
+        self.keypoints.append(pose)
+        return len(self.keypoints) - 1
+
+    def world2cam(self, index: int) -> np.ndarray:
+        """Inverse of keypoint ``index``: world -> OpenCV camera coordinates."""
+        pose = self.keypoints[index]
+        inv = np.eye(4)
+        inv[:3, :3] = pose[:3, :3].T
+        inv[:3, 3] = -pose[:3, :3].T @ pose[:3, 3]
+        return inv
+
+    def __len__(self) -> int:
+        return len(self.keypoints)

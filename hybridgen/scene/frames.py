@@ -1,0 +1,109 @@
+"""Camera frame conventions and rotations (SPEC section 1).
+
+World: right-handed, Z up, metres. Camera poses are ``cam2world`` 4x4 matrices in **OpenCV axes**
+(x right, y down, z forward). Blender camera axes are x right, y up, looking along -z; the two differ
+by a rotation of pi about the camera x axis: ``cam2world_cv = cam2world_blender @ diag(1, -1, -1, 1)``.
+"""
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+BLENDER_TO_OPENCV = np.diag([1.0, -1.0, -1.0, 1.0])
+"""Right-multiplying a Blender-axes cam2world by this gives the OpenCV-axes cam2world (it is its own inverse)."""
+
+_AXIS_VECTORS = {"X": np.array([1.0, 0, 0]), "Y": np.array([0, 1.0, 0]), "Z": np.array([0, 0, 1.0])}
+
+
+def blender_to_opencv(cam2world: np.ndarray) -> np.ndarray:
+    """Convert a 4x4 cam2world from Blender camera axes to OpenCV camera axes."""
+    return np.asarray(cam2world, dtype=np.float64) @ BLENDER_TO_OPENCV
+
+
+def opencv_to_blender(cam2world: np.ndarray) -> np.ndarray:
+    """Convert a 4x4 cam2world from OpenCV camera axes to Blender camera axes."""
+    return np.asarray(cam2world, dtype=np.float64) @ BLENDER_TO_OPENCV
+
+
+def source_frame_matrix(axes: Sequence[str]) -> np.ndarray:
+    """4x4 matrix mapping OpenCV camera coordinates into a camera frame named by its axes.
+
+    ``axes`` names, for each of the source frame's x, y, z axes, which OpenCV-relative axis it is, the
+    BlenderProc way: ``["X", "-Y", "-Z"]`` is Blender's camera frame, ``["X", "Y", "Z"]`` is OpenCV.
+    ``cam2world_cv = cam2world_source @ source_frame_matrix(axes)``.
+    """
+    if len(axes) != 3:
+        raise ValueError(f"source_frame needs 3 axes like [X, -Y, -Z], got {list(axes)}")
+    rows = []
+    for axis in axes:
+        text = str(axis).strip().upper()
+        sign = -1.0 if text.startswith("-") else 1.0
+        name = text.lstrip("+-")
+        if name not in _AXIS_VECTORS:
+            raise ValueError(f"source_frame axis must be one of X, Y, Z with an optional '-', got {axis!r}")
+        rows.append(sign * _AXIS_VECTORS[name])
+    # source axis i expressed in OpenCV camera coordinates = rows[i]; the matrix S maps cv -> source
+    # coordinates, i.e. p_src = S p_cv with S[i] = rows[i] (rows are orthonormal).
+    rot = np.array(rows)
+    if abs(abs(np.linalg.det(rot)) - 1.0) > 1e-9:
+        raise ValueError(f"source_frame axes {list(axes)} repeat an axis")
+    out = np.eye(4)
+    out[:3, :3] = rot
+    return out
+
+
+def euler_xyz_to_matrix(angles: Sequence[float]) -> np.ndarray:
+    """3x3 rotation from Blender ``XYZ`` Euler angles in radians: ``R = Rz(c) @ Ry(b) @ Rx(a)``."""
+    a, b, c = (float(v) for v in angles)
+    ca, sa, cb, sb, cc, sc = np.cos(a), np.sin(a), np.cos(b), np.sin(b), np.cos(c), np.sin(c)
+    rx = np.array([[1, 0, 0], [0, ca, -sa], [0, sa, ca]])
+    ry = np.array([[cb, 0, sb], [0, 1, 0], [-sb, 0, cb]])
+    rz = np.array([[cc, -sc, 0], [sc, cc, 0], [0, 0, 1]])
+    return rz @ ry @ rx
+
+
+def rotation_about_axis(axis: np.ndarray, angle: float) -> np.ndarray:
+    """3x3 rotation of ``angle`` radians about ``axis`` (right-hand rule)."""
+    axis = np.asarray(axis, dtype=np.float64)
+    axis = axis / np.linalg.norm(axis)
+    x, y, z = axis
+    k = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
+    return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * (k @ k)
+
+
+def forward_to_rotation_blender(forward: Sequence[float], inplane_rot: float = 0.0) -> np.ndarray:
+    """Blender-axes camera rotation (3x3, camera->world) whose view direction (-z) is ``forward``.
+
+    The image "up" (+y in Blender axes) is as close as possible to world +Z; ``inplane_rot`` (radians)
+    then rotates the camera about its own Blender z axis (right-multiplied, as BlenderProc does).
+    Looking straight up or down, image up is world +Y.
+    """
+    fwd = np.asarray(forward, dtype=np.float64)
+    norm = np.linalg.norm(fwd)
+    if not np.isfinite(norm) or norm == 0:
+        raise ValueError(f"forward vector must be finite and non-zero, got {list(fwd)}")
+    fwd = fwd / norm
+    up_world = np.array([0.0, 0.0, 1.0])
+    right = np.cross(fwd, up_world)
+    if np.linalg.norm(right) < 1e-9:  # looking along +-Z: pick world +Y as up
+        right = np.cross(fwd, np.array([0.0, 1.0, 0.0]))
+    right /= np.linalg.norm(right)
+    up = np.cross(right, fwd)
+    rot = np.stack([right, up, -fwd], axis=1)
+    if inplane_rot:
+        rot = rot @ rotation_about_axis(np.array([0.0, 0.0, 1.0]), float(inplane_rot))
+    return rot
+
+
+def look_at_blender(location: Sequence[float], target: Sequence[float], inplane_rot: float = 0.0) -> np.ndarray:
+    """Blender-axes 3x3 camera rotation looking from ``location`` to ``target`` (SPEC section 1)."""
+    return forward_to_rotation_blender(np.asarray(target, float) - np.asarray(location, float), inplane_rot)
+
+
+def make_pose(rotation: np.ndarray, location: Sequence[float]) -> np.ndarray:
+    """4x4 homogeneous transform from a 3x3 rotation and a translation (metres)."""
+    pose = np.eye(4)
+    pose[:3, :3] = rotation
+    pose[:3, 3] = np.asarray(location, dtype=np.float64)
+    return pose

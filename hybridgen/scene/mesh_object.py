@@ -1,0 +1,99 @@
+"""A triangle mesh placed in the scene, with the labels it carries."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from .material import Material
+
+
+@dataclass(eq=False)
+class MeshObject:
+    """Geometry in the object's local frame (metres) plus a ``local2world`` pose.
+
+    ``vertex_normals`` is None for flat-shaded meshes (labels then use exact face normals).
+    ``instance_id`` is assigned by :class:`~hybridgen.scene.scene.Scene` when the object is added and
+    stays the same for the whole scene (1..N; 0 is the background).
+    """
+
+    name: str
+    vertices: np.ndarray
+    faces: np.ndarray
+    vertex_normals: np.ndarray | None = None
+    uvs: np.ndarray | None = None
+    material: Material = field(default_factory=Material)
+    category_id: int | None = None
+    attributes: dict[str, Any] = field(default_factory=dict)
+    local2world: np.ndarray = field(default_factory=lambda: np.eye(4))
+    instance_id: int = 0
+
+    def __post_init__(self) -> None:
+        self.vertices = np.ascontiguousarray(self.vertices, dtype=np.float64).reshape(-1, 3)
+        self.faces = np.ascontiguousarray(self.faces, dtype=np.int64).reshape(-1, 3)
+        if self.vertex_normals is not None:
+            self.vertex_normals = np.ascontiguousarray(self.vertex_normals, dtype=np.float64).reshape(-1, 3)
+            if len(self.vertex_normals) != len(self.vertices):
+                raise InputError(f"object '{self.name}': {len(self.vertex_normals)} vertex normals for "
+                                 f"{len(self.vertices)} vertices")
+        self.local2world = np.array(self.local2world, dtype=np.float64).reshape(4, 4)
+        self.validate()
+
+    def validate(self) -> None:
+        """Raise :class:`InputError` for data no renderer can draw (empty, NaN/inf, bad indices)."""
+        if len(self.vertices) == 0 or len(self.faces) == 0:
+            raise InputError(f"object '{self.name}' has no triangles")
+        if not np.all(np.isfinite(self.vertices)):
+            bad = int(np.count_nonzero(~np.all(np.isfinite(self.vertices), axis=1)))
+            raise InputError(f"object '{self.name}' has {bad} vertices with NaN or inf coordinates")
+        if self.faces.min() < 0 or self.faces.max() >= len(self.vertices):
+            raise InputError(f"object '{self.name}' has face indices outside 0..{len(self.vertices) - 1}")
+        if self.vertex_normals is not None and not np.all(np.isfinite(self.vertex_normals)):
+            raise InputError(f"object '{self.name}' has NaN or inf vertex normals")
+        if not np.all(np.isfinite(self.local2world)):
+            raise InputError(f"object '{self.name}' has a non-finite pose")
+
+    @cached_property
+    def face_normals(self) -> np.ndarray:
+        """(F, 3) unit geometric normals in the local frame (right-hand rule over the face's vertex order).
+
+        Degenerate faces get (0, 0, 0); they cover no pixel centre.
+        """
+        tri = self.vertices[self.faces]
+        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        length = np.linalg.norm(n, axis=1, keepdims=True)
+        return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
+
+    @cached_property
+    def is_closed(self) -> bool:
+        """True if the mesh is a watertight, consistently wound volume with outward faces.
+
+        Only then can back faces never be the first surface seen from outside it.
+        """
+        import trimesh
+
+        mesh = trimesh.Trimesh(self.vertices, self.faces, process=False)
+        return bool(mesh.is_watertight and mesh.is_winding_consistent and mesh.volume > 0)
+
+    @property
+    def bounds_local(self) -> np.ndarray:
+        """(2, 3) axis-aligned box of the vertices in the local frame, metres."""
+        return np.stack([self.vertices.min(axis=0), self.vertices.max(axis=0)])
+
+    def world_vertices(self) -> np.ndarray:
+        """(V, 3) vertices in world coordinates."""
+        return self.vertices @ self.local2world[:3, :3].T + self.local2world[:3, 3]
+
+    def state(self) -> dict[str, Any]:
+        """JSON-ready pose record (SPEC section 4, ``object_states``)."""
+        record: dict[str, Any] = {"idx": self.instance_id, "name": self.name, "category_id": self.category_id}
+        record.update({k: v for k, v in self.attributes.items() if _is_json_scalar(v)})
+        record["local2world"] = self.local2world.tolist()
+        return record
+
+
+def _is_json_scalar(value: Any) -> bool:
+    return isinstance(value, (str, int, float, bool)) or value is None
