@@ -1,4 +1,4 @@
-"""Command line: ``hybridgen run CONFIG [ARGS...]``, ``hybridgen modules [NAME]``, ``hybridgen --version``.
+"""Command line: ``hybridgen run CONFIG [ARGS...]``, ``modules [NAME]``, ``vis FILE... --save DIR``, ``--version``.
 
 User errors (config, input, missing system libraries) print one line to stderr and exit with status 2;
 ``--debug`` shows the traceback instead.
@@ -50,6 +50,14 @@ def _cmd_modules(ns: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_vis(ns: argparse.Namespace) -> int:
+    from .io.visualize import save_contact_sheets
+
+    written = save_contact_sheets(ns.files, ns.save, ns.keys)
+    print(f"hybridgen: wrote {len(written)} contact sheet(s) to {ns.save}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="hybridgen", description=__doc__.splitlines()[0] if __doc__ else None)
     parser.add_argument("--version", action="version", version=f"hybridgen {__version__}")
@@ -63,6 +71,11 @@ def build_parser() -> argparse.ArgumentParser:
     modules = sub.add_parser("modules", help="list modules and their parameters")
     modules.add_argument("name", nargs="?", help="show one module")
     modules.set_defaults(func=_cmd_modules)
+    vis = sub.add_parser("vis", help="save a contact sheet PNG per keypoint of HDF5 outputs")
+    vis.add_argument("files", nargs="+", help="HDF5 files written by hybridgen")
+    vis.add_argument("--keys", nargs="+", help="keys to show (default: every image key)")
+    vis.add_argument("--save", required=True, help="folder for the PNG files")
+    vis.set_defaults(func=_cmd_vis)
     return parser
 
 

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Checks the system libraries hybridgen needs and installs the missing ones from Debian when run as root.
+#   - Mesa EGL + the llvmpipe software driver: headless OpenGL for the label rasterizer.
+# Exit status 0 when everything is there (or was installed), 1 with the command to run otherwise.
+set -euo pipefail
+
+multiarch=$(gcc -print-multiarch 2>/dev/null || dpkg-architecture -qDEB_HOST_MULTIARCH 2>/dev/null || echo x86_64-linux-gnu)
+libdirs="/usr/lib/$multiarch /usr/lib /usr/lib64 /lib/$multiarch"
+
+have() {  # have FILE: is a library file present in a system library dir?
+  for d in $libdirs; do [ -e "$d/$1" ] && return 0; done
+  return 1
+}
+
+missing=()
+have libEGL.so.1 || missing+=(libegl1)
+have libEGL_mesa.so.0 || missing+=(libegl-mesa0)
+have libgbm.so.1 || missing+=(libgbm1)
+have libGL.so.1 || missing+=(libgl1)
+have dri/swrast_dri.so || have dri/kms_swrast_dri.so || missing+=(libgl1-mesa-dri)
+
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+  echo "hybridgen setup: installing ${missing[*]} (Debian packages)" >&2
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
+  exit 0
+fi
+echo "hybridgen setup: missing system libraries; run: sudo apt-get install ${missing[*]}" >&2
+exit 1
