@@ -1,0 +1,63 @@
+"""Shared fixtures. The GL context is the real EGL one (llvmpipe here); without it the render tests fail
+with the setup message rather than pass silently."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import pytest
+
+import hybridgen as hg
+from hybridgen.cli import main as cli_main
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="session")
+def gl_context():
+    from hybridgen.render.gl_context import shared_context
+
+    return shared_context()
+
+
+@pytest.fixture
+def run_cli(capsys: pytest.CaptureFixture[str]) -> Callable[..., tuple[int, str, str]]:
+    """Run the CLI in-process; returns (exit status, stdout, stderr)."""
+
+    def run(*argv: str) -> tuple[int, str, str]:
+        try:
+            code = cli_main(list(argv))
+        except SystemExit as exc:  # argparse usage errors
+            code = int(exc.code or 0)
+        out = capsys.readouterr()
+        return code, out.out, out.err
+
+    return run
+
+
+@pytest.fixture
+def write_config(tmp_path: Path) -> Callable[[str], Path]:
+    """Write YAML text to a config file in tmp_path and return its path."""
+
+    def write(text: str, name: str = "config.yaml") -> Path:
+        path = tmp_path / name
+        path.write_text(text)
+        return path
+
+    return write
+
+
+def camera_at(location, target, intr: hg.Intrinsics) -> hg.Scene:
+    """An empty scene whose camera has one look-at keypoint."""
+    scene = hg.Scene()
+    scene.camera.intrinsics = intr
+    scene.camera.add_keypoint(hg.look_at(location, target))
+    return scene
+
+
+def pixel_rays_world(intr: hg.Intrinsics, cam2world: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit world-space ray directions through every pixel centre (H*W, 3) and the ray z components."""
+    rays = intr.pixel_rays().reshape(-1, 3)
+    unit = rays / np.linalg.norm(rays, axis=1, keepdims=True)
+    return unit @ cam2world[:3, :3].T, unit[:, 2]
