@@ -33,12 +33,12 @@ def build_modules(config: ConfigFile) -> list[Module]:
         except ConfigError as exc:
             raise exc.located(file=config.path, module=entry.name, index=entry.index) from None
         modules.append(cls(values, entry.index))
+    _check_order(modules, config.path)
     declared = {p.name for m in modules for p in m.params}
     for key in config.global_all:
         if key not in declared:
             raise ConfigError(f"no module of this config takes this key{_suggest(key, declared)}",
                               file=config.path, key=f"global.all.{key}")
-    _check_order(modules, config.path)
     return modules
 
 

@@ -1,0 +1,118 @@
+"""SPEC section 4: the single-file HDF5 output, read back against the renderer's own values."""
+from __future__ import annotations
+
+import hashlib
+import json
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+
+import hybridgen as hg
+from tests.conftest import REPO
+
+
+def _run(tmp_path, run_cli, name="out", *extra):
+    out = tmp_path / name
+    code, stdout, err = run_cli("run", "-q", str(REPO / "configs/quickstart.yaml"), str(out), *extra)
+    assert code == 0, err
+    return out / "data.hdf5", stdout
+
+
+def test_quickstart_file_layout(gl_context, tmp_path, run_cli, monkeypatch):
+    monkeypatch.chdir(REPO)
+    path, stdout = _run(tmp_path, run_cli)
+    assert "6 keypoint(s)" in stdout and str(path) in stdout
+    with h5py.File(path) as f:
+        n, h, w = 6, 240, 320
+        expected = {"depth": ("float32", (n, h, w)), "distance": ("float32", (n, h, w)),
+                    "normals": ("float32", (n, h, w, 3)), "instance_segmaps": ("int32", (n, h, w)),
+                    "category_id_segmaps": ("int32", (n, h, w)), "cam_K": ("float64", (n, 3, 3)),
+                    "cam2world": ("float64", (n, 4, 4))}
+        for key, (dtype, shape) in expected.items():
+            assert f[key].dtype == np.dtype(dtype) and f[key].shape == shape, key
+        for key in ("depth", "normals", "instance_segmaps"):
+            assert f[key].chunks == (1, *f[key].shape[1:]) and f[key].compression == "gzip"
+        assert f["instance_attribute_maps"].shape == (n,)
+        attrs = dict(f.attrs)
+        assert attrs["seed"] == 42 and attrs["hybridgen_version"] == hg.__version__
+        assert attrs["normals_space"] == "camera" and np.isinf(attrs["depth_background"])
+        config = yaml.safe_load(attrs["config"])
+        assert config["global"]["all"]["output_dir"] == str(path.parent)  # resolved, not "<args:0>"
+        states = json.loads(f["object_states"][()])
+        assert [s["idx"] for s in states] == [1, 2, 3, 4, 5]
+        assert [s["category_id"] for s in states] == [1, 2, 3, 4, 5]
+        assert states[1]["name"] == "box" and np.array(states[1]["local2world"]).shape == (4, 4)
+        np.testing.assert_allclose(np.array(states[1]["local2world"])[:3, 3], [-0.9, 0.4, 0.4])
+        visible = json.loads(f["instance_attribute_maps"][0])
+        ids = f["instance_segmaps"][0]
+        assert sorted(r["idx"] for r in visible) == sorted(set(np.unique(ids)) - {0})
+        # class map is the instance map through object_states
+        lut = np.zeros(6, np.int32)
+        for s in states:
+            lut[s["idx"]] = s["category_id"]
+        np.testing.assert_array_equal(f["category_id_segmaps"][()], lut[f["instance_segmaps"][()]])
+        # what was written is what the renderer renders for that keypoint
+        scene = hg.Scene()
+        for s, shape, size in zip(states[:4], ["plane", "cube", "sphere", "torus"], [6.0, 0.8, 0.9, 1.0]):
+            scene.add(hg.make_primitive(shape, size, name=s["name"], category_id=s["category_id"],
+                                        local2world=np.array(s["local2world"])))
+        for obj in hg.load_objects(REPO / "configs/assets/knot.obj", name="knot", category_id=5,
+                                   local2world=np.array(states[4]["local2world"])):
+            scene.add(obj)
+        intr = hg.Intrinsics(f["cam_K"][2], w, h)
+        fresh = hg.RasterView(scene).render(f["cam2world"][2], ["depth", "normals", "instance_segmaps"],
+                                            intrinsics=intr)
+        for key in fresh:
+            np.testing.assert_array_equal(f[key][2], fresh[key])
+        # distance is depth scaled by the pixel ray length
+        rays = np.linalg.norm(intr.pixel_rays(), axis=-1)
+        hit = np.isfinite(f["depth"][2])
+        np.testing.assert_allclose(f["distance"][2][hit], (f["depth"][2] * rays)[hit], rtol=1e-6)
+        assert np.isinf(f["distance"][2][~hit]).all() and (f["normals"][2][~hit] == 0).all()
+
+
+def test_same_config_and_seed_give_identical_bytes(gl_context, tmp_path, run_cli, monkeypatch):
+    monkeypatch.chdir(REPO)
+    path, _ = _run(tmp_path, run_cli)
+    first = hashlib.sha256(path.read_bytes()).hexdigest()
+    path.unlink()
+    again, _ = _run(tmp_path, run_cli)
+    assert hashlib.sha256(again.read_bytes()).hexdigest() == first
+
+
+@pytest.mark.parametrize("compression", ["gzip", "lzf", "none"])
+def test_compressions_read_back_identically(gl_context, tmp_path, compression):
+    scene = hg.Scene()
+    scene.add(hg.make_primitive("sphere", 1.0, name="s", category_id=4))
+    scene.camera.intrinsics = hg.Intrinsics.from_fov(0.9, 48, 32)
+    for loc in ([2, 0, 1], [0, 2, 1], [-2, -1, 0.5]):
+        scene.camera.add_keypoint(hg.look_at(loc, [0, 0, 0]))
+    request = hg.LabelRequest(distance=True, map_by=["class", "instance"], depth_background=-1.0)
+    writer = hg.Hdf5SingleFileWriter(tmp_path / "x.hdf5", compression=compression)
+    hg.render_labels(scene, [writer], request)
+    writer.finalize({"object_states": [o.state() for o in scene.objects]})
+    view = hg.RasterView(scene, depth_background=-1.0)
+    with h5py.File(tmp_path / "x.hdf5") as f:
+        assert f["depth"].compression == (None if compression == "none" else compression)
+        for i, pose in enumerate(scene.camera.keypoints):
+            expected = request.compute(view.render_raw(pose), request.lookup_tables(view), scene)
+            for key in ("depth", "distance", "normals", "instance_segmaps", "category_id_segmaps"):
+                np.testing.assert_array_equal(f[key][i], expected[key])
+            assert json.loads(f["instance_attribute_maps"][i]) == expected["instance_attribute_maps"]
+        assert (f["depth"][()] == -1.0).any() and (f["category_id_segmaps"][()] == 4).any()
+        np.testing.assert_array_equal(f["cam2world"][()], np.stack(scene.camera.keypoints))
+
+
+def test_incomplete_file_never_has_the_final_name(tmp_path):
+    writer = hg.Hdf5SingleFileWriter(tmp_path / "data.hdf5")
+    from hybridgen.io.frame_sink import PassLayout
+
+    writer.begin(2, [PassLayout("depth", "float32", (4, 4))], {}, {})
+    writer.write(0, {"depth": np.zeros((4, 4), np.float32)})
+    writer.end()
+    assert not (tmp_path / "data.hdf5").exists()
+    assert len(list(tmp_path.iterdir())) == 1  # the hidden temporary file
+    writer.abort()
+    assert list(tmp_path.iterdir()) == []
