@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Checks the system libraries hybridgen needs and installs the missing ones from Debian when run as root.
 #   - Mesa EGL + the llvmpipe software driver: headless OpenGL for the label rasterizer.
+#   - libLLVM >= 17 for Mitsuba's llvm_ad_rgb variant (Dr.Jit aborts on LLVM 15/16 at its first kernel;
+#     without a usable LLVM hybridgen falls back to the slower scalar_rgb variant).
 # Exit status 0 when everything is there (or was installed), 1 with the command to run otherwise.
 set -euo pipefail
 
@@ -18,6 +20,7 @@ have libEGL_mesa.so.0 || missing+=(libegl-mesa0)
 have libgbm.so.1 || missing+=(libgbm1)
 have libGL.so.1 || missing+=(libgl1)
 have dri/swrast_dri.so || have dri/kms_swrast_dri.so || missing+=(libgl1-mesa-dri)
+have libLLVM-19.so || have libLLVM-18.so || have libLLVM-17.so || have libLLVM.so.19.1 || missing+=(libllvm19)
 
 if [ ${#missing[@]} -eq 0 ]; then
   exit 0

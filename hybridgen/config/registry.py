@@ -23,6 +23,7 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.primitive_loader",
     "hybridgen.modules.camera_loader",
     "hybridgen.modules.segmap_renderer",
+    "hybridgen.modules.rgb_renderer",
     "hybridgen.modules.hdf5_writer",
 )
 

@@ -66,6 +66,23 @@ class Intrinsics:
         """SPEC defaults: 512 x 512, horizontal fov 0.691111 rad, clip 0.1..1000 m."""
         return cls.from_fov(DEFAULT_FOV)
 
+    def resized(self, width: int | None = None, height: int | None = None) -> "Intrinsics":
+        """The same camera at another resolution: K scaled so the image covers the same field of view.
+
+        A missing side keeps the aspect ratio. Pixel centres map as u' + 0.5 = (u + 0.5) * width' / width.
+        """
+        if width is None and height is None:
+            return self
+        new_w = int(width if width is not None else round(self.width * height / self.height))  # type: ignore[operator]
+        new_h = int(height if height is not None else round(self.height * new_w / self.width))
+        sx, sy = new_w / self.width, new_h / self.height
+        K = self.K.copy()
+        K[0, 0] *= sx
+        K[1, 1] *= sy
+        K[0, 2] = (K[0, 2] + 0.5) * sx - 0.5
+        K[1, 2] = (K[1, 2] + 0.5) * sy - 0.5
+        return Intrinsics(K, new_w, new_h, self.clip_start, self.clip_end)
+
     @property
     def resolution(self) -> tuple[int, int]:
         """(width, height) in pixels."""

@@ -1,0 +1,133 @@
+"""The per-keypoint loop every renderer shares: producers make values, sinks (writers) receive them.
+
+A producer is one view of the scene (labels, color, ...). :func:`run_keypoints` asks each producer for
+keypoint i's values and streams their union to the sinks, so color and labels of a keypoint travel
+together. :class:`StereoProducer` turns any producers into left/right pairs.
+"""
+from __future__ import annotations
+
+from typing import Any, Callable, Iterable, Protocol
+
+import numpy as np
+
+from .._version import __version__
+from ..errors import InputError
+from ..io.frame_sink import FrameSink, PassLayout
+from ..scene.scene import Scene
+
+ProgressFactory = Callable[[int, str], Any]
+
+
+class Producer(Protocol):
+    """Makes some output keys of every keypoint.
+
+    ``records`` are whole-run datasets (e.g. poses) it adds; ``eye`` is 0, or 1 for a stereo right eye
+    (producers with randomness draw a different stream for it).
+    """
+
+    def layouts(self) -> list[PassLayout]: ...
+
+    def attributes(self) -> dict[str, Any]: ...
+
+    def records(self) -> dict[str, np.ndarray]: ...
+
+    def produce(self, index: int, cam2world: np.ndarray, eye: int = 0) -> dict[str, Any]: ...
+
+    def close(self) -> None: ...
+
+
+def camera_records(scene: Scene) -> dict[str, np.ndarray]:
+    """``cam_K`` (N,3,3) and ``cam2world`` (N,4,4, OpenCV axes) of every keypoint, float64."""
+    n = len(scene.camera)
+    return {"cam_K": np.repeat(scene.camera.intrinsics.K[None], n, axis=0),
+            "cam2world": np.stack(scene.camera.keypoints) if n else np.zeros((0, 4, 4))}
+
+
+def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Producer], *,
+                  progress: ProgressFactory | None = None, what: str = "keypoints") -> int:
+    """Render every keypoint of ``scene.camera`` with ``producers`` into ``sinks``; returns the count.
+
+    Producers are closed at the end, also on errors.
+    """
+    sinks = list(sinks)
+    try:
+        n = len(scene.camera)
+        if n == 0:
+            raise InputError("the camera has no keypoints: add poses (camera.CameraLoader) before rendering")
+        layouts = [layout for p in producers for layout in p.layouts()]
+        keys = [layout.key for layout in layouts]
+        if len(set(keys)) != len(keys):
+            raise InputError(f"two producers write the same key: {sorted(k for k in keys if keys.count(k) > 1)}")
+        attributes: dict[str, Any] = {"hybridgen_version": __version__}
+        records = camera_records(scene)
+        for producer in producers:
+            attributes.update(producer.attributes())
+            records.update(producer.records())
+        for sink in sinks:
+            sink.begin(n, layouts, records, attributes)
+        bar = progress(n, what) if progress else None
+        for index, pose in enumerate(scene.camera.keypoints):
+            values: dict[str, Any] = {}
+            for producer in producers:
+                values.update(producer.produce(index, pose))
+            for sink in sinks:
+                sink.write(index, values)
+            if bar is not None:
+                bar.update(1)
+        if bar is not None:
+            bar.close()
+        for sink in sinks:
+            sink.end()
+    finally:
+        for producer in producers:
+            producer.close()
+    return n
+
+
+def baseline_shift(cam2world: np.ndarray, baseline: float) -> np.ndarray:
+    """The pose ``baseline`` metres to the right (camera +x, OpenCV axes) of ``cam2world``: the right eye."""
+    shifted = np.array(cam2world, dtype=np.float64)
+    shifted[:3, 3] += shifted[:3, 0] * baseline
+    return shifted
+
+
+class StereoProducer:
+    """Left/right pairs of its producers' values: every key gains a leading axis of 2 (left, right).
+
+    The keypoint pose is the left eye; the right eye is ``baseline`` metres along the camera's +x axis
+    (parallel axes, as BlenderProc's stereo). ``cam2world_right`` records the right poses.
+    """
+
+    def __init__(self, producers: list[Producer], baseline: float, scene: Scene) -> None:
+        if not baseline > 0:
+            raise InputError(f"stereo baseline must be > 0 m, got {baseline}")
+        self.producers, self.baseline, self.scene = producers, float(baseline), scene
+
+    def layouts(self) -> list[PassLayout]:
+        return [PassLayout(l.key, l.dtype, l.shape if l.dtype == "json" else (2, *l.shape))
+                for p in self.producers for l in p.layouts()]
+
+    def attributes(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"stereo_baseline": self.baseline}
+        for producer in self.producers:
+            out.update(producer.attributes())
+        return out
+
+    def records(self) -> dict[str, np.ndarray]:
+        out = {k: v for p in self.producers for k, v in p.records().items()}
+        rights = [baseline_shift(pose, self.baseline) for pose in self.scene.camera.keypoints]
+        return out | {"cam2world_right": np.stack(rights)}
+
+    def produce(self, index: int, cam2world: np.ndarray, eye: int = 0) -> dict[str, Any]:
+        right_pose = baseline_shift(cam2world, self.baseline)
+        out: dict[str, Any] = {}
+        for producer in self.producers:
+            left = producer.produce(index, cam2world, 0)
+            right = producer.produce(index, right_pose, 1)
+            for key, value in left.items():
+                out[key] = np.stack([value, right[key]]) if isinstance(value, np.ndarray) else [value, right[key]]
+        return out
+
+    def close(self) -> None:
+        for producer in self.producers:
+            producer.close()

@@ -1,0 +1,165 @@
+"""Translation of the renderer-agnostic scene into a Mitsuba 3 scene dictionary (done once per run).
+
+Geometry is handed over as in-memory meshes in world coordinates (flat-shaded meshes without vertex
+normals stay flat). Materials become Mitsuba's ``principled`` BSDF; lights map as follows (Blender's
+units, as BlenderProc configs give them):
+
+- POINT of power P [W]: ``point`` with intensity P / (4 pi) [W/sr], uniform in all directions.
+- SPOT: ``spot`` with the same intensity, cutoff = spot_size / 2, falloff from spot_blend.
+- SUN of strength E [W/m^2]: ``directional`` with irradiance E, shining along the light's -z axis.
+- AREA of power P, square of edge ``size``: a one-sided emitting rectangle of radiance P / (size^2 pi),
+  facing the light's -z axis.
+- Emissive materials (``emission`` x ``emission_strength``): an ``area`` emitter on the mesh, radiance
+  emission x strength.
+- World: ``constant`` radiance color x strength, or an ``envmap`` HDRI (scale = strength, rotated about +Z).
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from ..scene.light import Light
+from ..scene.material import Material
+from ..scene.mesh_object import MeshObject
+from ..scene.scene import Scene, World
+
+Y_UP_TO_Z_UP = np.array([[1.0, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1]])
+"""Mitsuba's environment maps are +Y up; this turns them to hybridgen's +Z up."""
+
+
+def _rgb(value: Any) -> dict[str, Any]:
+    return {"type": "rgb", "value": [float(v) for v in list(value)[:3]]}
+
+
+def _texture(material: Material, owner: str) -> dict[str, Any]:
+    import mitsuba as mi
+
+    texture = material.base_color_texture
+    if isinstance(texture, (str, Path)):
+        path = Path(texture)
+        if not path.is_file():
+            raise InputError(f"object '{owner}': texture file not found: '{path}'")
+        return {"type": "bitmap", "filename": str(path)}
+    array = np.ascontiguousarray(np.asarray(texture)[..., :3])
+    if array.dtype != np.uint8 or array.ndim != 3:
+        raise InputError(f"object '{owner}': base_color_texture must be an HxWx3/4 uint8 image")
+    return {"type": "bitmap", "bitmap": mi.Bitmap(array, pixel_format=mi.Bitmap.PixelFormat.RGB),
+            "raw": False}
+
+
+def bsdf_dict(material: Material, owner: str) -> dict[str, Any]:
+    """Mitsuba ``principled`` BSDF of ``material`` (wrapped in ``mask`` when alpha < 1)."""
+    for name in ("roughness", "metallic", "specular", "transmission", "alpha"):
+        value = getattr(material, name)
+        if not (isinstance(value, (int, float)) and 0.0 <= value <= 1.0):
+            raise InputError(f"object '{owner}': material '{material.name}' {name} must be in 0..1, got {value!r}")
+    if material.extra:
+        raise InputError(f"object '{owner}': material '{material.name}' has unsupported parameter(s) "
+                         f"{sorted(material.extra)}")
+    base = _texture(material, owner) if material.base_color_texture is not None else _rgb(material.base_color)
+    bsdf: dict[str, Any] = {
+        "type": "principled", "base_color": base, "roughness": float(material.roughness),
+        "metallic": float(material.metallic), "spec_trans": float(material.transmission),
+    }
+    # Mitsuba's principled BSDF takes either the specular amount or the IOR: transmissive materials are
+    # defined by their IOR, opaque ones by their specular amount (as in Blender's UI).
+    if material.transmission > 0:
+        bsdf["eta"] = float(material.ior)
+    else:
+        bsdf["specular"] = float(material.specular)
+    if material.alpha < 1.0:
+        bsdf = {"type": "mask", "opacity": float(material.alpha), "material": bsdf}
+    return bsdf
+
+
+def mesh_shape(obj: MeshObject) -> Any:
+    """An in-memory Mitsuba mesh of ``obj`` in world coordinates, with its BSDF (and emitter if emissive)."""
+    import mitsuba as mi
+
+    props = mi.Properties()
+    props["bsdf"] = mi.load_dict(bsdf_dict(obj.material, obj.name))
+    radiance = np.asarray(obj.material.emission, float) * float(obj.material.emission_strength)
+    if np.any(radiance < 0) or not np.all(np.isfinite(radiance)):
+        raise InputError(f"object '{obj.name}': emission must be finite and >= 0, got {radiance.tolist()}")
+    if np.any(radiance > 0):
+        props["emitter"] = mi.load_dict({"type": "area", "radiance": _rgb(radiance)})
+    smooth = obj.vertex_normals is not None
+    has_uv = obj.uvs is not None and len(obj.uvs) == len(obj.vertices)
+    mesh = mi.Mesh(obj.name, len(obj.vertices), len(obj.faces), props=props, has_vertex_normals=smooth,
+                   has_vertex_texcoords=has_uv)
+    params = mi.traverse(mesh)
+    params["vertex_positions"] = obj.world_vertices().astype(np.float32).ravel()
+    params["faces"] = obj.faces.astype(np.uint32).ravel()
+    if smooth:
+        normal_matrix = np.linalg.inv(obj.local2world[:3, :3]).T
+        normals = obj.vertex_normals @ normal_matrix.T
+        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
+        params["vertex_normals"] = normals.astype(np.float32).ravel()
+    if has_uv:
+        uv = np.array(obj.uvs, dtype=np.float32)
+        uv[:, 1] = 1.0 - uv[:, 1]  # file UVs have v up; Mitsuba's bitmap rows run top-down
+        params["vertex_texcoords"] = uv.ravel()
+    params.update()
+    del params  # holding traversal wrappers slows later renders (measured in scalar mode)
+    return mesh
+
+
+def light_dict(light: Light) -> dict[str, Any]:
+    """Mitsuba emitter (or emitting rectangle) for ``light``; see the module docstring for units."""
+    import mitsuba as mi
+
+    if not math.isfinite(light.energy) or light.energy < 0:
+        raise InputError(f"light '{light.name}': energy must be >= 0, got {light.energy}")
+    color = np.asarray(light.color, float)
+    position = light.local2world[:3, 3].tolist()
+    if light.type in ("POINT", "SPOT"):
+        intensity = _rgb(color * light.energy / (4 * math.pi))
+        if light.type == "POINT":
+            return {"type": "point", "position": position, "intensity": intensity}
+        cutoff = math.degrees(light.spot_size / 2)
+        # Mitsuba's spot looks along its local +z; hybridgen lights shine along -z.
+        flip = mi.ScalarTransform4f((light.local2world @ np.diag([1.0, -1.0, -1.0, 1.0])).tolist())
+        return {"type": "spot", "to_world": flip, "intensity": intensity, "cutoff_angle": cutoff,
+                "beam_width": cutoff * (1 - min(max(light.spot_blend, 0.0), 1.0))}
+    if light.type == "SUN":
+        direction = (-light.local2world[:3, 2]).tolist()
+        return {"type": "directional", "direction": direction, "irradiance": _rgb(color * light.energy)}
+    # AREA: Mitsuba's rectangle spans [-1, 1]^2 in local xy and faces local +z: scale, then flip to -z.
+    half = light.size / 2
+    shape_to_world = light.local2world @ np.diag([half, -half, -1.0, 1.0])
+    radiance = color * light.energy / (light.size ** 2 * math.pi)
+    return {"type": "rectangle", "to_world": mi.ScalarTransform4f(shape_to_world.tolist()),
+            "bsdf": {"type": "diffuse", "reflectance": _rgb([0, 0, 0])},
+            "emitter": {"type": "area", "radiance": _rgb(radiance)}}
+
+
+def world_dict(world: World) -> dict[str, Any]:
+    """The background emitter."""
+    import mitsuba as mi
+
+    if world.strength < 0 or not math.isfinite(world.strength):
+        raise InputError(f"world strength must be >= 0, got {world.strength}")
+    if world.hdri_path:
+        path = Path(world.hdri_path)
+        if not path.is_file():
+            raise InputError(f"HDRI file not found: '{path}'")
+        rotation = np.eye(4)
+        c, s = math.cos(world.hdri_rotation), math.sin(world.hdri_rotation)
+        rotation[:2, :2] = [[c, -s], [s, c]]
+        return {"type": "envmap", "filename": str(path), "scale": float(world.strength),
+                "to_world": mi.ScalarTransform4f((rotation @ Y_UP_TO_Z_UP).tolist())}
+    return {"type": "constant", "radiance": _rgb(np.asarray(world.color, float) * world.strength)}
+
+
+def scene_dict(scene: Scene) -> dict[str, Any]:
+    """Everything but the sensor and integrator, keyed by stable names."""
+    out: dict[str, Any] = {"type": "scene", "world": world_dict(scene.world)}
+    for obj in scene.objects:
+        out[f"object_{obj.instance_id}"] = mesh_shape(obj)
+    for index, light in enumerate(scene.lights):
+        out[f"light_{index}"] = light_dict(light)
+    return out
