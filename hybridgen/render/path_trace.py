@@ -17,7 +17,8 @@ from ..errors import InputError
 from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
 from .mitsuba_scene import scene_dict
-from .mitsuba_variant import activate, choose_variant
+from . import pinhole_sensor
+from .mitsuba_variant import activate, choose_variant, is_jit
 
 OPENCV_TO_MITSUBA = np.diag([-1.0, -1.0, 1.0, 1.0])
 """Mitsuba's camera looks along +z with +y up and +x to the image's left; OpenCV's x is right, y down."""
@@ -55,13 +56,25 @@ class PathTraceSettings:
                 "hide_emitters": False}
 
 
-def sensor_dict(intr: Intrinsics, cam2world: np.ndarray) -> dict[str, Any]:
-    """A Mitsuba ``perspective`` sensor with the projection of ``intr`` (square pixels) and a box filter."""
+def sensor_dict(intr: Intrinsics, cam2world: np.ndarray, variant: str) -> dict[str, Any]:
+    """The sensor of ``intr`` with a one-pixel box filter.
+
+    JIT variants use :mod:`hybridgen.render.pinhole_sensor` (any K); ``scalar_rgb``, where a Python sensor
+    would run per sample, uses Mitsuba's ``perspective`` sensor, which needs square pixels.
+    """
     import mitsuba as mi
 
+    film = {"type": "hdrfilm", "width": intr.width, "height": intr.height, "pixel_format": "rgb",
+            "rfilter": {"type": "box"}, "sample_border": False}
     fx, fy, cx, cy = intr.K[0, 0], intr.K[1, 1], intr.K[0, 2], intr.K[1, 2]
+    common = {"near_clip": intr.clip_start, "far_clip": intr.clip_end, "film": film,
+              "sampler": {"type": "independent"}}
+    if is_jit(variant):
+        pinhole_sensor.register(variant)
+        return {"type": pinhole_sensor.PLUGIN_NAME, "fx": fx, "fy": fy, "cx": cx, "cy": cy, **common}
     if not math.isclose(fx, fy, rel_tol=1e-9):
-        raise InputError(f"the path tracer needs square pixels (fx == fy), got fx={fx}, fy={fy}")
+        raise InputError(f"fx != fy ({fx} vs {fy}) needs a JIT Mitsuba variant (llvm_ad_rgb or cuda_ad_rgb); "
+                         "scalar_rgb's perspective sensor has square pixels (install libllvm19)")
     return {
         "type": "perspective",
         "fov_axis": "x",
@@ -69,12 +82,8 @@ def sensor_dict(intr: Intrinsics, cam2world: np.ndarray) -> dict[str, Any]:
         # Mitsuba measures the principal point offset in film widths/heights, positive towards -u / -v.
         "principal_point_offset_x": -(cx - (intr.width - 1) / 2) / intr.width,
         "principal_point_offset_y": -(cy - (intr.height - 1) / 2) / intr.height,
-        "near_clip": intr.clip_start,
-        "far_clip": intr.clip_end,
         "to_world": mi.ScalarTransform4f((np.asarray(cam2world) @ OPENCV_TO_MITSUBA).tolist()),
-        "film": {"type": "hdrfilm", "width": intr.width, "height": intr.height, "pixel_format": "rgb",
-                 "rfilter": {"type": "box"}, "sample_border": False},
-        "sampler": {"type": "independent"},
+        **common,
     }
 
 
@@ -92,18 +101,21 @@ class PathTraceView:
         description = scene_dict(scene)
         description["integrator"] = integrator or self.settings.integrator()
         first = scene.camera.keypoints[0] if scene.camera.keypoints else np.eye(4)
-        description["sensor"] = sensor_dict(self.intrinsics, first)
+        description["sensor"] = sensor_dict(self.intrinsics, first, self.variant)
         try:
             self.mi_scene = mi.load_dict(description)
         except RuntimeError as exc:
             raise InputError(f"Mitsuba could not build the scene: {str(exc).splitlines()[-1]}") from None
         self.sensor = self.mi_scene.sensors()[0]
-        self._sensor_params = mi.traverse(self.sensor)
+        self._sensor_params = None if is_jit(self.variant) else mi.traverse(self.sensor)
 
     def set_pose(self, cam2world: np.ndarray) -> None:
         """Move the sensor to an OpenCV-axes ``cam2world`` (nothing else is rebuilt)."""
         import mitsuba as mi
 
+        if self._sensor_params is None:  # the pinhole sensor holds its pose as an opaque variable
+            self.sensor.set_pose(cam2world)
+            return
         self._sensor_params["to_world"] = mi.ScalarTransform4f((np.asarray(cam2world) @ OPENCV_TO_MITSUBA).tolist())
         self._sensor_params.update()
 
