@@ -88,7 +88,8 @@ def contact_sheet(tiles: Sequence[tuple[str, Image.Image]], columns: int = 3) ->
 
 def image_keys(h5: h5py.File) -> list[str]:
     """Keys of ``h5`` holding per-keypoint images (N, H, W[, C])."""
-    return [k for k in h5 if isinstance(h5[k], h5py.Dataset) and h5[k].ndim >= 3 and k not in ("cam_K", "cam2world")]
+    keys = [k for k in h5 if isinstance(h5[k], h5py.Dataset) and h5[k].ndim >= 3 and not k.startswith("cam")]
+    return sorted(keys, key=lambda k: (not k.startswith("colors"), k))
 
 
 def save_contact_sheets(files: Iterable[str | Path], out_dir: str | Path,

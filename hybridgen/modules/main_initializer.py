@@ -7,6 +7,11 @@ from ..run.context import DEFAULT_SEED, RunContext
 from .base import Module
 
 
+def _color_check(value: list) -> str | None:
+    ok = len(value) == 3 and all(isinstance(c, (int, float)) and not isinstance(c, bool) and c >= 0 for c in value)
+    return None if ok else f"must be 3 numbers >= 0, got {value!r}"
+
+
 @register_module("main.Initializer")
 class Initializer(Module):
     """Sets the root seed every random draw of the run derives from, and run-wide defaults."""
@@ -16,8 +21,21 @@ class Initializer(Module):
               check=lambda v: None if v >= 0 else "must be >= 0"),
         Param("default_category_id", "int|null", None,
               doc="category_id for objects that have none (otherwise class segmentation fails naming them)"),
+        Param("horizon_color", "list", [0.05, 0.05, 0.05], doc="world background radiance, linear RGB",
+              check=_color_check),
+        Param("world_strength", "float", 1.0, doc="multiplies the world background (color or HDRI)",
+              check=lambda v: None if v >= 0 else "must be >= 0"),
+        Param("hdri_path", "path|null", None, doc="HDR environment map (.exr/.hdr) lighting the scene"),
+        Param("hdri_rotation", "float", 0.0, "rad", "rotation of the environment map about world +Z"),
     )
 
     def run(self, context: RunContext) -> None:
-        context.set_seed(self.config["seed"])
-        context.default_category_id = self.config["default_category_id"]
+        cfg = self.config
+        context.set_seed(cfg["seed"])
+        context.default_category_id = cfg["default_category_id"]
+        world = context.scene.world
+        world.color = tuple(float(c) for c in cfg["horizon_color"])  # type: ignore[assignment]
+        world.strength = float(cfg["world_strength"])
+        world.hdri_path = cfg["hdri_path"]
+        world.hdri_rotation = float(cfg["hdri_rotation"])
+

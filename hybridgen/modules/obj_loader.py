@@ -6,7 +6,7 @@ from ..config.schema import Param
 from ..io.mesh_loader import LOADERS, load_objects
 from ..run.context import RunContext
 from .base import Module
-from .placement import PLACEMENT_PARAMS, placement_pose
+from .placement import PLACEMENT_PARAMS, apply_placement, placement_pose
 
 
 @register_module("loader.ObjLoader")
@@ -25,5 +25,5 @@ class ObjLoader(Module):
         objects = load_objects(cfg["path"], name=cfg["name"], category_id=cfg["category_id"],
                                local2world=placement_pose(cfg), up_axis=cfg["up_axis"],
                                attributes=cfg["attributes"])
-        for obj in objects:
+        for obj in apply_placement(objects, cfg):
             context.scene.add(obj)

@@ -5,7 +5,9 @@ from typing import Any
 
 import numpy as np
 
+from ..config.material_config import apply_material_config
 from ..config.schema import Param
+from ..scene.mesh_object import MeshObject
 from ..io.mesh_loader import object_pose
 
 
@@ -26,7 +28,17 @@ PLACEMENT_PARAMS: tuple[Param, ...] = (
     Param("location", "vec3", [0.0, 0.0, 0.0], "m", "position in world coordinates"),
     Param("rotation", "vec3", [0.0, 0.0, 0.0], "rad", "Euler XYZ angles, as in Blender"),
     Param("scale", "float|list", 1.0, "", "uniform scale or [sx, sy, sz]", check=_scale_check),
+    Param("material", "dict", {}, doc="principled values replacing the file's: base_color, base_color_texture "
+          "(path), roughness, metallic, specular, transmission, ior, alpha, emission, emission_strength"),
 )
+
+
+def apply_placement(objects: list[MeshObject], config: dict[str, Any]) -> list[MeshObject]:
+    """Apply the loader's ``material`` overrides to freshly loaded objects (poses are set at load)."""
+    if config["material"]:
+        for obj in objects:
+            obj.material = apply_material_config(obj.material, config["material"])
+    return objects
 
 
 def placement_pose(config: dict[str, Any]) -> np.ndarray:

@@ -6,7 +6,7 @@ from ..config.schema import Param, positive
 from ..run.context import RunContext
 from ..scene.primitives import PRIMITIVES, make_primitive
 from .base import Module
-from .placement import PLACEMENT_PARAMS, placement_pose
+from .placement import PLACEMENT_PARAMS, apply_placement, placement_pose
 
 
 def _color_check(value: object) -> str | None:
@@ -30,6 +30,7 @@ class PrimitiveLoader(Module):
 
     def run(self, context: RunContext) -> None:
         cfg = self.config
-        context.scene.add(make_primitive(cfg["shape"], cfg["size"], name=cfg["name"],
-                                         category_id=cfg["category_id"], local2world=placement_pose(cfg),
-                                         color=cfg["color"], attributes=cfg["attributes"]))
+        obj = make_primitive(cfg["shape"], cfg["size"], name=cfg["name"], category_id=cfg["category_id"],
+                             local2world=placement_pose(cfg), color=cfg["color"], attributes=cfg["attributes"])
+        for placed in apply_placement([obj], cfg):
+            context.scene.add(placed)

@@ -10,7 +10,8 @@ units, as BlenderProc configs give them):
 - AREA of power P, square of edge ``size``: a one-sided emitting rectangle of radiance P / (size^2 pi),
   facing the light's -z axis.
 - Emissive materials (``emission`` x ``emission_strength``): an ``area`` emitter on the mesh, radiance
-  emission x strength.
+  emission x strength, on both sides (a flipped copy a hair behind the surface emits backwards).
+- Opaque BSDFs are two-sided (Mitsuba's are one-sided; Blender's and most real meshes' are not).
 - World: ``constant`` radiance color x strength, or an ``envmap`` HDRI (scale = strength, rotated about +Z).
 """
 from __future__ import annotations
@@ -61,43 +62,75 @@ def bsdf_dict(material: Material, owner: str) -> dict[str, Any]:
         raise InputError(f"object '{owner}': material '{material.name}' has unsupported parameter(s) "
                          f"{sorted(material.extra)}")
     base = _texture(material, owner) if material.base_color_texture is not None else _rgb(material.base_color)
-    bsdf: dict[str, Any] = {
-        "type": "principled", "base_color": base, "roughness": float(material.roughness),
-        "metallic": float(material.metallic), "spec_trans": float(material.transmission),
-    }
-    # Mitsuba's principled BSDF takes either the specular amount or the IOR: transmissive materials are
-    # defined by their IOR, opaque ones by their specular amount (as in Blender's UI).
-    if material.transmission > 0:
-        bsdf["eta"] = float(material.ior)
+    bsdf: dict[str, Any]
+    if material.specular == 0 and material.metallic == 0 and material.transmission == 0:
+        # A principled material without specular, metal or transmission is Lambertian (as Blender 4's).
+        bsdf = {"type": "diffuse", "reflectance": base}
     else:
-        bsdf["specular"] = float(material.specular)
+        bsdf = {"type": "principled", "base_color": base, "roughness": float(material.roughness),
+                "metallic": float(material.metallic), "spec_trans": float(material.transmission)}
+        # Mitsuba's principled BSDF takes either the specular amount or the IOR: transmissive materials are
+        # defined by their IOR, opaque ones by their specular amount (as in Blender's UI).
+        if material.transmission > 0:
+            bsdf["eta"] = float(material.ior)
+        else:
+            bsdf["specular"] = float(material.specular)
+    if material.transmission == 0:
+        # Mitsuba's opaque BSDFs are one-sided; Blender (and real meshes with mixed windings) need both sides.
+        bsdf = {"type": "twosided", "material": bsdf}
     if material.alpha < 1.0:
         bsdf = {"type": "mask", "opacity": float(material.alpha), "material": bsdf}
     return bsdf
 
 
-def mesh_shape(obj: MeshObject) -> Any:
-    """An in-memory Mitsuba mesh of ``obj`` in world coordinates, with its BSDF (and emitter if emissive)."""
+def emitted_radiance(obj: MeshObject) -> np.ndarray:
+    """Linear RGB radiance (W sr^-1 m^-2) the object's surface emits: emission x emission_strength."""
+    radiance = np.asarray(obj.material.emission, float)[:3] * float(obj.material.emission_strength)
+    if np.any(radiance < 0) or not np.all(np.isfinite(radiance)):
+        raise InputError(f"object '{obj.name}': emission must be finite and >= 0, got {radiance.tolist()}")
+    return radiance
+
+
+def _world_normals(obj: MeshObject) -> np.ndarray:
+    """Unit vertex normals in world axes: the mesh's own, else area-weighted face normals."""
+    import trimesh
+
+    local = obj.vertex_normals if obj.vertex_normals is not None else \
+        trimesh.Trimesh(obj.vertices, obj.faces, process=False).vertex_normals
+    normals = local @ np.linalg.inv(obj.local2world[:3, :3])
+    return normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
+
+
+def mesh_shape(obj: MeshObject, *, back_side: bool = False) -> Any:
+    """An in-memory Mitsuba mesh of ``obj`` in world coordinates, with its BSDF (and emitter if emissive).
+
+    ``back_side`` gives the emitting back of an emissive mesh: faces flipped and moved a hair (1e-6 of the
+    object's size) behind the surface, so each side emits once, like Blender's two-sided emission.
+    """
     import mitsuba as mi
 
     props = mi.Properties()
     props["bsdf"] = mi.load_dict(bsdf_dict(obj.material, obj.name))
-    radiance = np.asarray(obj.material.emission, float) * float(obj.material.emission_strength)
-    if np.any(radiance < 0) or not np.all(np.isfinite(radiance)):
-        raise InputError(f"object '{obj.name}': emission must be finite and >= 0, got {radiance.tolist()}")
+    radiance = emitted_radiance(obj)
     if np.any(radiance > 0):
         props["emitter"] = mi.load_dict({"type": "area", "radiance": _rgb(radiance)})
     smooth = obj.vertex_normals is not None
     has_uv = obj.uvs is not None and len(obj.uvs) == len(obj.vertices)
-    mesh = mi.Mesh(obj.name, len(obj.vertices), len(obj.faces), props=props, has_vertex_normals=smooth,
+    name = obj.name + (".back" if back_side else "")
+    mesh = mi.Mesh(name, len(obj.vertices), len(obj.faces), props=props, has_vertex_normals=smooth,
                    has_vertex_texcoords=has_uv)
     params = mi.traverse(mesh)
-    params["vertex_positions"] = obj.world_vertices().astype(np.float32).ravel()
-    params["faces"] = obj.faces.astype(np.uint32).ravel()
+    positions, faces = obj.world_vertices(), obj.faces
+    normals = _world_normals(obj) if smooth or back_side else None
+    if back_side:
+        assert normals is not None
+        size = float(np.linalg.norm(np.ptp(positions, axis=0)))
+        positions = positions - normals * (1e-6 * max(size, 1e-3))
+        faces, normals = faces[:, ::-1], -normals
+    params["vertex_positions"] = positions.astype(np.float32).ravel()
+    params["faces"] = faces.astype(np.uint32).ravel()
     if smooth:
-        normal_matrix = np.linalg.inv(obj.local2world[:3, :3]).T
-        normals = obj.vertex_normals @ normal_matrix.T
-        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
+        assert normals is not None
         params["vertex_normals"] = normals.astype(np.float32).ravel()
     if has_uv:
         uv = np.array(obj.uvs, dtype=np.float32)
@@ -160,6 +193,8 @@ def scene_dict(scene: Scene) -> dict[str, Any]:
     out: dict[str, Any] = {"type": "scene", "world": world_dict(scene.world)}
     for obj in scene.objects:
         out[f"object_{obj.instance_id}"] = mesh_shape(obj)
+        if np.any(emitted_radiance(obj) > 0):
+            out[f"object_{obj.instance_id}_back"] = mesh_shape(obj, back_side=True)
     for index, light in enumerate(scene.lights):
         out[f"light_{index}"] = light_dict(light)
     return out

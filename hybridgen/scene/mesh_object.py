@@ -76,6 +76,7 @@ class MeshObject:
         import trimesh
 
         mesh = trimesh.Trimesh(self.vertices, self.faces, process=False)
+        mesh.merge_vertices(merge_tex=True, merge_norm=True)  # UV and normal seams do not open a volume
         return bool(mesh.is_watertight and mesh.is_winding_consistent and mesh.volume > 0)
 
     @property

@@ -1,0 +1,59 @@
+"""Material values given in a config (``material: {...}`` on loaders), validated key by key."""
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+from ..errors import ConfigError
+from ..scene.material import Material
+from .schema import closest
+
+_UNIT_KEYS = ("roughness", "metallic", "specular", "transmission", "alpha")
+_COLOR_KEYS = {"base_color": (3, 4), "emission": (3, 3)}
+KNOWN_KEYS = (*_UNIT_KEYS, *_COLOR_KEYS, "emission_strength", "ior", "base_color_texture", "name")
+
+
+def _number(value: Any, key: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ConfigError(f"must be a finite number, got {value!r}", key=f"material.{key}")
+    return float(value)
+
+
+def apply_material_config(material: Material, config: dict[str, Any]) -> Material:
+    """A copy of ``material`` with the config's values; errors name ``material.<key>``."""
+    values: dict[str, Any] = {}
+    for key, value in config.items():
+        if key not in KNOWN_KEYS:
+            raise ConfigError(f"unsupported material parameter{closest(key, KNOWN_KEYS)}; supported: "
+                              f"{', '.join(KNOWN_KEYS)}", key=f"material.{key}")
+        if key in _UNIT_KEYS:
+            number = _number(value, key)
+            if not 0.0 <= number <= 1.0:
+                raise ConfigError(f"must be in 0..1, got {value!r}", key=f"material.{key}")
+            values[key] = number
+        elif key in _COLOR_KEYS:
+            low, high = _COLOR_KEYS[key]
+            if not isinstance(value, list) or not low <= len(value) <= high:
+                raise ConfigError(f"must be a list of {low}{'' if low == high else f'-{high}'} numbers",
+                                  key=f"material.{key}")
+            channels = [_number(v, key) for v in value]
+            if any(c < 0 for c in channels) or (key == "base_color" and any(c > 1 for c in channels)):
+                raise ConfigError(f"channels must be {'in 0..1' if key == 'base_color' else '>= 0'}, got {value}",
+                                  key=f"material.{key}")
+            values[key] = tuple(channels + [1.0] * (high - len(channels)))
+        elif key == "emission_strength":
+            number = _number(value, key)
+            if number < 0:
+                raise ConfigError(f"must be >= 0, got {value!r}", key=f"material.{key}")
+            values[key] = number
+        elif key == "ior":
+            number = _number(value, key)
+            if not 1.0 <= number <= 5.0:
+                raise ConfigError(f"must be in 1..5, got {value!r}", key=f"material.{key}")
+            values[key] = number
+        else:
+            if not isinstance(value, str) or not value:
+                raise ConfigError(f"must be a non-empty string, got {value!r}", key=f"material.{key}")
+            values[key] = value
+    return dataclasses.replace(material, **values)
