@@ -66,6 +66,20 @@ CASES = {
     "missing_category": (_replace("category_id: 1", "name: anon"), ["out"], ["no category_id", "'anon'"]),
     "unknown_global_key": (config_text().replace("output_dir:", "output_dri: x\n    output_dir:"), ["out"],
                            ["global.all.output_dri", "did you mean 'output_dir'"]),
+    "unsupported_material_parameter": (_replace("category_id: 1", "category_id: 1, material: {shinyness: 1}"),
+                                       ["out"], ["loader.PrimitiveLoader", "material.shinyness",
+                                                 "unsupported material parameter"]),
+    "missing_texture": (config_text(GOOD_MODULES.replace("category_id: 1", "category_id: 1, material: "
+                                                         "{base_color_texture: nowhere/wood.png}")
+                                    .replace("renderer.SegMapRenderer", "renderer.RgbRenderer\n    config: "
+                                             "{samples: 1}")), ["out"],
+                        ["renderer.RgbRenderer", "object 'cube'", "texture file not found", "wood.png"]),
+    "negative_light_energy": (config_text(GOOD_MODULES.replace(
+        "  - name: camera", "  - name: lighting.LightLoader\n    config: {lights: [{type: POINT, energy: -5}]}\n"
+        "  - name: camera")), ["out"], ["lighting.LightLoader", "lights[0].energy", ">= 0"]),
+    "zero_samples": (config_text(GOOD_MODULES.replace("renderer.SegMapRenderer", "renderer.RgbRenderer\n    config: "
+                                                      "{samples: 0}")), ["out"],
+                     ["renderer.RgbRenderer", "key 'samples'", "must be > 0"]),
     "setup_pip_missing": ("setup:\n  pip: [surely-not-installed-pkg]\n" + config_text(), ["out"],
                           ["setup.pip", "surely-not-installed-pkg", "pip install"]),
 }

@@ -1,0 +1,36 @@
+"""A frame sink that keeps every keypoint's values in memory (for notebooks, tests, custom pipelines)."""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .frame_sink import PassLayout
+
+
+class MemorySink:
+    """Collects ``frames[i][key]`` for every keypoint i; ``records`` and ``attributes`` as given by renderers."""
+
+    def __init__(self) -> None:
+        self.frames: list[dict[str, Any]] = []
+        self.layouts: dict[str, PassLayout] = {}
+        self.records: dict[str, np.ndarray] = {}
+        self.attributes: dict[str, Any] = {}
+
+    def begin(self, n_keypoints: int, layouts: list[PassLayout], camera_records: dict[str, np.ndarray],
+              attributes: dict[str, Any]) -> None:
+        while len(self.frames) < n_keypoints:
+            self.frames.append({})
+        self.layouts.update({layout.key: layout for layout in layouts})
+        self.records.update(camera_records)
+        self.attributes.update(attributes)
+
+    def write(self, index: int, values: dict[str, Any]) -> None:
+        self.frames[index].update(values)
+
+    def end(self) -> None:
+        """Nothing to flush."""
+
+    def stacked(self, key: str) -> np.ndarray:
+        """All keypoints' ``key`` as one array with a leading keypoint axis."""
+        return np.stack([frame[key] for frame in self.frames])
