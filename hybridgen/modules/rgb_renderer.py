@@ -31,6 +31,8 @@ class RgbRenderer(Module):
         Param("resolution_x", "int|null", None, "px", "overrides the camera width (K scaled)"),
         Param("resolution_y", "int|null", None, "px", "overrides the camera height (K scaled)"),
         Param("output_hdr", "bool", False, doc="also write linear colors_hdr (float16)"),
+        Param("denoise", "bool", False, doc="Open Image Denoise (needs pyoidn) guided by the raster albedo and "
+              "normals; colors_hdr is the denoised image too"),
         Param("stereo", "bool", False, doc="render left/right pairs (every key gains a leading axis of 2)"),
         Param("interocular_distance", "float", 0.065, "m", "stereo baseline", check=positive),
         Param("variant", "str", "auto", choices=("auto", "cuda_ad_rgb", "llvm_ad_rgb", "scalar_rgb"),
@@ -48,6 +50,6 @@ class RgbRenderer(Module):
         settings = PathTraceSettings(cfg["samples"], cfg["min_bounces"], cfg["max_bounces"], cfg["glossy_bounces"])
         context.frames_rendered += render_color(
             scene, context.sinks, settings, labels=request if wants_labels else None, seed=context.seed,
-            variant=cfg["variant"], hdr=cfg["output_hdr"],
+            variant=cfg["variant"], hdr=cfg["output_hdr"], denoise=cfg["denoise"],
             stereo_baseline=cfg["interocular_distance"] if cfg["stereo"] else None,
             default_category_id=context.default_category_id, progress=context.progress)

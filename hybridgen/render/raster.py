@@ -24,9 +24,13 @@ NORMAL_SPACES = ("camera", "world")
 
 
 @dataclass
-class _GpuObject:
+class GpuObject:
+    """GL resources of one scene object (vertex positions and indices are shared with other passes)."""
+
     instance_id: int
     vao: Any
+    positions: Any
+    indices: Any
     buffers: list[Any]
     face_normals: Any
     smooth: bool
@@ -53,14 +57,14 @@ class RasterView:
         self.ctx = ctx if ctx is not None else shared_context(device_index)
         self.program = self.ctx.program(vertex_shader=shader_source("labels.vert"),
                                         fragment_shader=shader_source("labels.frag"))
-        self._objects = [self._upload(obj) for obj in scene.objects]
+        self.gpu_objects = [self._upload(obj) for obj in scene.objects]
         self._fbo: Any = None
         self._fbo_size: tuple[int, int] | None = None
         self._ray_lengths: np.ndarray | None = None
         self._ray_key: Any = None
 
     # ----------------------------------------------------------------- resources
-    def _upload(self, obj: Any) -> _GpuObject:
+    def _upload(self, obj: Any) -> GpuObject:
         ctx = self.ctx
         positions = ctx.buffer(obj.vertices.astype(np.float32).tobytes())
         indices = ctx.buffer(obj.faces.astype(np.uint32).tobytes())
@@ -73,8 +77,8 @@ class RasterView:
             content.append((normals, "3f", "in_normal"))
             buffers.append(normals)
         vao = ctx.vertex_array(self.program, content, index_buffer=indices, index_element_size=4)
-        return _GpuObject(obj.instance_id, vao, buffers, face_normals, smooth, obj.is_closed,
-                          obj.bounds_local, obj.local2world)
+        return GpuObject(obj.instance_id, vao, positions, indices, buffers, face_normals, smooth,
+                         obj.is_closed, obj.bounds_local, obj.local2world)
 
     def _framebuffer(self, width: int, height: int) -> Any:
         if self._fbo_size != (width, height):
@@ -126,7 +130,7 @@ class RasterView:
         prog["u_cam_to_output"].write(to_output.T.astype(np.float32).tobytes())
         near_reach = near_plane_corner_distance(intr.K, width, height, intr.clip_start)
         cam_pos = cam2world[:3, 3]
-        for gpu, obj in zip(self._objects, self.scene.objects):
+        for gpu, obj in zip(self.gpu_objects, self.scene.objects):
             modelview = world2cam @ obj.local2world
             linear = modelview[:3, :3]
             det = np.linalg.det(linear)
@@ -169,12 +173,12 @@ class RasterView:
 
     def release(self) -> None:
         """Free the GL resources of this view (the context stays)."""
-        for gpu in self._objects:
+        for gpu in self.gpu_objects:
             gpu.vao.release()
             gpu.face_normals.release()
             for buf in gpu.buffers:
                 buf.release()
-        self._objects = []
+        self.gpu_objects = []
         if self._fbo is not None:
             self._fbo.release()
             self._fbo = None

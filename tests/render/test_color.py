@@ -164,3 +164,39 @@ def test_path_trace_settings_validation():
         PathTraceSettings(max_bounces=8, glossy_bounces=4)
     assert PathTraceSettings(min_bounces=1, max_bounces=3).integrator() == {
         "type": "path", "max_depth": 5, "rr_depth": 3, "hide_emitters": False}
+
+
+def test_raster_albedo_matches_mitsuba_albedo_aov(gl_context, variant):
+    """The denoiser's guide: our raster albedo (textures included) against Mitsuba's own albedo AOV."""
+    from hybridgen.render.albedo_pass import AlbedoPass
+    from tests.conftest import REPO
+
+    scene = _objects_scene(*ALIGNMENT_CAMERAS["centred"])
+    for obj in hg.load_objects(REPO / "configs/assets/crate.obj", name="crate", category_id=5,
+                               local2world=hg.object_pose([0.6, -0.2, 1.4], [0.2, 0.1, 0.5], 0.8)):
+        scene.add(obj)
+    scene.objects[1].material.base_color = (0.9, 0.3, 0.2, 1.0)
+    pose = scene.camera.keypoints[0]
+    raster = hg.RasterView(scene)
+    ours = AlbedoPass(raster).render(pose)
+    aov = PathTraceView(scene, variant=variant, integrator={"type": "aov", "aovs": "a:albedo"}).render(
+        pose, seed=1, spp=16)
+    ids = raster.render(pose, ["instance_segmaps"])["instance_segmaps"]
+    interior = ~_silhouette(ids) & (ids > 0)  # the background's albedo is the world color here, 0 in the AOV
+    difference = np.abs(ours - aov)[interior]
+    assert np.median(difference) < 1e-3 and np.percentile(difference, 95) < 0.02
+    crate = ids == 5
+    assert crate.sum() > 50 and ours[crate].std() > 0.02  # the texture shows
+
+
+def test_denoising_guided_by_raster_passes_improves_psnr(gl_context, variant):
+    pytest.importorskip("pyoidn")
+    scene = _objects_scene(*ALIGNMENT_CAMERAS["centred"])
+    scene.lights.append(hg.Light("sun", "SUN", energy=2.0, local2world=hg.object_pose([0, 0, 5], [0.4, 0.2, 0])))
+    pose = scene.camera.keypoints[0]
+    reference = PathTraceView(scene, PathTraceSettings(samples=256, max_bounces=2), variant=variant).render(pose, 7)
+    settings = PathTraceSettings(samples=4, max_bounces=2)
+    noisy = ColorProducer(scene, settings, seed=3, variant=variant, hdr=True).produce(0, pose)["colors_hdr"]
+    clean = ColorProducer(scene, settings, seed=3, variant=variant, hdr=True, denoise=True).produce(0, pose)
+    psnr = lambda x: -10 * np.log10(np.mean((np.clip(x.astype(np.float32), 0, 1) - np.clip(reference, 0, 1)) ** 2))  # noqa: E731
+    assert psnr(clean["colors_hdr"]) > psnr(noisy) + 6
