@@ -30,7 +30,7 @@ class PathTraceSettings:
 
     Bounces count as in Cycles: ``max_bounces`` 0 is direct light only. Mitsuba's ``path`` integrator counts
     path segments, so ``max_depth = max_bounces + 2`` and Russian roulette starts at
-    ``rr_depth = min_bounces + 2``. Mitsuba has a single depth limit for all lobes, so ``glossy_bounces``
+    ``rr_depth = min(min_bounces, max_bounces) + 2``. Mitsuba has a single depth limit for all lobes, so ``glossy_bounces``
     is the stricter of the two only when it is not smaller than ``max_bounces``; a smaller value is
     rejected rather than silently ignored.
     """
@@ -45,14 +45,13 @@ class PathTraceSettings:
             raise InputError(f"samples must be >= 1, got {self.samples}")
         if self.min_bounces < 0 or self.max_bounces < 0:
             raise InputError("min_bounces and max_bounces must be >= 0")
-        if self.min_bounces > self.max_bounces:
-            raise InputError(f"min_bounces ({self.min_bounces}) must be <= max_bounces ({self.max_bounces})")
         if self.glossy_bounces is not None and self.glossy_bounces < self.max_bounces:
             raise InputError(f"glossy_bounces ({self.glossy_bounces}) < max_bounces ({self.max_bounces}) cannot "
                              "be honoured: Mitsuba's path tracer has one depth limit for every lobe")
 
     def integrator(self) -> dict[str, Any]:
-        return {"type": "path", "max_depth": self.max_bounces + 2, "rr_depth": self.min_bounces + 2,
+        rr_depth = min(self.min_bounces, self.max_bounces) + 2  # no roulette needed past the last bounce
+        return {"type": "path", "max_depth": self.max_bounces + 2, "rr_depth": rr_depth,
                 "hide_emitters": False}
 
 
