@@ -58,34 +58,38 @@ class LabelRequest:
             out.append(PassLayout("instance_attribute_maps", "json", ()))
         return out
 
-    def lookup_tables(self, view: Any) -> dict[str, np.ndarray]:
-        """instance id -> value tables of each segmap attribute (built once per run)."""
-        return {a: view.category_lut(a) for a in self.segmap_attributes()}
+    def tables(self, view: Any) -> "LabelTables":
+        """Per-object lookups the keypoints share (built once per view)."""
+        luts = {a: view.category_lut(a) for a in self.segmap_attributes()}
+        records = {o.instance_id: {k: v for k, v in o.state().items() if k != "local2world"}
+                   for o in view.scene.objects}
+        return LabelTables(luts, records)
 
-    def compute(self, raw: RasterOutput, luts: dict[str, np.ndarray], scene: Scene) -> dict[str, Any]:
+    def compute(self, raw: RasterOutput, tables: "LabelTables") -> dict[str, Any]:
         """All requested values of one keypoint from its raster readback."""
         values: dict[str, Any] = {}
         for flag, key in ((self.depth, "depth"), (self.distance, "distance"), (self.normals, "normals")):
             if flag:
                 values[key] = PASSES[key].compute(raw)
-        for attribute, lut in luts.items():
+        for attribute, lut in tables.luts.items():
             values[f"{attribute}_segmaps"] = lut[raw.instance]
         if self.wants_instances:
             values["instance_segmaps"] = raw.instance.astype(np.int32)
-            values["instance_attribute_maps"] = visible_instances(raw.instance, scene)
+            values["instance_attribute_maps"] = tables.visible(raw.instance)
         return values
 
 
-def visible_instances(instance: np.ndarray, scene: Scene) -> list[dict[str, Any]]:
-    """``[{"idx", "category_id", "name", custom attributes...}]`` for each instance id present in the map."""
-    counts = np.bincount(instance.ravel(), minlength=1)
-    present = set(int(i) for i in np.flatnonzero(counts) if i != 0)
-    records = []
-    for obj in scene.objects:
-        if obj.instance_id in present:
-            record = {k: v for k, v in obj.state().items() if k != "local2world"}
-            records.append(record)
-    return records
+@dataclass
+class LabelTables:
+    """``luts``: instance id -> segmap value per attribute; ``records``: instance id -> JSON record."""
+
+    luts: dict[str, np.ndarray]
+    records: dict[int, dict[str, Any]]
+
+    def visible(self, instance: np.ndarray) -> list[dict[str, Any]]:
+        """``[{"idx", "category_id", "name", custom attributes...}]`` of each instance in the map, by id."""
+        present = np.flatnonzero(np.bincount(instance.ravel()))
+        return [self.records[int(i)] for i in present if i != 0]
 
 
 def parse_map_by(value: str | list[str]) -> list[str]:

@@ -58,6 +58,10 @@ class RasterView:
         self.program = self.ctx.program(vertex_shader=shader_source("labels.vert"),
                                         fragment_shader=shader_source("labels.frag"))
         self.gpu_objects = [self._upload(obj) for obj in scene.objects]
+        try:  # instance id -> category_id, for the category_id_segmaps pass (0 where an object has none)
+            self._class_lut = self.category_lut()
+        except InputError:
+            self._class_lut = np.zeros(len(scene.objects) + 1, dtype=np.int32)
         self._fbo: Any = None
         self._fbo_size: tuple[int, int] | None = None
         self._ray_lengths: np.ndarray | None = None
@@ -153,13 +157,7 @@ class RasterView:
         instance = np.empty((height, width), dtype=np.uint32)
         fbo.read_into(normal_depth, attachment=0, components=4, dtype="f4")
         fbo.read_into(instance, attachment=1, components=1, dtype="u4")
-        return RasterOutput(normal_depth, instance, self._rays(intr), self._lut_cached(), self.depth_background)
-
-    def _lut_cached(self) -> np.ndarray:
-        try:
-            return self.category_lut()
-        except InputError:
-            return np.zeros(len(self.scene.objects) + 1, dtype=np.int32)
+        return RasterOutput(normal_depth, instance, self._rays(intr), self._class_lut, self.depth_background)
 
     def render(self, cam2world: np.ndarray, passes: Iterable[str] = ("depth", "normals", "instance_segmaps"),
                intrinsics: Intrinsics | None = None) -> dict[str, np.ndarray]:

@@ -28,7 +28,7 @@ class LabelProducer:
         self._own_view = view is None
         self.view = view or RasterView(scene, normals_space=request.normals_space,
                                        depth_background=request.depth_background)
-        self._luts = request.lookup_tables(self.view)
+        self._tables = request.tables(self.view)
 
     def layouts(self) -> list[PassLayout]:
         intr = self.scene.camera.intrinsics
@@ -41,7 +41,7 @@ class LabelProducer:
         return {}
 
     def produce(self, index: int, cam2world: np.ndarray, eye: int = 0) -> dict[str, Any]:
-        return self.request.compute(self.view.render_raw(cam2world), self._luts, self.scene)
+        return self.request.compute(self.view.render_raw(cam2world), self._tables)
 
     def close(self) -> None:
         if self._own_view:

@@ -97,7 +97,7 @@ def test_compressions_read_back_identically(gl_context, tmp_path, compression):
     with h5py.File(tmp_path / "x.hdf5") as f:
         assert f["depth"].compression == (None if compression == "none" else compression)
         for i, pose in enumerate(scene.camera.keypoints):
-            expected = request.compute(view.render_raw(pose), request.lookup_tables(view), scene)
+            expected = request.compute(view.render_raw(pose), request.tables(view))
             for key in ("depth", "distance", "normals", "instance_segmaps", "category_id_segmaps"):
                 np.testing.assert_array_equal(f[key][i], expected[key])
             assert json.loads(f["instance_attribute_maps"][i]) == expected["instance_attribute_maps"]

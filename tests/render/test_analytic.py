@@ -119,7 +119,7 @@ def test_id_layout_per_pixel_with_edges_off_centre(gl_context):
     np.testing.assert_allclose(out["depth"], expected_depth, rtol=1e-6)
     request = hg.LabelRequest(map_by=["class", "instance"])
     view = hg.RasterView(scene)
-    values = request.compute(view.render_raw(scene.camera.keypoints[0]), request.lookup_tables(view), scene)
+    values = request.compute(view.render_raw(scene.camera.keypoints[0]), request.tables(view))
     np.testing.assert_array_equal(values["category_id_segmaps"], np.array([0, 7, 8, 9])[expected])
     assert [r["idx"] for r in values["instance_attribute_maps"]] == [1, 2, 3]
 
