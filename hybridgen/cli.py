@@ -30,7 +30,8 @@ def _progress_factory(enabled: bool) -> Any:
 def _cmd_run(ns: argparse.Namespace) -> int:
     from .run.pipeline import run_config
 
-    summary = run_config(ns.config, ns.args, progress=_progress_factory(not ns.quiet))
+    log = None if ns.quiet else (lambda message: print(f"hybridgen: {message}", file=sys.stderr, flush=True))
+    summary = run_config(ns.config, ns.args, progress=_progress_factory(not ns.quiet), log=log)
     outputs = ", ".join(str(p) for p in summary.outputs) or "(no output file)"
     rate = summary.frames / summary.seconds if summary.seconds > 0 else 0.0
     print(f"hybridgen: {summary.frames} keypoint(s) in {summary.seconds:.2f} s ({rate:.1f}/s) -> {outputs}")

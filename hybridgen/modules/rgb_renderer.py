@@ -5,6 +5,7 @@ from typing import Any
 
 from ..config.registry import register_module
 from ..config.schema import Param, positive
+from ..render.mitsuba_variant import choose_variant
 from ..render.path_trace import PathTraceSettings
 from ..render.render_color import render_color
 from ..run.context import RunContext
@@ -48,8 +49,11 @@ class RgbRenderer(Module):
         request = label_request(cfg)
         wants_labels = request.depth or request.distance or request.normals or request.map_by
         settings = PathTraceSettings(cfg["samples"], cfg["min_bounces"], cfg["max_bounces"], cfg["glossy_bounces"])
+        variant = choose_variant(cfg["variant"])
+        context.log(f"color: Mitsuba {variant}, {settings.samples} spp, max_bounces {settings.max_bounces}"
+                    + (", denoised" if cfg["denoise"] else ""))
         context.frames_rendered += render_color(
             scene, context.sinks, settings, labels=request if wants_labels else None, seed=context.seed,
-            variant=cfg["variant"], hdr=cfg["output_hdr"], denoise=cfg["denoise"],
+            variant=variant, hdr=cfg["output_hdr"], denoise=cfg["denoise"],
             stereo_baseline=cfg["interocular_distance"] if cfg["stereo"] else None,
             default_category_id=context.default_category_id, progress=context.progress)

@@ -28,6 +28,7 @@ class RunContext:
     frames_rendered: int = 0
     attributes: dict[str, Any] = field(default_factory=dict)
     progress: Callable[[int, str], Any] | None = None
+    log: Callable[[str], None] = field(default=lambda message: None)
     cleanups: list[Callable[[], None]] = field(default_factory=list)
 
     def set_seed(self, seed: int) -> None:

@@ -62,12 +62,18 @@ def _check_order(modules: list[Module], file: str) -> None:
 
 
 def run_config(path: str | Path, args: Sequence[str] = (), *, env: Mapping[str, str] | None = None,
-               progress: Callable[[int, str], Any] | None = None) -> RunSummary:
-    """Run the config at ``path`` with command-line ``args`` (``<args:N>``); returns a summary."""
+               progress: Callable[[int, str], Any] | None = None,
+               log: Callable[[str], None] | None = None) -> RunSummary:
+    """Run the config at ``path`` with command-line ``args`` (``<args:N>``); returns a summary.
+
+    ``progress(total, what)`` makes a progress bar per renderer; ``log`` receives one-line status messages.
+    """
     start = time.perf_counter()
     config = load_config(path, args, env)
     modules = build_modules(config)
     context = RunContext(config=config, progress=progress)
+    if log is not None:
+        context.log = log
     try:
         for phase in ("prepare", "run"):
             for module in modules:
