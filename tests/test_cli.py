@@ -22,7 +22,7 @@ def test_modules_lists_every_module_with_parameters(run_cli):
                  "renderer.SegMapRenderer", "writer.Hdf5Writer"):
         assert f"{name}:" in out
     assert "seed: int, default 0" in out
-    assert "location: vec3 [m], default [0.0, 0.0, 0.0]" in out
+    assert "location: vec3 [m] (sampleable), default [0.0, 0.0, 0.0]" in out
     code, out, _ = run_cli("modules", "writer.Hdf5Writr")
     assert code == 0 or "did you mean 'writer.Hdf5Writer'" in _
 

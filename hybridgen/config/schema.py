@@ -38,6 +38,8 @@ class Param:
 
     ``type`` is a name from the table above or several joined by ``|`` (``"str|list"``);
     ``choices`` restricts values (each element, for lists); ``check`` returns an error text or None.
+    ``sampleable`` values may be samplers (``{provider: ...}``), at any depth; they are checked against the
+    type when drawn (:meth:`Module.value`).
     """
 
     name: str
@@ -47,6 +49,7 @@ class Param:
     doc: str = ""
     choices: tuple[Any, ...] = ()
     check: Callable[[Any], str | None] | None = field(default=None, compare=False)
+    sampleable: bool = False
 
     @property
     def required(self) -> bool:
@@ -54,6 +57,16 @@ class Param:
 
     def validate(self, value: Any) -> Any:
         """Return ``value`` if it fits, else raise ConfigError naming the key (module/file added by callers)."""
+        if self.sampleable:
+            from ..sampling.registry import Sampled, contains_sampled, parse_value
+
+            value = parse_value(value, self.name)
+            if isinstance(value, Sampled) or contains_sampled(value):
+                return value
+        return self.check_value(value)
+
+    def check_value(self, value: Any) -> Any:
+        """Type, choices and custom check of a concrete (drawn) value."""
         types = self.type.split("|")
         if not any(_TYPE_CHECKS[t](value) for t in types):
             raise ConfigError(f"expected {self.type.replace('|', ' or ')}, got {type(value).__name__} {value!r}",
@@ -76,7 +89,8 @@ class Param:
         """One line for `hybridgen modules`."""
         default = "required" if self.required else f"default {self.default!r}"
         unit = f" [{self.unit}]" if self.unit else ""
-        return f"{self.name}: {self.type}{unit}, {default} - {self.doc}"
+        sampled = " (sampleable)" if self.sampleable else ""
+        return f"{self.name}: {self.type}{unit}{sampled}, {default} - {self.doc}"
 
 
 def validate_config(params: Mapping[str, Param], given: Mapping[str, Any],

@@ -30,6 +30,20 @@ class Module:
         """The declared parameters by name."""
         return {p.name: p for p in cls.params}
 
+    def value(self, context: "RunContext", key: str) -> Any:
+        """The config value ``key`` with its samplers drawn afresh, checked against its declared type."""
+        from ..config.schema import ConfigError
+        from ..sampling.registry import DrawContext, contains_sampled, draw
+
+        raw = self.config[key]
+        if not contains_sampled(raw):
+            return raw
+        drawn = draw(raw, DrawContext(context.rng, context.scene))
+        try:
+            return self.param_table()[key].check_value(drawn)
+        except ConfigError as exc:
+            raise ConfigError(f"a drawn value is invalid: {exc.detail}", key=key) from None
+
     def prepare(self, context: "RunContext") -> None:
         """Called for all modules before the first one runs."""
 

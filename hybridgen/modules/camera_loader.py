@@ -16,7 +16,7 @@ class CameraLoader(Module):
     params = (
         Param("intrinsics", "dict", {}, doc="resolution_x/y [px], cam_K (9 numbers) or fov [rad] + fov_axis, "
               "clip_start/clip_end [m]; defaults 512x512, fov 0.691111, clip 0.1..1000"),
-        Param("cam_poses", "list", [], doc="pose entries: {location [m], rotation: {format: euler|look_at|"
+        Param("cam_poses", "list", [], sampleable=True, doc="pose entries: {location [m], rotation: {format: euler|look_at|"
               "forward_vec, value, inplane_rot [rad]}} or {cam2world_matrix, source_frame}"),
         Param("path", "path|null", None, doc="text file with one pose per line"),
         Param("file_format", "str", "location rotation/value",
@@ -32,7 +32,8 @@ class CameraLoader(Module):
         if cfg["intrinsics"] or not camera.keypoints:
             camera.intrinsics = intrinsics_from_config(cfg["intrinsics"])
         defaults = cfg["default_cam_param"]
-        poses = [pose_from_entry(e, f"cam_poses[{i}]", defaults) for i, e in enumerate(cfg["cam_poses"])]
+        entries = self.value(context, "cam_poses")
+        poses = [pose_from_entry(e, f"cam_poses[{i}]", defaults) for i, e in enumerate(entries)]
         if cfg["path"] is not None:
             poses += poses_from_file(cfg["path"], cfg["file_format"], defaults)
         if not poses:

@@ -49,11 +49,11 @@ class LightLoader(Module):
     """Adds point, spot, sun and area lights; SUN/SPOT/AREA shine along their local -z axis."""
 
     params = (
-        Param("lights", "list", doc="entries {type: POINT|SUN|SPOT|AREA, name, location [m], rotation [rad], "
+        Param("lights", "list", sampleable=True, doc="entries {type: POINT|SUN|SPOT|AREA, name, location [m], rotation [rad], "
               "color [0..], energy [W; W/m^2 for SUN], radius [m], spot_size [rad], spot_blend, size [m]}",
               check=lambda v: None if v else "must list at least one light"),
     )
 
     def run(self, context: RunContext) -> None:
-        for index, entry in enumerate(self.config["lights"]):
+        for index, entry in enumerate(self.value(context, "lights")):
             context.scene.add_light(light_from_entry(entry, f"lights[{index}]"))

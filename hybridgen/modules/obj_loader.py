@@ -6,7 +6,7 @@ from ..config.schema import Param
 from ..io.mesh_loader import LOADERS, load_objects
 from ..run.context import RunContext
 from .base import Module
-from .placement import PLACEMENT_PARAMS, apply_placement, placement_pose
+from .placement import PLACEMENT_PARAMS, apply_placement, drawn_placement, placement_pose
 
 
 @register_module("loader.ObjLoader")
@@ -21,7 +21,7 @@ class ObjLoader(Module):
     )
 
     def run(self, context: RunContext) -> None:
-        cfg = self.config
+        cfg = drawn_placement(self, context)
         objects = load_objects(cfg["path"], name=cfg["name"], category_id=cfg["category_id"],
                                local2world=placement_pose(cfg), up_axis=cfg["up_axis"],
                                attributes=cfg["attributes"])

@@ -7,7 +7,9 @@ import numpy as np
 
 from ..config.material_config import apply_material_config
 from ..config.schema import Param
+from ..run.context import RunContext
 from ..scene.mesh_object import MeshObject
+from .base import Module
 from ..io.mesh_loader import object_pose
 
 
@@ -25,12 +27,17 @@ PLACEMENT_PARAMS: tuple[Param, ...] = (
     Param("name", "str|null", None, doc="object name (several parts of one file get '<name>.<part>')"),
     Param("category_id", "int|null", None, doc="class label written to category_id_segmaps"),
     Param("attributes", "dict", {}, doc="custom attributes (numeric ones can be segmap keys via map_by)"),
-    Param("location", "vec3", [0.0, 0.0, 0.0], "m", "position in world coordinates"),
-    Param("rotation", "vec3", [0.0, 0.0, 0.0], "rad", "Euler XYZ angles, as in Blender"),
-    Param("scale", "float|list", 1.0, "", "uniform scale or [sx, sy, sz]", check=_scale_check),
-    Param("material", "dict", {}, doc="principled values replacing the file's: base_color, base_color_texture "
+    Param("location", "vec3", [0.0, 0.0, 0.0], "m", "position in world coordinates", sampleable=True),
+    Param("rotation", "vec3", [0.0, 0.0, 0.0], "rad", "Euler XYZ angles, as in Blender", sampleable=True),
+    Param("scale", "float|list", 1.0, "", "uniform scale or [sx, sy, sz]", check=_scale_check, sampleable=True),
+    Param("material", "dict", {}, sampleable=True, doc="principled values replacing the file's: base_color, base_color_texture "
           "(path), roughness, metallic, specular, transmission, ior, alpha, emission, emission_strength"),
 )
+
+
+def drawn_placement(module: Module, context: RunContext) -> dict[str, Any]:
+    """The loader's config with location, rotation, scale and material drawn (once per loaded file)."""
+    return {**module.config, **{p.name: module.value(context, p.name) for p in PLACEMENT_PARAMS if p.sampleable}}
 
 
 def apply_placement(objects: list[MeshObject], config: dict[str, Any]) -> list[MeshObject]:

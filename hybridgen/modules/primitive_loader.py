@@ -6,7 +6,7 @@ from ..config.schema import Param, positive
 from ..run.context import RunContext
 from ..scene.primitives import PRIMITIVES, make_primitive
 from .base import Module
-from .placement import PLACEMENT_PARAMS, apply_placement, placement_pose
+from .placement import PLACEMENT_PARAMS, apply_placement, drawn_placement, placement_pose
 
 
 def _color_check(value: object) -> str | None:
@@ -24,13 +24,15 @@ class PrimitiveLoader(Module):
     params = (
         Param("shape", "str", choices=tuple(PRIMITIVES), doc="which shape"),
         Param("size", "float", 1.0, "m", "edge length (cube, plane) or diameter", check=positive),
-        Param("color", "list|null", None, doc="base color, linear RGB(A) in 0..1", check=_color_check),
+        Param("color", "list|null", None, doc="base color, linear RGB(A) in 0..1", check=_color_check,
+              sampleable=True),
         *PLACEMENT_PARAMS,
     )
 
     def run(self, context: RunContext) -> None:
-        cfg = self.config
+        cfg = drawn_placement(self, context)
         obj = make_primitive(cfg["shape"], cfg["size"], name=cfg["name"], category_id=cfg["category_id"],
-                             local2world=placement_pose(cfg), color=cfg["color"], attributes=cfg["attributes"])
+                             local2world=placement_pose(cfg), color=self.value(context, "color"),
+                             attributes=cfg["attributes"])
         for placed in apply_placement([obj], cfg):
             context.scene.add(placed)

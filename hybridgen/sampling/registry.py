@@ -1,0 +1,165 @@
+"""Registry of samplers and providers by name, and the lazy ``Sampled`` values configs turn into.
+
+A config value ``{provider: sampler.Uniform3d, min: [...], max: [...]}`` or, in the paper's form,
+``{name: Uniform3dSampler, parameters: {min: [...], max: [...]}}`` becomes a :class:`Sampled`; a module
+draws it with :func:`draw` each time it reads it, so every object / pose / light gets a fresh value.
+Parameters are validated when the config is loaded (``min > max`` is an error then, not at the 500th draw).
+"""
+from __future__ import annotations
+
+import inspect
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import numpy as np
+
+from ..config.schema import closest
+from ..errors import ConfigError, InputError
+
+
+@dataclass
+class DrawContext:
+    """What a sampler may use: the run's generator and, for object-relative samplers, the scene."""
+
+    rng: np.random.Generator
+    scene: Any = None
+
+
+SamplerFn = Callable[..., Any]
+
+
+@dataclass(frozen=True)
+class SamplerSpec:
+    """A registered sampler: its function ``fn(ctx, **params)`` and a validator run at config load."""
+
+    name: str
+    fn: SamplerFn
+    validate: Callable[[dict[str, Any]], None]
+    doc: str
+
+
+SAMPLERS: dict[str, SamplerSpec] = {}
+ALIASES: dict[str, str] = {}
+
+
+def register_sampler(name: str, *aliases: str, validate: Callable[[dict[str, Any]], None] | None = None
+                     ) -> Callable[[SamplerFn], SamplerFn]:
+    """Register ``fn(ctx: DrawContext, **params)`` as ``name`` (e.g. ``sampler.Uniform3d``) and aliases
+    (e.g. the paper's ``Uniform3dSampler``)."""
+
+    def decorate(fn: SamplerFn) -> SamplerFn:
+        SAMPLERS[name] = SamplerSpec(name, fn, validate or (lambda params: None), (fn.__doc__ or "").strip())
+        for alias in aliases:
+            ALIASES[alias] = name
+        return fn
+
+    return decorate
+
+
+def _known() -> list[str]:
+    _load_builtins()
+    return sorted([*SAMPLERS, *ALIASES])
+
+
+def _load_builtins() -> None:
+    from . import getters, samplers  # noqa: F401  (registration side effects)
+
+
+@dataclass
+class Sampled:
+    """A config value drawn afresh every time a module reads it."""
+
+    spec: SamplerSpec
+    params: dict[str, Any]
+
+    def draw(self, ctx: DrawContext) -> Any:
+        params = {k: draw(v, ctx) for k, v in self.params.items()}
+        try:
+            return self.spec.fn(ctx, **params)
+        except (ValueError, TypeError) as exc:
+            raise InputError(f"{self.spec.name}: {exc}") from None
+
+
+def is_sampler_dict(value: Any) -> bool:
+    """True for ``{provider: ...}`` and the paper's ``{name: ..., parameters: {...}}`` (selectors, whose
+    provider is ``getter.Entity``, are not values)."""
+    if not isinstance(value, dict) or value.get("provider") == "getter.Entity":
+        return False
+    return "provider" in value or ("name" in value and "parameters" in value)
+
+
+def parse_sampled(value: dict[str, Any], key: str = "") -> Sampled:
+    """Turn a sampler dict into a :class:`Sampled`, validating name and parameters."""
+    _load_builtins()
+    if "provider" in value:
+        name = value["provider"]
+        params = {k: v for k, v in value.items() if k != "provider"}
+    else:
+        name = value["name"]
+        extra = [k for k in value if k not in ("name", "parameters")]
+        if extra:
+            raise ConfigError(f"a sampler in the paper's form has only 'name' and 'parameters', got {extra}", key=key)
+        params = dict(value["parameters"] or {})
+    name = ALIASES.get(name, name)
+    if name not in SAMPLERS:
+        raise ConfigError(f"unknown sampler {value.get('provider', value.get('name'))!r}"
+                          f"{closest(str(name), _known())}; known: {', '.join(sorted(SAMPLERS))}", key=key)
+    spec = SAMPLERS[name]
+    params = {k: parse_value(v, f"{key}.{k}") for k, v in params.items()}
+    signature = inspect.signature(spec.fn)
+    accepted = [p for p in signature.parameters if p != "ctx"]
+    for param in params:
+        if param not in accepted:
+            raise ConfigError(f"{name} has no parameter {param!r}{closest(param, accepted)}; it takes "
+                              f"{', '.join(accepted)}", key=key)
+    missing = [p.name for p in signature.parameters.values()
+               if p.name != "ctx" and p.default is inspect.Parameter.empty and p.name not in params]
+    if missing:
+        raise ConfigError(f"{name} needs {', '.join(missing)}", key=key)
+    constant = {k: v for k, v in params.items() if not isinstance(v, Sampled)}
+    try:
+        spec.validate(constant)
+    except (ValueError, TypeError) as exc:
+        raise ConfigError(f"{name}: {exc}", key=key) from None
+    return Sampled(spec, params)
+
+
+def parse_value(value: Any, key: str = "") -> Any:
+    """A config value with every sampler dict inside it (at any depth) turned into a :class:`Sampled`."""
+    if is_sampler_dict(value):
+        return parse_sampled(value, key)
+    if isinstance(value, dict):
+        return {k: parse_value(v, f"{key}.{k}" if key else str(k)) for k, v in value.items()}
+    if isinstance(value, list):
+        return [parse_value(v, f"{key}[{i}]") for i, v in enumerate(value)]
+    return value
+
+
+def contains_sampled(value: Any) -> bool:
+    """True if a :class:`Sampled` is anywhere inside ``value``."""
+    if isinstance(value, Sampled):
+        return True
+    if isinstance(value, dict):
+        return any(contains_sampled(v) for v in value.values())
+    if isinstance(value, list):
+        return any(contains_sampled(v) for v in value)
+    return False
+
+
+def draw(value: Any, ctx: DrawContext) -> Any:
+    """``value`` with every :class:`Sampled` inside it drawn once (numpy results become lists/scalars)."""
+    if isinstance(value, Sampled):
+        return _plain(value.draw(ctx))
+    if isinstance(value, dict):
+        return {k: draw(v, ctx) for k, v in value.items()}
+    if isinstance(value, list):
+        return [draw(v, ctx) for v in value]
+    return value
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
