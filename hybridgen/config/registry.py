@@ -22,6 +22,7 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.obj_loader",
     "hybridgen.modules.primitive_loader",
     "hybridgen.modules.camera_loader",
+    "hybridgen.modules.camera_sampler",
     "hybridgen.modules.light_loader",
     "hybridgen.modules.segmap_renderer",
     "hybridgen.modules.rgb_renderer",

@@ -117,8 +117,12 @@ class RasterView:
         return lut
 
     # ----------------------------------------------------------------- rendering
-    def render_raw(self, cam2world: np.ndarray, intrinsics: Intrinsics | None = None) -> RasterOutput:
-        """Draw one keypoint (OpenCV-axes ``cam2world``) and read back normals+depth and instance ids."""
+    def render_raw(self, cam2world: np.ndarray, intrinsics: Intrinsics | None = None,
+                   hidden: frozenset[int] = frozenset()) -> RasterOutput:
+        """Draw one keypoint (OpenCV-axes ``cam2world``) and read back normals+depth and instance ids.
+
+        Objects whose instance id is in ``hidden`` are left out (rays pass through them).
+        """
         intr = intrinsics or self.scene.camera.intrinsics
         width, height = intr.width, intr.height
         fbo = self._framebuffer(width, height)
@@ -135,6 +139,8 @@ class RasterView:
         near_reach = near_plane_corner_distance(intr.K, width, height, intr.clip_start)
         cam_pos = cam2world[:3, 3]
         for gpu, obj in zip(self.gpu_objects, self.scene.objects):
+            if gpu.instance_id in hidden:
+                continue
             modelview = world2cam @ obj.local2world
             linear = modelview[:3, :3]
             det = np.linalg.det(linear)

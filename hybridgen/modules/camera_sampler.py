@@ -1,0 +1,102 @@
+"""``camera.CameraSampler``: keypoints from pose samplers, kept only when they pass the checks."""
+from __future__ import annotations
+
+from typing import Any
+
+from ..config.camera_poses import intrinsics_from_config, pose_from_entry
+from ..config.registry import register_module
+from ..config.schema import Param, positive
+from ..errors import ConfigError, InputError
+from ..render.raster import RasterView
+from ..run.context import RunContext
+from ..sampling.camera_checks import NoveltyCheck, ProximityChecks
+from ..sampling.camera_sampling import PoseChecks, SamplingReport, sample_camera_poses
+from ..sampling.getters import parse_selector
+from ..sampling.registry import DrawContext, draw
+from .base import Module
+
+ENTRY_KEYS = ("number_of_samples", "location", "rotation", "cam2world_matrix", "source_frame",
+              "proximity_checks", "excluded_objs_in_proximity_check", "check_if_objects_visible",
+              "min_coverage", "check_pose_novelty_rot", "check_pose_novelty_translation",
+              "min_var_diff_rot", "min_var_diff_translation")
+POSE_ONLY = ("location", "rotation", "cam2world_matrix", "source_frame")
+
+
+@register_module("camera.CameraSampler")
+class CameraSampler(Module):
+    """Samples camera poses (BlenderProc's CameraSampler); each entry's samplers are drawn per try."""
+
+    params = (
+        Param("intrinsics", "dict", {}, doc="as camera.CameraLoader; omitted: keep the camera's"),
+        Param("cam_poses", "list", sampleable=True, doc=f"entries with keys {', '.join(ENTRY_KEYS)}; "
+              "proximity_checks: {min, max [m], avg: {min, max}, var: {min, max}, no_background}; "
+              "min_coverage: {selector, fraction} (image fraction the selected objects must cover)"),
+        Param("max_tries", "int", 10000, doc="candidate poses per entry before giving up", check=positive),
+        Param("check_width", "int", 64, "px", "width of the low-resolution check image", check=positive),
+        Param("on_failure", "str", "error", choices=("error", "warn"),
+              doc="too few poses within max_tries: error, or warn and keep what was found"),
+    )
+
+    def run(self, context: RunContext) -> None:
+        cfg = self.config
+        camera = context.scene.camera
+        if cfg["intrinsics"]:
+            camera.intrinsics = intrinsics_from_config(cfg["intrinsics"])
+        view = RasterView(context.scene)
+        report = SamplingReport()
+        try:
+            for index, entry in enumerate(cfg["cam_poses"]):
+                where = f"cam_poses[{index}]"
+                if not isinstance(entry, dict):
+                    raise ConfigError("a pose entry is a mapping", key=where)
+                for key in entry:
+                    if key not in ENTRY_KEYS:
+                        from ..config.schema import closest
+
+                        raise ConfigError(f"unknown key{closest(key, ENTRY_KEYS)}", key=f"{where}.{key}")
+                count = int(entry.get("number_of_samples", 1))
+                checks = self._checks(entry, context, where)
+                draw_ctx = DrawContext(context.rng, context.scene)
+                pose_part = {k: v for k, v in entry.items() if k in POSE_ONLY}
+
+                def propose(part: dict[str, Any] = pose_part, at: str = where) -> Any:
+                    return pose_from_entry(draw(part, draw_ctx), at)
+
+                poses, report = sample_camera_poses(context.scene, propose, count, cfg["max_tries"], checks,
+                                                    check_width=cfg["check_width"], view=view, report=report)
+                for pose in poses:
+                    camera.add_keypoint(pose)
+                if len(poses) < count:
+                    message = (f"{where}: found {len(poses)} of {count} poses in {cfg['max_tries']} tries "
+                               f"({report.summary()})")
+                    if cfg["on_failure"] == "error":
+                        raise InputError(message + "; relax the checks or raise max_tries")
+                    context.log(f"warning: camera.CameraSampler {message}")
+        finally:
+            view.release()
+        context.log(f"camera.CameraSampler: {report.summary()}")
+
+    @staticmethod
+    def _ids(value: Any, context: RunContext, key: str) -> frozenset[int]:
+        selector = parse_selector(value, key)
+        return frozenset(o.instance_id for o in selector.select(context.scene.objects, context.rng))
+
+    def _checks(self, entry: dict[str, Any], context: RunContext, where: str) -> PoseChecks:
+        coverage = entry.get("min_coverage")
+        coverage_of: frozenset[int] = frozenset()
+        fraction = 0.0
+        if coverage is not None:
+            if not isinstance(coverage, dict) or "fraction" not in coverage:
+                raise ConfigError("min_coverage takes {selector, fraction}", key=f"{where}.min_coverage")
+            coverage_of = self._ids(coverage.get("selector"), context, f"{where}.min_coverage.selector")
+            fraction = float(coverage["fraction"])
+        novelty = NoveltyCheck(
+            entry.get("min_var_diff_rot", 0.0) if entry.get("check_pose_novelty_rot") else None,
+            entry.get("min_var_diff_translation", 0.0) if entry.get("check_pose_novelty_translation") else None)
+        return PoseChecks(
+            proximity=ProximityChecks.parse(entry.get("proximity_checks"), f"{where}.proximity_checks"),
+            excluded=self._ids(entry["excluded_objs_in_proximity_check"], context, where)
+            if "excluded_objs_in_proximity_check" in entry else frozenset(),
+            must_see=self._ids(entry["check_if_objects_visible"], context, where)
+            if "check_if_objects_visible" in entry else frozenset(),
+            coverage_of=coverage_of, min_coverage=fraction, novelty=novelty)

@@ -1,0 +1,90 @@
+"""Python API: sample camera poses until enough pass the proximity, visibility and novelty checks."""
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ..render.raster import RasterView
+from ..scene.camera import Intrinsics
+from ..scene.scene import Scene
+from .camera_checks import NoveltyCheck, ProximityChecks
+
+
+@dataclass
+class PoseChecks:
+    """Everything a candidate pose is checked against (instance ids refer to ``scene.objects``)."""
+
+    proximity: ProximityChecks = field(default_factory=ProximityChecks)
+    excluded: frozenset[int] = frozenset()  # ids ignored by the proximity checks (rays pass through them)
+    must_see: frozenset[int] = frozenset()  # ids that must each cover at least one check pixel
+    coverage_of: frozenset[int] = frozenset()  # ids whose joint image coverage is checked
+    min_coverage: float = 0.0  # fraction of the check image those objects must cover
+    novelty: NoveltyCheck = field(default_factory=NoveltyCheck)
+
+
+@dataclass
+class SamplingReport:
+    """Tries made, poses accepted, rejections per check name."""
+
+    tries: int = 0
+    accepted: int = 0
+    rejections: Counter = field(default_factory=Counter)
+
+    def summary(self) -> str:
+        detail = ", ".join(f"{name} {count}" for name, count in self.rejections.most_common()) or "none"
+        return f"{self.accepted} pose(s) in {self.tries} tries; rejections: {detail}"
+
+
+def check_intrinsics(intr: Intrinsics, width: int) -> Intrinsics:
+    """The low-resolution camera the checks are evaluated with (same field of view)."""
+    width = max(4, min(width, intr.width))
+    return intr.resized(width, max(3, round(intr.height * width / intr.width)))
+
+
+def pose_failures(view: RasterView, cam2world: np.ndarray, intr: Intrinsics, checks: PoseChecks) -> list[str]:
+    """Names of the checks ``cam2world`` fails (empty: accepted), from one or two low-resolution draws."""
+    failed: list[str] = []
+    raw = view.render_raw(cam2world, intr, hidden=checks.excluded)
+    distance = raw.normal_depth[..., 3] * raw.ray_lengths
+    failed += checks.proximity.failures(distance, raw.hit)
+    if checks.must_see or checks.coverage_of:
+        ids = raw.instance if not checks.excluded else view.render_raw(cam2world, intr).instance
+        present = set(np.unique(ids).tolist())
+        if not checks.must_see <= present:
+            failed.append("visible")
+        if checks.coverage_of and np.isin(ids, list(checks.coverage_of)).mean() < checks.min_coverage:
+            failed.append("coverage")
+    failed += checks.novelty.failures(cam2world)
+    return failed
+
+
+def sample_camera_poses(scene: Scene, propose: Callable[[], np.ndarray], count: int, max_tries: int,
+                        checks: PoseChecks, *, check_width: int = 64, view: RasterView | None = None,
+                        report: SamplingReport | None = None) -> tuple[list[np.ndarray], SamplingReport]:
+    """Draw candidate poses from ``propose()`` (OpenCV-axes cam2world) until ``count`` pass ``checks`` or
+    ``max_tries`` candidates were tried. Returns the accepted poses and the report (tries, rejections)."""
+    report = report or SamplingReport()
+    own = view is None
+    view = view or RasterView(scene)
+    intr = check_intrinsics(scene.camera.intrinsics, check_width)
+    accepted: list[np.ndarray] = []
+    try:
+        tries = 0
+        while len(accepted) < count and tries < max_tries:
+            tries += 1
+            pose = propose()
+            failed = pose_failures(view, pose, intr, checks)
+            if failed:
+                report.rejections.update(failed)
+                continue
+            checks.novelty.accept(pose)
+            accepted.append(pose)
+    finally:
+        if own:
+            view.release()
+    report.tries += tries
+    report.accepted += len(accepted)
+    return accepted, report
