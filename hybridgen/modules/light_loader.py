@@ -15,7 +15,7 @@ LIGHT_KEYS = {"type": str, "name": str, "location": list, "rotation": list, "col
               "radius": float, "spot_size": float, "spot_blend": float, "size": float}
 
 
-def light_from_entry(entry: Any, where: str) -> Light:
+def light_from_entry(entry: Any, where: str, default_name: str = "light") -> Light:
     """A :class:`Light` from ``{type, name, location [m], rotation [rad, XYZ Euler], color, energy, ...}``."""
     if not isinstance(entry, dict):
         raise ConfigError(f"a light is a mapping, got {entry!r}", key=where)
@@ -38,7 +38,7 @@ def light_from_entry(entry: Any, where: str) -> Light:
     if any(c < 0 for c in entry.get("color", [1, 1, 1])):
         raise ConfigError("channels must be >= 0", key=f"{where}.color")
     optional = {k: float(entry[k]) for k in ("radius", "spot_size", "spot_blend", "size") if k in entry}
-    return Light(name=str(entry.get("name", f"light_{where}")), type=kind,
+    return Light(name=str(entry.get("name", default_name)), type=kind,
                  color=tuple(float(c) for c in entry.get("color", [1.0, 1.0, 1.0])),  # type: ignore[arg-type]
                  energy=energy, local2world=object_pose(entry.get("location", [0, 0, 0]),
                                                         entry.get("rotation", [0, 0, 0])), **optional)
@@ -56,4 +56,21 @@ class LightLoader(Module):
 
     def run(self, context: RunContext) -> None:
         for index, entry in enumerate(self.value(context, "lights")):
-            context.scene.add_light(light_from_entry(entry, f"lights[{index}]"))
+            default_name = f"light_{len(context.scene.lights)}"
+            context.scene.add_light(light_from_entry(entry, f"lights[{index}]", default_name))
+
+
+@register_module("lighting.LightSampler")
+class LightSampler(LightLoader):
+    """LightLoader whose entries are drawn ``number_of_samples`` times each (samplers give every light its
+    own location, color, energy, ...)."""
+
+    params = (
+        *LightLoader.params,
+        Param("number_of_samples", "int", 1, doc="lights drawn per entry",
+              check=lambda v: None if v >= 1 else "must be >= 1"),
+    )
+
+    def run(self, context: RunContext) -> None:
+        for _ in range(self.config["number_of_samples"]):
+            super().run(context)

@@ -1,0 +1,78 @@
+"""``manipulators.MaterialManipulator`` and ``manipulators.EntityManipulator``: change selected objects'
+materials and poses/attributes, with values from samplers (drawn per object)."""
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from ..config.material_config import apply_material_config
+from ..config.registry import register_module
+from ..config.schema import Param
+from ..errors import InputError
+from ..io.mesh_loader import object_pose
+from ..run.context import RunContext
+from ..sampling.getters import parse_selector
+from .base import Module
+
+
+class _SelectingModule(Module):
+    """Acts on the objects its ``selector`` picks (at least one)."""
+
+    def prepare(self, context: RunContext) -> None:
+        self.selector = parse_selector(self.config["selector"], "selector")
+
+    def selected(self, context: RunContext) -> list:
+        chosen = self.selector.select(context.scene.objects, context.rng)
+        if not chosen:
+            raise InputError(f"no object matches the selector {self.selector.conditions!r}")
+        return chosen
+
+
+@register_module("manipulators.MaterialManipulator")
+class MaterialManipulator(_SelectingModule):
+    """Sets principled values (and textures, e.g. from sampler.Path over a folder) on selected objects."""
+
+    params = (
+        Param("selector", "dict|list", doc="which objects (getter.Entity conditions, random_samples)"),
+        Param("material", "dict", sampleable=True, doc="principled values: base_color, base_color_texture "
+              "(path), roughness, metallic, specular, transmission, ior, alpha, emission, emission_strength"),
+        Param("randomize_color", "bool", False, doc="a uniform random base color per object"),
+    )
+
+    def run(self, context: RunContext) -> None:
+        for obj in self.selected(context):
+            values = dict(self.value(context, "material"))
+            if self.config["randomize_color"]:
+                values["base_color"] = [*context.rng.uniform(0, 1, 3).tolist(), 1.0]
+            if "base_color_texture" in values and obj.uvs is None:
+                raise InputError(f"object '{obj.name}' has no UVs to map base_color_texture with")
+            obj.material = apply_material_config(obj.material, values)
+
+
+@register_module("manipulators.EntityManipulator")
+class EntityManipulator(_SelectingModule):
+    """Sets the pose (location, rotation, scale) and custom attributes of selected objects."""
+
+    params = (
+        Param("selector", "dict|list", doc="which objects (getter.Entity conditions, random_samples)"),
+        Param("location", "vec3|null", None, "m", "new world position", sampleable=True),
+        Param("rotation", "vec3|null", None, "rad", "new Euler XYZ rotation", sampleable=True),
+        Param("scale", "float|list|null", None, doc="new scale", sampleable=True),
+        Param("attributes", "dict", {}, sampleable=True, doc="custom attributes to set (e.g. for map_by)"),
+        Param("category_id", "int|null", None, doc="new category_id"),
+    )
+
+    def run(self, context: RunContext) -> None:
+        for obj in self.selected(context):
+            location, rotation, scale = (self.value(context, k) for k in ("location", "rotation", "scale"))
+            if location is not None or rotation is not None or scale is not None:
+                current = obj.local2world
+                linear = current[:3, :3]
+                old_scale = np.linalg.norm(linear, axis=0)
+                old_rotation = Rotation.from_matrix(linear / old_scale).as_euler("xyz")
+                obj.local2world = object_pose(current[:3, 3] if location is None else location,
+                                              old_rotation if rotation is None else rotation,
+                                              old_scale if scale is None else scale)
+            obj.attributes.update(self.value(context, "attributes"))
+            if self.config["category_id"] is not None:
+                obj.category_id = self.config["category_id"]

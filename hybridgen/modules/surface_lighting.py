@@ -1,0 +1,44 @@
+"""``lighting.SurfaceLighting``: make selected surfaces emit light (the paper lit rooms by their ceiling)."""
+from __future__ import annotations
+
+import dataclasses
+
+from ..config.registry import register_module
+from ..config.schema import Param
+from ..errors import InputError
+from ..run.context import RunContext
+from ..sampling.getters import parse_selector
+from .base import Module
+
+
+def _color(value: list) -> str | None:
+    ok = len(value) in (3, 4) and all(isinstance(c, (int, float)) and c >= 0 for c in value)
+    return None if ok else f"must be 3 numbers >= 0, got {value!r}"
+
+
+@register_module("lighting.SurfaceLighting")
+class SurfaceLighting(Module):
+    """Selected objects emit ``emission_color`` x ``emission_strength`` (radiance, both sides)."""
+
+    params = (
+        Param("selector", "dict|list", doc="which objects emit (getter.Entity conditions)"),
+        Param("emission_strength", "float", 10.0, doc="radiance scale", sampleable=True,
+              check=lambda v: None if v >= 0 else f"must be >= 0, got {v}"),
+        Param("emission_color", "list|null", None, doc="linear RGB; null: the object's base color",
+              sampleable=True, check=lambda v: None if v is None else _color(v)),
+        Param("keep_using_base_color", "bool", False, doc="when emission_color is null, emit the base color"),
+    )
+
+    def prepare(self, context: RunContext) -> None:
+        self.selector = parse_selector(self.config["selector"], "selector")
+
+    def run(self, context: RunContext) -> None:
+        chosen = self.selector.select(context.scene.objects, context.rng)
+        if not chosen:
+            raise InputError(f"no object matches the selector {self.selector.conditions!r}")
+        for obj in chosen:
+            color = self.value(context, "emission_color")
+            if color is None:
+                color = obj.material.base_color[:3] if self.config["keep_using_base_color"] else (1.0, 1.0, 1.0)
+            obj.material = dataclasses.replace(obj.material, emission=tuple(float(c) for c in color[:3]),
+                                               emission_strength=float(self.value(context, "emission_strength")))
