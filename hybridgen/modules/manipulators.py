@@ -11,25 +11,11 @@ from ..config.schema import Param
 from ..errors import InputError
 from ..io.mesh_loader import object_pose
 from ..run.context import RunContext
-from ..sampling.getters import parse_selector
-from .base import Module
-
-
-class _SelectingModule(Module):
-    """Acts on the objects its ``selector`` picks (at least one)."""
-
-    def prepare(self, context: RunContext) -> None:
-        self.selector = parse_selector(self.config["selector"], "selector")
-
-    def selected(self, context: RunContext) -> list:
-        chosen = self.selector.select(context.scene.objects, context.rng)
-        if not chosen:
-            raise InputError(f"no object matches the selector {self.selector.conditions!r}")
-        return chosen
+from .selecting import SelectingModule
 
 
 @register_module("manipulators.MaterialManipulator")
-class MaterialManipulator(_SelectingModule):
+class MaterialManipulator(SelectingModule):
     """Sets principled values (and textures, e.g. from sampler.Path over a folder) on selected objects."""
 
     params = (
@@ -50,7 +36,7 @@ class MaterialManipulator(_SelectingModule):
 
 
 @register_module("manipulators.EntityManipulator")
-class EntityManipulator(_SelectingModule):
+class EntityManipulator(SelectingModule):
     """Sets the pose (location, rotation, scale) and custom attributes of selected objects."""
 
     params = (

@@ -14,7 +14,7 @@ from ..sampling.getters import parse_selector
 from ..io.mesh_loader import object_pose
 from ..sampling.placement import (PlacementResult, SurfaceProbe, check_spacing, rest_on_surface, sample_poses,
                                   scale_of)
-from .base import Module
+from .selecting import SelectingModule
 
 _COMMON = (
     Param("objects_to_sample", "dict|list", doc="which objects to place (getter.Entity conditions)"),
@@ -25,15 +25,8 @@ _COMMON = (
 )
 
 
-class _Placer(Module):
-    def prepare(self, context: RunContext) -> None:
-        self.targets = parse_selector(self.config["objects_to_sample"], "objects_to_sample")
-
-    def _objects(self, context: RunContext) -> list[Any]:
-        chosen = self.targets.select(context.scene.objects, context.rng)
-        if not chosen:
-            raise InputError(f"objects_to_sample matches no object ({self.targets.conditions!r})")
-        return chosen
+class _Placer(SelectingModule):
+    selector_key = "objects_to_sample"
 
     def _report(self, context: RunContext, result: PlacementResult) -> None:
         message = f"{self.module_name}: placed {len(result.placed)} object(s) in {result.tries} tries"
@@ -58,7 +51,7 @@ class ObjectPoseSampler(_Placer):
     )
 
     def run(self, context: RunContext) -> None:
-        objects = self._objects(context)
+        objects = self.selected(context)
         obstacles = parse_selector(self.config["objects_to_check_collisions"], "objects_to_check_collisions") \
             .select(context.scene.objects, context.rng)
 
@@ -86,7 +79,7 @@ class OnSurfaceSampler(_Placer):
         if len(surfaces) != 1:
             raise InputError(f"surface must select exactly one object, got {len(surfaces)}")
         surface = surfaces[0]
-        objects = [o for o in self._objects(context) if o is not surface]
+        objects = [o for o in self.selected(context) if o is not surface]
         probe = SurfaceProbe(surface)
         corners = surface.world_vertices()
         low, high = corners.min(axis=0), corners.max(axis=0)

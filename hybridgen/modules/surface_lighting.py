@@ -5,10 +5,8 @@ import dataclasses
 
 from ..config.registry import register_module
 from ..config.schema import Param
-from ..errors import InputError
 from ..run.context import RunContext
-from ..sampling.getters import parse_selector
-from .base import Module
+from .selecting import SelectingModule
 
 
 def _color(value: list) -> str | None:
@@ -17,7 +15,7 @@ def _color(value: list) -> str | None:
 
 
 @register_module("lighting.SurfaceLighting")
-class SurfaceLighting(Module):
+class SurfaceLighting(SelectingModule):
     """Selected objects emit ``emission_color`` x ``emission_strength`` (radiance, both sides)."""
 
     params = (
@@ -29,14 +27,8 @@ class SurfaceLighting(Module):
         Param("keep_using_base_color", "bool", False, doc="when emission_color is null, emit the base color"),
     )
 
-    def prepare(self, context: RunContext) -> None:
-        self.selector = parse_selector(self.config["selector"], "selector")
-
     def run(self, context: RunContext) -> None:
-        chosen = self.selector.select(context.scene.objects, context.rng)
-        if not chosen:
-            raise InputError(f"no object matches the selector {self.selector.conditions!r}")
-        for obj in chosen:
+        for obj in self.selected(context):
             color = self.value(context, "emission_color")
             if color is None:
                 color = obj.material.base_color[:3] if self.config["keep_using_base_color"] else (1.0, 1.0, 1.0)

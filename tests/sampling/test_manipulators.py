@@ -85,7 +85,7 @@ def test_light_sampler_draws_each_light(write_config):
 
 
 @pytest.mark.parametrize("text,fragment", [
-    ("  - name: lighting.SurfaceLighting\n    config: {selector: {name: nothing}}\n", "no object matches"),
+    ("  - name: lighting.SurfaceLighting\n    config: {selector: {name: nothing}}\n", "selector matches no object"),
     ("  - name: manipulators.MaterialManipulator\n    config: {selector: {name: crate}, material: {glow: 1}}\n",
      "material.glow"),
     ("  - name: lighting.LightSampler\n    config: {lights: [{type: POINT, energy: {provider: sampler.Value, "
