@@ -16,8 +16,9 @@ class CameraLoader(Module):
     params = (
         Param("intrinsics", "dict", {}, doc="resolution_x/y [px], cam_K (9 numbers) or fov [rad] + fov_axis, "
               "clip_start/clip_end [m]; defaults 512x512, fov 0.691111, clip 0.1..1000"),
-        Param("cam_poses", "list", [], sampleable=True, doc="pose entries: {location [m], rotation: {format: euler|look_at|"
-              "forward_vec, value, inplane_rot [rad]}} or {cam2world_matrix, source_frame}"),
+        Param("cam_poses", "list", [], sampleable=True,
+              doc="pose entries: {location [m], rotation: {format: euler|look_at|forward_vec, value, inplane_rot "
+                  "[rad]}} or {cam2world_matrix, source_frame}"),
         Param("path", "path|null", None, doc="text file with one pose per line"),
         Param("file_format", "str", "location rotation/value",
               doc="fields of a pose file line: location, rotation/value, rotation/inplane_rot, "

@@ -49,8 +49,9 @@ class LightLoader(Module):
     """Adds point, spot, sun and area lights; SUN/SPOT/AREA shine along their local -z axis."""
 
     params = (
-        Param("lights", "list", sampleable=True, doc="entries {type: POINT|SUN|SPOT|AREA, name, location [m], rotation [rad], "
-              "color [0..], energy [W; W/m^2 for SUN], radius [m], spot_size [rad], spot_blend, size [m]}",
+        Param("lights", "list", sampleable=True,
+              doc="entries {type: POINT|SUN|SPOT|AREA, name, location [m], rotation [rad], color [0..], energy [W; "
+                  "W/m^2 for SUN], radius [m], spot_size [rad], spot_blend, size [m]}",
               check=lambda v: None if v else "must list at least one light"),
     )
 

@@ -30,8 +30,9 @@ PLACEMENT_PARAMS: tuple[Param, ...] = (
     Param("location", "vec3", [0.0, 0.0, 0.0], "m", "position in world coordinates", sampleable=True),
     Param("rotation", "vec3", [0.0, 0.0, 0.0], "rad", "Euler XYZ angles, as in Blender", sampleable=True),
     Param("scale", "float|list", 1.0, "", "uniform scale or [sx, sy, sz]", check=_scale_check, sampleable=True),
-    Param("material", "dict", {}, sampleable=True, doc="principled values replacing the file's: base_color, base_color_texture "
-          "(path), roughness, metallic, specular, transmission, ior, alpha, emission, emission_strength"),
+    Param("material", "dict", {}, sampleable=True,
+          doc="principled values replacing the file's: base_color, base_color_texture (path), roughness, metallic, "
+              "specular, transmission, ior, alpha, emission, emission_strength"),
 )
 
 

@@ -104,8 +104,8 @@ class StereoProducer:
         self.producers, self.baseline, self.scene = producers, float(baseline), scene
 
     def layouts(self) -> list[PassLayout]:
-        return [PassLayout(l.key, l.dtype, l.shape if l.dtype == "json" else (2, *l.shape))
-                for p in self.producers for l in p.layouts()]
+        return [PassLayout(layout.key, layout.dtype, layout.shape if layout.dtype == "json" else (2, *layout.shape))
+                for p in self.producers for layout in p.layouts()]
 
     def attributes(self) -> dict[str, Any]:
         out: dict[str, Any] = {"stereo_baseline": self.baseline}

@@ -30,9 +30,9 @@ class PathTraceSettings:
 
     Bounces count as in Cycles: ``max_bounces`` 0 is direct light only. Mitsuba's ``path`` integrator counts
     path segments, so ``max_depth = max_bounces + 2`` and Russian roulette starts at
-    ``rr_depth = min(min_bounces, max_bounces) + 2``. Mitsuba has a single depth limit for all lobes, so ``glossy_bounces``
-    is the stricter of the two only when it is not smaller than ``max_bounces``; a smaller value is
-    rejected rather than silently ignored.
+    ``rr_depth = min(min_bounces, max_bounces) + 2``. Mitsuba has a single depth limit for all
+    lobes, so ``glossy_bounces`` can only be honoured when it is not smaller than ``max_bounces``; a
+    smaller value is rejected rather than silently ignored.
     """
 
     samples: int = 64

@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import subprocess
 import sys
-import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -103,7 +102,8 @@ def test_bad_config_gives_one_clear_line(name, tmp_path, write_config, run_cli, 
 
 def _mesh_config(tmp_path: Path, mesh: Path) -> str:
     return config_text(GOOD_MODULES.replace(
-        "  - name: camera", f"  - name: loader.ObjLoader\n    config: {{path: '{mesh}', category_id: 2}}\n  - name: camera"))
+        "  - name: camera",
+        f"  - name: loader.ObjLoader\n    config: {{path: '{mesh}', category_id: 2}}\n  - name: camera"))
 
 
 def test_corrupt_mesh(tmp_path, write_config, run_cli):
@@ -174,7 +174,7 @@ def test_config_values_reach_the_scene(tmp_path, write_config):
     poses.write_text("# x y z  tx ty tz\n3 -3 2  0 0 0\n\n-3 3 2 0 0 1  # comment\n")
     text = config_text(GOOD_MODULES.replace(
         "cam_poses: [{location: [3, -3, 2], rotation: {format: look_at, value: [0, 0, 0]}}]",
-        f"path: '<env:POSES_DIR>/poses.txt'\n      default_cam_param: {{rotation: {{format: look_at}}}}"))
+        "path: '<env:POSES_DIR>/poses.txt'\n      default_cam_param: {rotation: {format: look_at}}"))
     config = load_config(write_config(text), [str(tmp_path / "o")], env={"POSES_DIR": str(tmp_path)})
     assert config.global_all["output_dir"] == str(tmp_path / "o")
     assert config.modules[2].config["path"] == f"{tmp_path}/poses.txt"
