@@ -34,6 +34,10 @@ def label_params(*, depth: bool, normals: bool, map_by: Any) -> tuple[Param, ...
               "instance_attribute_maps, <attr> -> <attr>_segmaps; null: none"),
         Param("depth_background", "float|str", math.inf, "m", "depth/distance of pixels that hit nothing",
               check=_background_check),
+        Param("render_albedo", "bool", False, doc="write 'albedo': linear base color / texture at each pixel"),
+        Param("render_flow", "bool", False, doc="write forward/backward optical flow [px] between consecutive "
+              "keypoints with *_flow_occluded masks"),
+        Param("render_nocs", "bool", False, doc="write 'nocs': normalized object coordinates in [0, 1]"),
     )
 
 
@@ -44,4 +48,5 @@ def label_request(config: dict[str, Any]) -> LabelRequest:
         depth=config["render_depth"], distance=config["render_distance"], normals=config["render_normals"],
         map_by=[] if config["map_by"] is None else parse_map_by(config["map_by"]),
         depth_background=math.inf if isinstance(background, str) else float(background),
-        normals_space=config["normals_space"])
+        normals_space=config["normals_space"], albedo=config["render_albedo"], flow=config["render_flow"],
+        nocs=config["render_nocs"])

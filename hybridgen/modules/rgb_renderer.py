@@ -47,7 +47,8 @@ class RgbRenderer(Module):
         if cfg["resolution_x"] is not None or cfg["resolution_y"] is not None:
             scene.camera.intrinsics = scene.camera.intrinsics.resized(cfg["resolution_x"], cfg["resolution_y"])
         request = label_request(cfg)
-        wants_labels = request.depth or request.distance or request.normals or request.map_by
+        wants_labels = any((request.depth, request.distance, request.normals, request.map_by, request.albedo,
+                            request.flow, request.nocs))
         settings = PathTraceSettings(cfg["samples"], cfg["min_bounces"], cfg["max_bounces"], cfg["glossy_bounces"])
         variant = choose_variant(cfg["variant"])
         context.log(f"color: Mitsuba {variant}, {settings.samples} spp, max_bounces {settings.max_bounces}"

@@ -20,7 +20,8 @@ class LabelRequest:
 
     ``map_by`` entries: ``class`` (``category_id_segmaps``), ``instance`` (``instance_segmaps`` plus the
     per-keypoint ``instance_attribute_maps``) or the name of a numeric object attribute ``a``
-    (``a_segmaps``).
+    (``a_segmaps``). ``albedo``, ``flow`` and ``nocs`` add the passes of
+    :mod:`hybridgen.render.albedo_pass` and :mod:`hybridgen.render.geometry_passes`.
     """
 
     depth: bool = True
@@ -29,6 +30,9 @@ class LabelRequest:
     map_by: list[str] = field(default_factory=lambda: ["class", "instance"])
     depth_background: float = float("inf")
     normals_space: str = "camera"
+    albedo: bool = False
+    flow: bool = False
+    nocs: bool = False
 
     def segmap_attributes(self) -> list[str]:
         """Attributes (``category_id``, custom) that get an ``<attr>_segmaps`` pass, in order."""
@@ -56,6 +60,14 @@ class LabelRequest:
         if self.wants_instances:
             out.append(PassLayout("instance_segmaps", "int32", (height, width)))
             out.append(PassLayout("instance_attribute_maps", "json", ()))
+        if self.albedo:
+            out.append(PassLayout("albedo", "float32", (height, width, 3)))
+        if self.nocs:
+            out.append(PassLayout("nocs", "float32", (height, width, 3)))
+        if self.flow:
+            for direction in ("forward", "backward"):
+                out.append(PassLayout(f"{direction}_flow", "float32", (height, width, 2)))
+                out.append(PassLayout(f"{direction}_flow_occluded", "uint8", (height, width)))
         return out
 
     def tables(self, view: Any) -> "LabelTables":

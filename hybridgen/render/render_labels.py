@@ -8,6 +8,8 @@ import numpy as np
 from ..errors import InputError
 from ..io.frame_sink import FrameSink, PassLayout
 from ..scene.scene import Scene
+from .albedo_pass import AlbedoPass
+from .geometry_passes import nocs, optical_flow
 from .keypoint_loop import ProgressFactory, run_keypoints
 from .label_request import LabelRequest
 from .raster import RasterView
@@ -29,6 +31,7 @@ class LabelProducer:
         self.view = view or RasterView(scene, normals_space=request.normals_space,
                                        depth_background=request.depth_background)
         self._tables = request.tables(self.view)
+        self._albedo = AlbedoPass(self.view) if request.albedo else None
 
     def layouts(self) -> list[PassLayout]:
         intr = self.scene.camera.intrinsics
@@ -41,9 +44,31 @@ class LabelProducer:
         return {}
 
     def produce(self, index: int, cam2world: np.ndarray, eye: int = 0) -> dict[str, Any]:
-        return self.request.compute(self.view.render_raw(cam2world), self._tables)
+        raw = self.view.render_raw(cam2world)
+        values = self.request.compute(raw, self._tables)
+        intr = self.scene.camera.intrinsics
+        if self._albedo is not None:
+            values["albedo"] = self._albedo.render(cam2world)
+        if self.request.nocs:
+            values["nocs"] = nocs(raw, intr, cam2world, self.scene)
+        if self.request.flow:
+            for direction, step in (("forward", 1), ("backward", -1)):
+                other = self._neighbour(index, step, cam2world)
+                depth = None if other is None else self.view.render(other, ["depth"])["depth"]
+                flow, occluded = optical_flow(raw, intr, cam2world, other, depth)
+                values[f"{direction}_flow"], values[f"{direction}_flow_occluded"] = flow, occluded
+        return values
+
+    def _neighbour(self, index: int, step: int, cam2world: np.ndarray) -> np.ndarray | None:
+        """Keypoint ``index + step``'s pose, moved like ``cam2world`` is from keypoint ``index`` (stereo eyes)."""
+        keypoints = self.scene.camera.keypoints
+        if not 0 <= index + step < len(keypoints):
+            return None
+        return keypoints[index + step] @ np.linalg.inv(keypoints[index]) @ cam2world
 
     def close(self) -> None:
+        if self._albedo is not None:
+            self._albedo.release()
         if self._own_view:
             self.view.release()
 
