@@ -38,6 +38,8 @@ def label_params(*, depth: bool, normals: bool, map_by: Any) -> tuple[Param, ...
         Param("render_flow", "bool", False, doc="write forward/backward optical flow [px] between consecutive "
               "keypoints with *_flow_occluded masks"),
         Param("render_nocs", "bool", False, doc="write 'nocs': normalized object coordinates in [0, 1]"),
+        Param("render_object_records", "bool", False, doc="write 'object_records' per keypoint: object-to-camera "
+              "poses, 3D boxes, visible and amodal 2D boxes, pixel counts, visible fractions"),
     )
 
 
@@ -49,4 +51,4 @@ def label_request(config: dict[str, Any]) -> LabelRequest:
         map_by=[] if config["map_by"] is None else parse_map_by(config["map_by"]),
         depth_background=math.inf if isinstance(background, str) else float(background),
         normals_space=config["normals_space"], albedo=config["render_albedo"], flow=config["render_flow"],
-        nocs=config["render_nocs"])
+        nocs=config["render_nocs"], object_records=config["render_object_records"])

@@ -48,7 +48,7 @@ class RgbRenderer(Module):
             scene.camera.intrinsics = scene.camera.intrinsics.resized(cfg["resolution_x"], cfg["resolution_y"])
         request = label_request(cfg)
         wants_labels = any((request.depth, request.distance, request.normals, request.map_by, request.albedo,
-                            request.flow, request.nocs))
+                            request.flow, request.nocs, request.object_records))
         settings = PathTraceSettings(cfg["samples"], cfg["min_bounces"], cfg["max_bounces"], cfg["glossy_bounces"])
         variant = choose_variant(cfg["variant"])
         context.log(f"color: Mitsuba {variant}, {settings.samples} spp, max_bounces {settings.max_bounces}"

@@ -20,8 +20,9 @@ class LabelRequest:
 
     ``map_by`` entries: ``class`` (``category_id_segmaps``), ``instance`` (``instance_segmaps`` plus the
     per-keypoint ``instance_attribute_maps``) or the name of a numeric object attribute ``a``
-    (``a_segmaps``). ``albedo``, ``flow`` and ``nocs`` add the passes of
-    :mod:`hybridgen.render.albedo_pass` and :mod:`hybridgen.render.geometry_passes`.
+    (``a_segmaps``). ``albedo``, ``flow``, ``nocs`` and ``object_records`` add the passes of
+    :mod:`hybridgen.render.albedo_pass`, :mod:`hybridgen.render.geometry_passes` and
+    :mod:`hybridgen.render.object_records`.
     """
 
     depth: bool = True
@@ -33,6 +34,7 @@ class LabelRequest:
     albedo: bool = False
     flow: bool = False
     nocs: bool = False
+    object_records: bool = False
 
     def segmap_attributes(self) -> list[str]:
         """Attributes (``category_id``, custom) that get an ``<attr>_segmaps`` pass, in order."""
@@ -64,6 +66,8 @@ class LabelRequest:
             out.append(PassLayout("albedo", "float32", (height, width, 3)))
         if self.nocs:
             out.append(PassLayout("nocs", "float32", (height, width, 3)))
+        if self.object_records:
+            out.append(PassLayout("object_records", "json", ()))
         if self.flow:
             for direction in ("forward", "backward"):
                 out.append(PassLayout(f"{direction}_flow", "float32", (height, width, 2)))

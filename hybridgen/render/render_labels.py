@@ -11,6 +11,7 @@ from ..scene.scene import Scene
 from .albedo_pass import AlbedoPass
 from .geometry_passes import nocs, optical_flow
 from .keypoint_loop import ProgressFactory, run_keypoints
+from .object_records import object_records
 from .label_request import LabelRequest
 from .raster import RasterView
 
@@ -51,6 +52,8 @@ class LabelProducer:
             values["albedo"] = self._albedo.render(cam2world)
         if self.request.nocs:
             values["nocs"] = nocs(raw, intr, cam2world, self.scene)
+        if self.request.object_records:
+            values["object_records"] = object_records(self.view, raw, cam2world)
         if self.request.flow:
             for direction, step in (("forward", 1), ("backward", -1)):
                 other = self._neighbour(index, step, cam2world)

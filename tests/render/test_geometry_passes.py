@@ -86,3 +86,29 @@ def test_nocs_of_a_cube(gl_context):
     on_face = (np.abs(values - low) < 1e-4) | (np.abs(values - high) < 1e-4)
     assert on_face.any(axis=1).all()
     assert (frame["nocs"][~hit] == 0).all()
+
+
+def test_object_records_poses_boxes_and_visible_fractions(gl_context):
+    """A cube half hidden behind a wall: amodal box from drawing it alone, visible fraction about 1/2."""
+    scene = hg.Scene()
+    scene.add(hg.make_primitive("cube", 1.0, name="cube", category_id=3, local2world=hg.object_pose([0, 0, 0])))
+    wall = hg.MeshObject("wall", [[0, -5, -5], [10, -5, -5], [10, -5, 5], [0, -5, 5]], [[0, 1, 2], [0, 2, 3]],
+                         category_id=1)
+    scene.add(wall)
+    wall.local2world = hg.object_pose([0, 4.0, 0])  # the wall plane y = -1 covers x >= 0
+    scene.camera.intrinsics = hg.Intrinsics(np.array([[40.0, 0, 31.5], [0, 40.0, 23.5], [0, 0, 1]]), 64, 48)
+    pose = hg.look_at([0, -6, 0], [0, 0, 0])
+    scene.camera.add_keypoint(pose)
+    frame = _render(scene, object_records=True)[0]
+    records = {r["name"]: r for r in frame["object_records"]}
+    cube = records["cube"]
+    obj2cam = np.array(cube["obj2cam"])
+    np.testing.assert_allclose(obj2cam, np.linalg.inv(pose) @ scene.objects[0].local2world, atol=1e-12)
+    np.testing.assert_allclose(obj2cam[:3, 3], [0, 0, 6], atol=1e-12)  # 6 m straight ahead
+    # the cube's front face (y = -0.5, depth 5.5) spans u, v in 31.5 -+ 40 * 0.5 / 5.5 = 27.86..35.14
+    assert cube["bbox_obj"] == [28, 20, 8, 8]
+    assert cube["bbox_visib"][0] == 28 and cube["bbox_visib"][2] == 4  # the right half (x >= 0) is hidden
+    assert cube["px_count_all"] == 64 and cube["px_count_visib"] == 32 and cube["visib_fract"] == 0.5
+    corners = np.array(cube["bbox3d_cam"])
+    np.testing.assert_allclose(corners[:, 2].min(), 5.5) and np.testing.assert_allclose(corners[:, 2].max(), 6.5)
+    assert records["wall"]["visib_fract"] == 1.0
