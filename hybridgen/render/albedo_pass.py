@@ -48,7 +48,8 @@ class AlbedoPass:
             texture = None
             content = [(gpu.positions, "3f", "in_position")]
             if image is not None:
-                uv = ctx.buffer(np.asarray(obj.uvs, dtype=np.float32).tobytes())
+                uvs = np.asarray(obj.uvs, dtype=np.float32)
+                uv = ctx.buffer((uvs if gpu.vertex_order is None else uvs[gpu.vertex_order]).tobytes())
                 content.append((uv, "2f", "in_uv"))
                 texture = ctx.texture((image.shape[1], image.shape[0]), 4, image.tobytes(),
                                       internal_format=GL_SRGB8_ALPHA8)

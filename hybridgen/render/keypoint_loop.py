@@ -22,7 +22,8 @@ class Producer(Protocol):
     """Makes some output keys of every keypoint.
 
     ``records`` are whole-run datasets (e.g. poses) it adds; ``eye`` is 0, or 1 for a stereo right eye
-    (producers with randomness draw a different stream for it).
+    (producers with randomness draw a different stream for it). A producer may also have
+    ``prefetch(index, cam2world)``, called one keypoint ahead so that its work can overlap.
     """
 
     def layouts(self) -> list[PassLayout]: ...
@@ -66,7 +67,14 @@ def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Prod
         for sink in sinks:
             sink.begin(n, layouts, records, attributes)
         bar = progress(n, what) if progress else None
-        for index, pose in enumerate(scene.camera.keypoints):
+        prefetching = [p for p in producers if hasattr(p, "prefetch")]
+        keypoints = scene.camera.keypoints
+        for producer in prefetching:
+            producer.prefetch(0, keypoints[0])  # type: ignore[attr-defined]
+        for index, pose in enumerate(keypoints):
+            if index + 1 < n:  # the next keypoint draws while this one is read back and processed
+                for producer in prefetching:
+                    producer.prefetch(index + 1, keypoints[index + 1])  # type: ignore[attr-defined]
             values: dict[str, Any] = {}
             for producer in producers:
                 values.update(producer.produce(index, pose))

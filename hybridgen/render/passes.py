@@ -54,7 +54,7 @@ def _distance(out: RasterOutput) -> np.ndarray:
 
 
 def _normals(out: RasterOutput) -> np.ndarray:
-    return np.ascontiguousarray(out.normal_depth[..., :3])
+    return out.normal_depth[..., :3]  # a view: writers copy it (off the render thread) when they store it
 
 
 def _instance(out: RasterOutput) -> np.ndarray:

@@ -32,11 +32,9 @@ class GpuObject:
     positions: Any
     indices: Any
     buffers: list[Any]
-    face_normals: Any
-    smooth: bool
+    vertex_order: np.ndarray | None  # mesh vertex of each GPU vertex (flat meshes), None: the same order
     closed: bool
     bounds: np.ndarray  # (2, 3) local box
-    local2world: np.ndarray
 
 
 class RasterView:
@@ -62,41 +60,51 @@ class RasterView:
             self._class_lut = self.category_lut()
         except InputError:
             self._class_lut = np.zeros(len(scene.objects) + 1, dtype=np.int32)
-        self._fbo: Any = None
-        self._fbo_size: tuple[int, int] | None = None
+        self._fbos: dict[Any, Any] = {}  # (slot, width, height) -> framebuffer
+        self._submitted: dict[Any, Intrinsics] = {}
         self._ray_lengths: np.ndarray | None = None
         self._ray_key: Any = None
+        self._cached_pose_key: bytes | None = None
+        self._cached_pose: dict[str, Any] = {}
 
     # ----------------------------------------------------------------- resources
     def _upload(self, obj: Any) -> GpuObject:
+        """GPU buffers of ``obj``: smooth meshes as they are; flat ones with a vertex per face corner that
+        carries the face normal (``vertex_order`` maps GPU vertices back to mesh vertices)."""
         ctx = self.ctx
-        positions = ctx.buffer(obj.vertices.astype(np.float32).tobytes())
-        indices = ctx.buffer(obj.faces.astype(np.uint32).tobytes())
-        face_normals = ctx.buffer(obj.face_normals.astype(np.float32).tobytes())
-        content = [(positions, "3f", "in_position")]
-        buffers = [positions, indices]
-        smooth = obj.vertex_normals is not None
-        if smooth:
-            normals = ctx.buffer(obj.vertex_normals.astype(np.float32).tobytes())
-            content.append((normals, "3f", "in_normal"))
-            buffers.append(normals)
-        vao = ctx.vertex_array(self.program, content, index_buffer=indices, index_element_size=4)
-        return GpuObject(obj.instance_id, vao, positions, indices, buffers, face_normals, smooth,
-                         obj.is_closed, obj.bounds_local, obj.local2world)
+        if obj.vertex_normals is not None:
+            vertex_order = None
+            vertices, normals, faces = obj.vertices, obj.vertex_normals, obj.faces
+        else:
+            vertex_order = obj.faces.ravel()
+            vertices = obj.vertices[vertex_order]
+            normals = np.repeat(obj.face_normals, 3, axis=0)
+            faces = np.arange(len(vertex_order)).reshape(-1, 3)
+        positions = ctx.buffer(vertices.astype(np.float32).tobytes())
+        normal_buffer = ctx.buffer(normals.astype(np.float32).tobytes())
+        indices = ctx.buffer(faces.astype(np.uint32).tobytes())
+        vao = ctx.vertex_array(self.program, [(positions, "3f", "in_position"), (normal_buffer, "3f", "in_normal")],
+                               index_buffer=indices, index_element_size=4)
+        return GpuObject(obj.instance_id, vao, positions, indices, [positions, normal_buffer, indices],
+                         vertex_order, obj.is_closed, obj.bounds_local)
 
-    def _framebuffer(self, width: int, height: int) -> Any:
-        if self._fbo_size != (width, height):
-            if self._fbo is not None:
-                for attachment in (*self._fbo.color_attachments, self._fbo.depth_attachment):
-                    attachment.release()
-                self._fbo.release()
+    def _framebuffer(self, slot: Any, width: int, height: int) -> Any:
+        key = (slot, width, height)
+        if key not in self._fbos:
+            for old in [k for k in self._fbos if k[0] == slot]:
+                self._release_fbo(self._fbos.pop(old))
             ctx = self.ctx
-            self._fbo = ctx.framebuffer(
+            self._fbos[key] = ctx.framebuffer(
                 color_attachments=[ctx.renderbuffer((width, height), 4, dtype="f4"),
                                    ctx.renderbuffer((width, height), 1, dtype="u4")],
                 depth_attachment=ctx.depth_renderbuffer((width, height)))
-            self._fbo_size = (width, height)
-        return self._fbo
+        return self._fbos[key]
+
+    @staticmethod
+    def _release_fbo(fbo: Any) -> None:
+        for attachment in (*fbo.color_attachments, fbo.depth_attachment):
+            attachment.release()
+        fbo.release()
 
     def _rays(self, intr: Intrinsics) -> np.ndarray:
         key = (intr.K.tobytes(), intr.width, intr.height)
@@ -123,47 +131,100 @@ class RasterView:
 
         Objects whose instance id is in ``hidden`` are left out (rays pass through them).
         """
+        self.submit(cam2world, intrinsics, hidden, slot="now")
+        return self.collect("now")
+
+    def submit(self, cam2world: np.ndarray, intrinsics: Intrinsics | None = None,
+               hidden: frozenset[int] = frozenset(), slot: Any = 0) -> None:
+        """Issue the draws of one keypoint into framebuffer ``slot`` without waiting for them.
+
+        The rasterizer (llvmpipe's threads, or the GPU) works on it while the caller goes on - e.g. turning
+        the previous keypoint's readback into passes; :meth:`collect` then reads it back. Two slots give a
+        two-deep pipeline.
+        """
         intr = intrinsics or self.scene.camera.intrinsics
         width, height = intr.width, intr.height
-        fbo = self._framebuffer(width, height)
+        fbo = self._framebuffer(slot, width, height)
         fbo.use()
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         self.ctx.enable(self.ctx.DEPTH_TEST)
         cam2world = np.asarray(cam2world, dtype=np.float64)
-        world2cam = np.linalg.inv(cam2world)
+        world2cam = np.eye(4)
+        world2cam[:3, :3] = cam2world[:3, :3].T
+        world2cam[:3, 3] = -cam2world[:3, :3].T @ cam2world[:3, 3]
         prog = self.program
         prog["u_projection"].write(projection_from_K(intr.K, width, height, intr.clip_start, intr.clip_end)
                                    .T.astype(np.float32).tobytes())
         to_output = np.eye(3) if self.normals_space == "camera" else cam2world[:3, :3]
         prog["u_cam_to_output"].write(to_output.T.astype(np.float32).tobytes())
         near_reach = near_plane_corner_distance(intr.K, width, height, intr.clip_start)
-        cam_pos = cam2world[:3, 3]
-        for gpu, obj in zip(self.gpu_objects, self.scene.objects):
-            if gpu.instance_id in hidden:
-                continue
-            modelview = world2cam @ obj.local2world
-            linear = modelview[:3, :3]
-            det = np.linalg.det(linear)
-            if det == 0:
-                continue  # zero scale: nothing to draw
-            normal_to_cam = np.linalg.inv(linear).T
-            prog["u_modelview"].write(modelview.T.astype(np.float32).tobytes())
-            prog["u_normal_to_cam"].write(normal_to_cam.T.astype(np.float32).tobytes())
-            prog["u_smooth"].value = gpu.smooth
+        draws = self._object_uniforms(cam2world, world2cam, near_reach, hidden)
+        for gpu, modelview, normal_to_cam, cull, front_face in draws:
+            prog["u_modelview"].write(modelview)
+            prog["u_normal_to_cam"].write(normal_to_cam)
             prog["u_instance_id"].value = gpu.instance_id
-            if gpu.closed and _outside_box(cam_pos, obj.local2world, gpu.bounds, near_reach):
+            # The projection mirrors handedness (and so may the object's transform): front_face is set so
+            # that gl_FrontFacing means "the side the normal points to faces the camera".
+            self.ctx.front_face = front_face
+            if cull:
                 self.ctx.enable(self.ctx.CULL_FACE)
-                # The projection mirrors handedness, and so does a mirroring object transform.
-                self.ctx.front_face = "cw" if det > 0 else "ccw"
             else:
                 self.ctx.disable(self.ctx.CULL_FACE)
-            gpu.face_normals.bind_to_storage_buffer(0)
             gpu.vao.render()
+        self._submitted[slot] = intr
+
+    def collect(self, slot: Any = 0) -> RasterOutput:
+        """Read back what :meth:`submit` drew into ``slot`` (waits for it to finish)."""
+        intr = self._submitted.pop(slot)
+        width, height = intr.width, intr.height
+        fbo = self._fbos[(slot, width, height)]
         normal_depth = np.empty((height, width, 4), dtype=np.float32)
         instance = np.empty((height, width), dtype=np.uint32)
         fbo.read_into(normal_depth, attachment=0, components=4, dtype="f4")
         fbo.read_into(instance, attachment=1, components=1, dtype="u4")
         return RasterOutput(normal_depth, instance, self._rays(intr), self._class_lut, self.depth_background)
+
+    def _object_uniforms(self, cam2world: np.ndarray, world2cam: np.ndarray, near_reach: float,
+                         hidden: frozenset[int]) -> list[tuple[GpuObject, bytes, bytes, bool, str]]:
+        """Per object to draw: modelview and normal matrix (float32 bytes, column-major), cull flag and the
+        front-face winding - computed for all objects at once from cached per-pose values."""
+        cache = self._pose_cache()
+        if not cache["objects"]:
+            return []
+        modelview = np.einsum("ij,njk->nik", world2cam, cache["local2world"])
+        normal_to_cam = np.einsum("ij,njk->nik", world2cam[:3, :3], cache["normal_to_world"])
+        cam_local = np.einsum("nij,j->ni", cache["to_local"][:, :3, :3], cam2world[:3, 3]) + cache["to_local"][:, :3, 3]
+        bounds = cache["bounds"]
+        gap = np.maximum(np.maximum(bounds[:, 0] - cam_local, cam_local - bounds[:, 1]), 0.0)
+        outside = np.linalg.norm(gap, axis=1) > near_reach * cache["stretch"]
+        modelview_bytes = np.ascontiguousarray(modelview.transpose(0, 2, 1), dtype=np.float32)
+        normal_bytes = np.ascontiguousarray(normal_to_cam.transpose(0, 2, 1), dtype=np.float32)
+        draws = []
+        for i, gpu in enumerate(cache["objects"]):
+            if gpu.instance_id in hidden:
+                continue
+            draws.append((gpu, modelview_bytes[i].tobytes(), normal_bytes[i].tobytes(),
+                          bool(gpu.closed and outside[i]), "cw" if cache["det"][i] > 0 else "ccw"))
+        return draws
+
+    def _pose_cache(self) -> dict[str, Any]:
+        """Camera-independent per-object matrices, recomputed only when an object's pose changed."""
+        key = b"".join(obj.local2world.tobytes() for obj in self.scene.objects)
+        if self._cached_pose_key != key:
+            pairs = [(gpu, obj) for gpu, obj in zip(self.gpu_objects, self.scene.objects)
+                     if np.linalg.det(obj.local2world[:3, :3]) != 0]  # zero scale: nothing to draw
+            local2world = np.array([obj.local2world for _, obj in pairs]).reshape(-1, 4, 4)
+            to_local = np.linalg.inv(local2world) if len(pairs) else local2world
+            self._cached_pose = {
+                "objects": [gpu for gpu, _ in pairs], "local2world": local2world, "to_local": to_local,
+                "normal_to_world": to_local[:, :3, :3].transpose(0, 2, 1),
+                "det": np.linalg.det(local2world[:, :3, :3]) if len(pairs) else np.zeros(0),
+                "bounds": np.array([gpu.bounds for gpu, _ in pairs]).reshape(-1, 2, 3),
+                # a world distance d is at most d * |to_local|_2 in local units
+                "stretch": np.linalg.norm(to_local[:, :3, :3], ord=2, axis=(1, 2)) if len(pairs) else np.zeros(0),
+            }
+            self._cached_pose_key = key
+        return self._cached_pose
 
     def render(self, cam2world: np.ndarray, passes: Iterable[str] = ("depth", "normals", "instance_segmaps"),
                intrinsics: Intrinsics | None = None) -> dict[str, np.ndarray]:
@@ -179,21 +240,10 @@ class RasterView:
         """Free the GL resources of this view (the context stays)."""
         for gpu in self.gpu_objects:
             gpu.vao.release()
-            gpu.face_normals.release()
             for buf in gpu.buffers:
                 buf.release()
         self.gpu_objects = []
-        if self._fbo is not None:
-            self._fbo.release()
-            self._fbo = None
-            self._fbo_size = None
+        for fbo in self._fbos.values():
+            self._release_fbo(fbo)
+        self._fbos.clear()
 
-
-def _outside_box(cam_pos: np.ndarray, local2world: np.ndarray, bounds: np.ndarray, margin: float) -> bool:
-    """True if the camera centre is farther than ``margin`` (m, world) from the object's local box."""
-    to_local = np.linalg.inv(local2world)
-    p = to_local[:3, :3] @ cam_pos + to_local[:3, 3]
-    # Distance in local units; convert the world margin with the largest local->world stretch bound.
-    stretch = np.linalg.norm(to_local[:3, :3], ord=2)
-    gap = np.maximum(np.maximum(bounds[0] - p, p - bounds[1]), 0.0)
-    return bool(np.linalg.norm(gap) > margin * stretch)

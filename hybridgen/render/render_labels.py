@@ -33,6 +33,7 @@ class LabelProducer:
                                        depth_background=request.depth_background)
         self._tables = request.tables(self.view)
         self._albedo = AlbedoPass(self.view) if request.albedo else None
+        self._pending: dict[int, tuple[int, int, bytes]] = {}
 
     def layouts(self) -> list[PassLayout]:
         intr = self.scene.camera.intrinsics
@@ -44,8 +45,19 @@ class LabelProducer:
     def records(self) -> dict[str, np.ndarray]:
         return {}
 
+    def prefetch(self, index: int, cam2world: np.ndarray, eye: int = 0) -> None:
+        """Start drawing keypoint ``index`` so that it rasterizes while the previous one is processed."""
+        slot = index % 2
+        self.view.submit(cam2world, slot=slot)
+        self._pending[slot] = (index, eye, np.asarray(cam2world).tobytes())
+
     def produce(self, index: int, cam2world: np.ndarray, eye: int = 0) -> dict[str, Any]:
-        raw = self.view.render_raw(cam2world)
+        slot = index % 2
+        if self._pending.get(slot) == (index, eye, np.asarray(cam2world).tobytes()):
+            del self._pending[slot]
+            raw = self.view.collect(slot)
+        else:
+            raw = self.view.render_raw(cam2world)
         values = self.request.compute(raw, self._tables)
         intr = self.scene.camera.intrinsics
         if self._albedo is not None:
