@@ -31,7 +31,7 @@ class Hdf5SingleFileWriter:
     Use :meth:`finalize` to add scene-level records and commit, :meth:`abort` to drop the partial file.
     """
 
-    def __init__(self, path: str | Path, *, compression: str = "gzip", compression_level: int = 4,
+    def __init__(self, path: str | Path, *, compression: str = "gzip", compression_level: int = 1,
                  queue_size: int = 3) -> None:
         if compression not in COMPRESSIONS:
             raise InputError(f"compression must be one of {COMPRESSIONS}, got {compression!r}")

@@ -25,7 +25,7 @@ class Hdf5Writer(Module):
         Param("file_name", "str", "data.hdf5", doc="file name inside output_dir", check=_file_name_check),
         Param("layout", "str", "single", choices=("single",), doc="single: one file, keypoint axis first"),
         Param("compression", "str", "gzip", choices=COMPRESSIONS, doc="dataset compression"),
-        Param("compression_level", "int", 4, doc="gzip level 0..9",
+        Param("compression_level", "int", 1, doc="gzip level 0..9 (1: twice as fast as 4, files ~10 % larger)",
               check=lambda v: None if 0 <= v <= 9 else f"must be in 0..9, got {v}"),
     )
 
