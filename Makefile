@@ -33,6 +33,7 @@ test: setup
 bench: setup
 	$(PIP) install -q -e '.[bench]'
 	$(BIN)/python tools/bench_labels.py
+	$(BIN)/python tools/bench_color.py
 
 clean:
 	rm -rf output .pytest_cache

@@ -32,7 +32,7 @@ def _ours_worker(conn) -> None:  # type: ignore[no-untyped-def]
         message = conn.recv()
         if message is None:
             return
-        kind, scene_name, resolution, frames = message
+        kind, scene_name, resolution, frames, *options = message
         key = (scene_name, resolution)
         if key not in cache:
             scene = bs.SCENES[scene_name]()
@@ -54,7 +54,7 @@ def _ours_worker(conn) -> None:  # type: ignore[no-untyped-def]
             for pose in poses:
                 scene.camera.add_keypoint(pose)
             with tempfile.TemporaryDirectory() as tmp:
-                writer = hg.Hdf5SingleFileWriter(Path(tmp) / "data.hdf5", compression="gzip")
+                writer = hg.Hdf5SingleFileWriter(Path(tmp) / "data.hdf5", compression=options[0])
                 start = time.perf_counter()
                 hg.render_labels(scene, [writer], request, view=view)
                 writer.finalize({"object_states": [o.state() for o in scene.objects]})
@@ -114,6 +114,9 @@ def main() -> None:
     parser.add_argument("--frames", type=int, default=12, help="keypoints per round")
     parser.add_argument("--rounds", type=int, default=3, help="alternating rounds per scene and engine")
     parser.add_argument("--quick", action="store_true", help="640x480 only, fewer frames")
+    parser.add_argument("--compression", nargs="+", default=["gzip", "lzf", "none"],
+                        help="HDF5 compressions to time end to end")
+    parser.add_argument("--skip-pyrender", action="store_true", help="only the HDF5 end-to-end part")
     args = parser.parse_args()
     resolutions = ["640x480"] if args.quick else ["640x480", "1280x720"]
     frames = 4 if args.quick else args.frames
@@ -134,7 +137,7 @@ def main() -> None:
 
     print(f"{'scene':<18} {'resolution':<10} {'triangles':>10} {'ours fps':>9} {'pyrender fps':>13} {'ratio':>6}")
     rows = []
-    for scene_name in bs.SCENES:
+    for scene_name in [] if args.skip_pyrender else bs.SCENES:
         triangles = bs.SCENES[scene_name]().triangle_count
         for resolution in resolutions:
             ours, theirs = [], []
@@ -144,14 +147,16 @@ def main() -> None:
             a, b = statistics.median(ours), statistics.median(theirs)
             rows.append((scene_name, resolution, a, b))
             print(f"{scene_name:<18} {resolution:<10} {triangles:>10,} {a:>9.1f} {b:>13.1f} {a / b:>6.2f}", flush=True)
-    print("\nend to end with HDF5 (gzip, depth + normals + instance + class maps, written while rendering):")
+    print("\nend to end with HDF5 (depth + normals + instance + class maps, written while the next keypoint renders):")
     for scene_name in bs.SCENES:
-        raw, full = [], []
-        for _ in range(args.rounds):
-            raw.append(ask("ours", ("raw", scene_name, "640x480", frames)))
-            full.append(ask("ours", ("hdf5", scene_name, "640x480", frames)))
-        a, b = statistics.median(raw), statistics.median(full)
-        print(f"{scene_name:<18} 640x480  raw {a:6.1f} fps  with HDF5 {b:6.1f} fps  ratio {b / a:.2f}", flush=True)
+        for compression in args.compression:
+            raw, full = [], []
+            for _ in range(args.rounds):
+                raw.append(ask("ours", ("raw", scene_name, "640x480", frames)))
+                full.append(ask("ours", ("hdf5", scene_name, "640x480", frames, compression)))
+            a, b = statistics.median(raw), statistics.median(full)
+            print(f"{scene_name:<18} 640x480 {compression:<5} raw {a:6.1f} fps  with HDF5 {b:6.1f} fps  "
+                  f"ratio {b / a:.2f}", flush=True)
     for conn, process in workers.values():
         conn.send(None)
         process.join(timeout=10)

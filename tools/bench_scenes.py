@@ -15,7 +15,7 @@ def pybullet_data_dir() -> Path:
     try:
         import pybullet_data
     except ImportError:
-        raise SystemExit("the benchmark's real scene mesh comes with pybullet: .venv/bin/pip install pybullet") from None
+        raise SystemExit("the benchmarks' real meshes come with pybullet: .venv/bin/pip install pybullet") from None
     return Path(pybullet_data.getDataPath())
 
 
