@@ -5,6 +5,7 @@ from pathlib import Path
 
 from ..config.registry import register_module
 from ..config.schema import Param
+from ..io.hdf5_blenderproc import BlenderProcHdf5Writer
 from ..io.hdf5_single import COMPRESSIONS, Hdf5SingleFileWriter
 from ..run.context import RunContext
 from .base import Module
@@ -23,16 +24,26 @@ class Hdf5Writer(Module):
     params = (
         Param("output_dir", "path", doc="folder of the output file (usually from global.all)"),
         Param("file_name", "str", "data.hdf5", doc="file name inside output_dir", check=_file_name_check),
-        Param("layout", "str", "single", choices=("single",), doc="single: one file, keypoint axis first"),
+        Param("layout", "str", "single", choices=("single", "blenderproc"),
+              doc="single: one file, keypoint axis first; blenderproc: one <i>.hdf5 per keypoint, BlenderProc's keys"),
+        Param("append_to_existing_output", "bool", False,
+              doc="blenderproc layout: number the files after the highest <i>.hdf5 already in output_dir"),
         Param("compression", "str", "gzip", choices=COMPRESSIONS, doc="dataset compression"),
         Param("compression_level", "int", 1, doc="gzip level 0..9 (1: twice as fast as 4, files ~10 % larger)",
               check=lambda v: None if 0 <= v <= 9 else f"must be in 0..9, got {v}"),
     )
 
     def prepare(self, context: RunContext) -> None:
-        self.writer = Hdf5SingleFileWriter(Path(self.config["output_dir"]) / self.config["file_name"],
-                                           compression=self.config["compression"],
-                                           compression_level=self.config["compression_level"])
+        cfg = self.config
+        self.writer: Hdf5SingleFileWriter | BlenderProcHdf5Writer
+        if cfg["layout"] == "blenderproc":
+            self.writer = BlenderProcHdf5Writer(cfg["output_dir"], append=cfg["append_to_existing_output"],
+                                                compression=cfg["compression"],
+                                                compression_level=cfg["compression_level"])
+        else:
+            self.writer = Hdf5SingleFileWriter(Path(cfg["output_dir"]) / cfg["file_name"],
+                                               compression=cfg["compression"],
+                                               compression_level=cfg["compression_level"])
         context.sinks.append(self.writer)
         context.cleanups.append(self.writer.abort)
 
@@ -42,5 +53,7 @@ class Hdf5Writer(Module):
                    "light_states": [{"name": light.name, "type": light.type, "energy": light.energy,
                                      "color": list(light.color), "local2world": light.local2world.tolist()}
                                     for light in scene.lights]}
-        path = self.writer.finalize(records, context.run_attributes())
-        context.outputs.append(path)
+        if isinstance(self.writer, BlenderProcHdf5Writer):
+            context.outputs += self.writer.finalize(records)
+        else:
+            context.outputs.append(self.writer.finalize(records, context.run_attributes()))

@@ -1,0 +1,126 @@
+"""BlenderProc-compatible output (SPEC section 4): one ``<i>.hdf5`` per keypoint, keys as BlenderProc writes.
+
+Per file: every image pass under its key (``colors``, ``depth``, ``distance``, ``<attr>_segmaps``, flow,
+...), gzip-compressed; ``normals`` in the camera frame with **Blender axes** (x right, y up, z backwards:
+OpenCV's with y and z negated) encoded ``0.5 * n + 0.5``; JSON values (``instance_attribute_maps``,
+``object_records``) and ``cam_states`` (Blender-axes ``cam2world_matrix``, ``cam_K``, ``location``,
+``fov_x``/``fov_y``) as scalar byte strings, like BlenderProc's ``WriterUtility``. BlenderProc's viewer
+(``blenderproc vis hdf5``) opens them.
+
+Each file is written under a temporary name while renderers add keys to it and renamed by
+:meth:`finalize`; ``append`` continues the numbering after the highest ``<i>.hdf5`` already in the folder.
+"""
+from __future__ import annotations
+
+import json
+import math
+import re
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+
+from ..scene.frames import opencv_to_blender
+from .atomic import commit, prepare_output_dir, temporary_path
+from .frame_sink import PassLayout
+
+
+def next_index(directory: Path) -> int:
+    """One past the highest ``<i>.hdf5`` in ``directory`` (0 when there is none)."""
+    numbers = [int(m.group(1)) for p in directory.glob("*.hdf5") if (m := re.fullmatch(r"(\d+)\.hdf5", p.name))]
+    return max(numbers, default=-1) + 1
+
+
+def cam_state(K: np.ndarray, cam2world_cv: np.ndarray, width: int, height: int) -> dict[str, Any]:
+    """BlenderProc's camera attributes of one keypoint (Blender camera axes)."""
+    cam2world = opencv_to_blender(cam2world_cv)
+    return {"cam2world_matrix": cam2world.tolist(), "cam_K": np.asarray(K).tolist(),
+            "location": cam2world[:3, 3].tolist(),
+            "fov_x": 2 * math.atan(width / (2 * K[0, 0])), "fov_y": 2 * math.atan(height / (2 * K[1, 1]))}
+
+
+def encode_normals(normals: np.ndarray, cam2world_cv: np.ndarray, space: str) -> np.ndarray:
+    """Unit normals (OpenCV camera or world axes) -> Blender camera axes, encoded 0.5 * n + 0.5."""
+    n = np.asarray(normals, dtype=np.float32)
+    if space == "world":
+        n = n @ cam2world_cv[:3, :3].astype(np.float32)  # world -> OpenCV camera: R^T n, row-vector form
+    blender = n * np.array([1.0, -1.0, -1.0], np.float32)
+    return (0.5 * blender + 0.5).astype(np.float32)
+
+
+class BlenderProcHdf5Writer:
+    """A :class:`~hybridgen.io.frame_sink.FrameSink` writing BlenderProc's per-keypoint layout into ``directory``."""
+
+    def __init__(self, directory: str | Path, *, append: bool = False, compression: str = "gzip",
+                 compression_level: int = 1) -> None:
+        self.directory = prepare_output_dir(Path(directory))
+        self.offset = next_index(self.directory) if append else 0
+        self.compression = None if compression == "none" else compression
+        self.level = compression_level if compression == "gzip" else None
+        self._layouts: dict[str, PassLayout] = {}
+        self._records: dict[str, np.ndarray] = {}
+        self._attributes: dict[str, Any] = {}
+        self._n = 0
+        self._touched: set[int] = set()
+
+    def final_path(self, index: int) -> Path:
+        return self.directory / f"{index + self.offset}.hdf5"
+
+    def _temp(self, index: int) -> Path:
+        return temporary_path(self.final_path(index))
+
+    def begin(self, n_keypoints: int, layouts: list[PassLayout], camera_records: dict[str, np.ndarray],
+              attributes: dict[str, Any]) -> None:
+        self._n = max(self._n, n_keypoints)
+        self._layouts.update({layout.key: layout for layout in layouts})
+        self._records.update(camera_records)
+        self._attributes.update(attributes)
+
+    def write(self, index: int, values: dict[str, Any]) -> None:
+        with h5py.File(self._temp(index), "a") as h5:
+            for key, value in values.items():
+                self._store(h5, key, value, index)
+        self._touched.add(index)
+
+    def _store(self, h5: h5py.File, key: str, value: Any, index: int) -> None:
+        layout = self._layouts.get(key)
+        if layout is not None and layout.dtype == "json":
+            h5.create_dataset(key, data=np.bytes_(json.dumps(value)))
+            return
+        array = np.asarray(value)
+        if key == "normals":
+            cam2world = self._records["cam2world"][index]
+            array = encode_normals(array, cam2world, str(self._attributes.get("normals_space", "camera")))
+        h5.create_dataset(key, data=array, compression=self.compression, compression_opts=self.level)
+
+    def end(self) -> None:
+        """Nothing is buffered between keypoints."""
+
+    def finalize(self, records: dict[str, Any] | None = None) -> list[Path]:
+        """Add ``cam_states`` and the JSON ``records`` (e.g. ``object_states``) to every keypoint's file and
+        rename them all to ``<i>.hdf5``."""
+        paths = []
+        K, cam2world = self._records.get("cam_K"), self._records.get("cam2world")
+        for index in sorted(self._touched):
+            with h5py.File(self._temp(index), "a") as h5:
+                if K is not None and cam2world is not None:
+                    height, width = next((layout.shape[-3:-1] if layout.key.startswith(("colors", "normals"))
+                                          else layout.shape[-2:] for layout in self._layouts.values()
+                                          if len(layout.shape) >= 2), (0, 0))
+                    state = cam_state(K[index], cam2world[index], width, height)
+                    h5.create_dataset("cam_states", data=np.bytes_(json.dumps(state)))
+                for key, value in (records or {}).items():
+                    h5.create_dataset(key, data=np.bytes_(json.dumps(value)))
+                h5.create_dataset("hybridgen_version",
+                                  data=np.bytes_(str(self._attributes.get("hybridgen_version", ""))))
+            commit(self._temp(index), self.final_path(index))
+            paths.append(self.final_path(index))
+        self._touched.clear()
+        return paths
+
+    def abort(self) -> None:
+        """Delete every temporary file; no ``<i>.hdf5`` of this run appears."""
+        for index in self._touched:
+            self._temp(index).unlink(missing_ok=True)
+        self._touched.clear()
