@@ -10,7 +10,7 @@ import sys
 from typing import Any, Sequence
 
 from ._version import __version__
-from .errors import HybridgenError
+from .errors import HybridgenError, InputError
 
 EXIT_USER_ERROR = 2
 
@@ -31,7 +31,15 @@ def _cmd_run(ns: argparse.Namespace) -> int:
     from .run.pipeline import run_config
 
     log = None if ns.quiet else (lambda message: print(f"hybridgen: {message}", file=sys.stderr, flush=True))
-    summary = run_config(ns.config, ns.args, progress=_progress_factory(not ns.quiet), log=log)
+    shard = None
+    if ns.shard:
+        try:
+            index, count = (int(v) for v in ns.shard.split("/"))
+        except ValueError:
+            raise InputError(f"--shard takes i/N (e.g. 0/4), got {ns.shard!r}") from None
+        shard = (index, count)
+    summary = run_config(ns.config, ns.args, progress=_progress_factory(not ns.quiet), log=log, workers=ns.workers,
+                         shard=shard, executor=ns.executor, address=ns.address)
     outputs = ", ".join(str(p) for p in summary.outputs) or "(no output file)"
     rate = summary.frames / summary.seconds if summary.seconds > 0 else 0.0
     print(f"hybridgen: {summary.frames} keypoint(s) in {summary.seconds:.2f} s ({rate:.1f}/s) -> {outputs}")
@@ -68,6 +76,10 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("config", help="YAML config file")
     run.add_argument("args", nargs="*", help="values for <args:0>, <args:1>, ...")
     run.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
+    run.add_argument("--workers", type=int, default=1, help="processes running work units in parallel")
+    run.add_argument("--shard", help="i/N: run only the scenes with scene %% N == i (external schedulers)")
+    run.add_argument("--executor", default="pool", choices=("pool", "ray"), help="where work units run")
+    run.add_argument("--address", help="Ray cluster address (with --executor ray); default: a local cluster")
     run.set_defaults(func=_cmd_run)
     modules = sub.add_parser("modules", help="list modules and their parameters")
     modules.add_argument("name", nargs="?", help="show one module")

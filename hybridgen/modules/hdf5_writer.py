@@ -40,6 +40,10 @@ class Hdf5Writer(Module):
             self.writer = BlenderProcHdf5Writer(cfg["output_dir"], append=cfg["append_to_existing_output"],
                                                 compression=cfg["compression"],
                                                 compression_level=cfg["compression_level"])
+        elif context.unit is not None:  # one work unit of a sharded run: its own complete file
+            self.writer = Hdf5SingleFileWriter(context.unit.shard_path(cfg["output_dir"]),
+                                               compression=cfg["compression"],
+                                               compression_level=cfg["compression_level"])
         else:
             self.writer = Hdf5SingleFileWriter(Path(cfg["output_dir"]) / cfg["file_name"],
                                                compression=cfg["compression"],

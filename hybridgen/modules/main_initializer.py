@@ -27,6 +27,12 @@ class Initializer(Module):
               check=lambda v: None if v >= 0 else "must be >= 0"),
         Param("hdri_path", "path|null", None, doc="HDR environment map (.exr/.hdr) lighting the scene"),
         Param("hdri_rotation", "float", 0.0, "rad", "rotation of the environment map about world +Z"),
+        Param("number_of_scenes", "int", 1, doc="scene variations: every module runs once per scene, each scene "
+              "with its own seed (SeedSequence(seed).spawn); more than 1 writes shards (see README)",
+              check=lambda v: None if v >= 1 else "must be >= 1"),
+        Param("keypoints_per_chunk", "int", 0, doc="split each scene's keypoints into work units of this many "
+              "(0: one unit per scene); units run in parallel with --workers and resume independently",
+              check=lambda v: None if v >= 0 else "must be >= 0"),
     )
 
     def run(self, context: RunContext) -> None:

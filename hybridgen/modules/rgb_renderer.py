@@ -54,7 +54,8 @@ class RgbRenderer(Module):
         context.log(f"color: Mitsuba {variant}, {settings.samples} spp, max_bounces {settings.max_bounces}"
                     + (", denoised" if cfg["denoise"] else ""))
         context.frames_rendered += render_color(
-            scene, context.sinks, settings, labels=request if wants_labels else None, seed=context.seed,
+            scene, context.sinks, settings, labels=request if wants_labels else None, seed=context.scene_seed,
             variant=variant, hdr=cfg["output_hdr"], denoise=cfg["denoise"],
             stereo_baseline=cfg["interocular_distance"] if cfg["stereo"] else None,
-            default_category_id=context.default_category_id, progress=context.progress)
+            default_category_id=context.default_category_id, progress=context.progress,
+            indices=context.keypoint_indices())

@@ -17,4 +17,5 @@ class SegMapRenderer(Module):
     def run(self, context: RunContext) -> None:
         context.frames_rendered += render_labels(context.scene, context.sinks, label_request(self.config),
                                                  default_category_id=context.default_category_id,
-                                                 progress=context.progress)
+                                                 progress=context.progress,
+                                                 indices=context.keypoint_indices())

@@ -6,7 +6,7 @@ together. :class:`StereoProducer` turns any producers into left/right pairs.
 """
 from __future__ import annotations
 
-from typing import Any, Callable, Iterable, Protocol
+from typing import Any, Callable, Iterable, Protocol, Sequence
 
 import numpy as np
 
@@ -45,16 +45,21 @@ def camera_records(scene: Scene) -> dict[str, np.ndarray]:
 
 
 def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Producer], *,
-                  progress: ProgressFactory | None = None, what: str = "keypoints") -> int:
-    """Render every keypoint of ``scene.camera`` with ``producers`` into ``sinks``; returns the count.
+                  progress: ProgressFactory | None = None, what: str = "keypoints",
+                  indices: Sequence[int] | None = None) -> int:
+    """Render the keypoints ``indices`` (default: all) of ``scene.camera`` with ``producers`` into ``sinks``;
+    returns the count. Sinks see them as 0..len(indices)-1 and get a ``keypoint_index`` record of the
+    scene's indices; producers see the scene's indices (seeds and neighbours stay those of the scene).
 
     Producers are closed at the end, also on errors.
     """
     sinks = list(sinks)
     try:
-        n = len(scene.camera)
-        if n == 0:
+        total = len(scene.camera)
+        if total == 0:
             raise InputError("the camera has no keypoints: add poses (camera.CameraLoader) before rendering")
+        chosen = list(range(total) if indices is None else indices)
+        n = len(chosen)
         layouts = [layout for p in producers for layout in p.layouts()]
         keys = [layout.key for layout in layouts]
         if len(set(keys)) != len(keys):
@@ -64,22 +69,26 @@ def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Prod
         for producer in producers:
             attributes.update(producer.attributes())
             records.update(producer.records())
+        records = {k: v[chosen] if len(v) == total else v for k, v in records.items()}
+        records["keypoint_index"] = np.asarray(chosen, dtype=np.int64)
         for sink in sinks:
             sink.begin(n, layouts, records, attributes)
         bar = progress(n, what) if progress else None
         prefetching = [p for p in producers if hasattr(p, "prefetch")]
         keypoints = scene.camera.keypoints
-        for producer in prefetching:
-            producer.prefetch(0, keypoints[0])  # type: ignore[attr-defined]
-        for index, pose in enumerate(keypoints):
-            if index + 1 < n:  # the next keypoint draws while this one is read back and processed
+        if chosen:
+            for producer in prefetching:
+                producer.prefetch(chosen[0], keypoints[chosen[0]])  # type: ignore[attr-defined]
+        for local, index in enumerate(chosen):
+            if local + 1 < n:  # the next keypoint draws while this one is read back and processed
+                ahead = chosen[local + 1]
                 for producer in prefetching:
-                    producer.prefetch(index + 1, keypoints[index + 1])  # type: ignore[attr-defined]
+                    producer.prefetch(ahead, keypoints[ahead])  # type: ignore[attr-defined]
             values: dict[str, Any] = {}
             for producer in producers:
-                values.update(producer.produce(index, pose))
+                values.update(producer.produce(index, keypoints[index]))
             for sink in sinks:
-                sink.write(index, values)
+                sink.write(local, values)
             if bar is not None:
                 bar.update(1)
         if bar is not None:

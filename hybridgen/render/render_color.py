@@ -1,7 +1,7 @@
 """Python API: path-traced color of every keypoint (plus, optionally, the labels) into frame sinks."""
 from __future__ import annotations
 
-from typing import Any, Iterable
+from typing import Any, Iterable, Sequence
 
 import numpy as np
 
@@ -77,7 +77,8 @@ class ColorProducer:
 def render_color(scene: Scene, sinks: Iterable[FrameSink], settings: PathTraceSettings | None = None, *,
                  labels: LabelRequest | None = None, seed: int = 0, variant: str | None = None,
                  hdr: bool = False, denoise: bool = False, stereo_baseline: float | None = None,
-                 default_category_id: int | None = None, progress: ProgressFactory | None = None) -> int:
+                 default_category_id: int | None = None, progress: ProgressFactory | None = None,
+                 indices: Sequence[int] | None = None) -> int:
     """Color (and ``labels`` if given) of every keypoint, as left/right pairs when ``stereo_baseline`` (m)."""
     producers: list[Producer] = []
     if labels is not None:
@@ -86,4 +87,4 @@ def render_color(scene: Scene, sinks: Iterable[FrameSink], settings: PathTraceSe
                                       denoise=denoise))
     if stereo_baseline is not None:
         producers = [StereoProducer(producers, stereo_baseline, scene)]
-    return run_keypoints(scene, sinks, producers, progress=progress, what="color")
+    return run_keypoints(scene, sinks, producers, progress=progress, what="color", indices=indices)

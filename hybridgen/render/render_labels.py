@@ -1,7 +1,7 @@
 """Python API: the label passes of every keypoint, from the raster view, into frame sinks."""
 from __future__ import annotations
 
-from typing import Any, Iterable
+from typing import Any, Iterable, Sequence
 
 import numpy as np
 
@@ -90,7 +90,8 @@ class LabelProducer:
 
 def render_labels(scene: Scene, sinks: Iterable[FrameSink], request: LabelRequest | None = None, *,
                   default_category_id: int | None = None, view: RasterView | None = None,
-                  progress: ProgressFactory | None = None) -> int:
-    """Render the labels of every keypoint of ``scene.camera`` into ``sinks``; returns the keypoint count."""
+                  progress: ProgressFactory | None = None, indices: Sequence[int] | None = None) -> int:
+    """Render the labels of the keypoints ``indices`` (default: all) of ``scene.camera`` into ``sinks``;
+    returns how many."""
     producer = LabelProducer(scene, request or LabelRequest(), default_category_id=default_category_id, view=view)
-    return run_keypoints(scene, sinks, [producer], progress=progress, what="labels")
+    return run_keypoints(scene, sinks, [producer], progress=progress, what="labels", indices=indices)

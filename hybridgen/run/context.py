@@ -10,6 +10,7 @@ import numpy as np
 from ..config.config_file import ConfigFile
 from ..io.frame_sink import FrameSink
 from ..scene.scene import Scene
+from .units import WorkUnit, scene_seed_sequence
 
 DEFAULT_SEED = 0
 
@@ -21,7 +22,9 @@ class RunContext:
     config: ConfigFile | None = None
     scene: Scene = field(default_factory=Scene)
     seed: int = DEFAULT_SEED
-    rng: np.random.Generator = field(default_factory=lambda: np.random.default_rng(DEFAULT_SEED))
+    scene_seed: int = DEFAULT_SEED  # per-scene seed for renderer randomness (sampler seeds of color)
+    unit: WorkUnit | None = None
+    rng: np.random.Generator = field(init=False)
     default_category_id: int | None = None
     sinks: list[FrameSink] = field(default_factory=list)
     outputs: list[Path] = field(default_factory=list)
@@ -31,14 +34,27 @@ class RunContext:
     log: Callable[[str], None] = field(default=lambda message: None)
     cleanups: list[Callable[[], None]] = field(default_factory=list)
 
+    def __post_init__(self) -> None:
+        self.set_seed(self.seed)
+
     def set_seed(self, seed: int) -> None:
-        """Re-seed the run: every later random draw derives from ``seed``."""
+        """Re-seed the run: every later random draw derives from ``seed`` and the unit's scene index."""
         self.seed = int(seed)
-        self.rng = np.random.default_rng(np.random.SeedSequence(self.seed))
+        sequence = scene_seed_sequence(self.seed, self.unit.scene if self.unit else 0)
+        self.rng = np.random.default_rng(sequence)
+        self.scene_seed = int(sequence.generate_state(1)[0])
+
+    def keypoint_indices(self) -> range:
+        """The keypoints of the scene this run (or work unit) renders."""
+        total = len(self.scene.camera)
+        return self.unit.keypoints(total) if self.unit else range(total)
 
     def run_attributes(self) -> dict[str, Any]:
         """Attributes every output file records: seed, resolved config and those renderers added."""
         attrs: dict[str, Any] = {"seed": self.seed}
+        if self.unit is not None:
+            attrs.update({"scene_index": self.unit.scene, "chunk_index": self.unit.chunk,
+                          "scene_keypoints": len(self.scene.camera)})
         if self.config is not None:
             attrs["config"] = self.config.resolved_yaml()
             attrs["config_path"] = self.config.path

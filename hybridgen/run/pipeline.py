@@ -12,6 +12,7 @@ from ..config.schema import validate_config
 from ..errors import ConfigError, HybridgenError
 from ..modules.base import Module
 from .context import RunContext
+from .units import WorkUnit
 
 
 @dataclass
@@ -61,17 +62,11 @@ def _check_order(modules: list[Module], file: str) -> None:
                           index=renderers[-1].index)
 
 
-def run_config(path: str | Path, args: Sequence[str] = (), *, env: Mapping[str, str] | None = None,
-               progress: Callable[[int, str], Any] | None = None,
-               log: Callable[[str], None] | None = None) -> RunSummary:
-    """Run the config at ``path`` with command-line ``args`` (``<args:N>``); returns a summary.
-
-    ``progress(total, what)`` makes a progress bar per renderer; ``log`` receives one-line status messages.
-    """
-    start = time.perf_counter()
-    config = load_config(path, args, env)
-    modules = build_modules(config)
-    context = RunContext(config=config, progress=progress)
+def execute(config: ConfigFile, modules: list[Module], *, unit: WorkUnit | None = None,
+            progress: Callable[[int, str], Any] | None = None,
+            log: Callable[[str], None] | None = None) -> RunContext:
+    """Prepare, then run every module in order (for ``unit``: one work unit of a sharded run)."""
+    context = RunContext(config=config, progress=progress, unit=unit)
     if log is not None:
         context.log = log
     try:
@@ -87,4 +82,27 @@ def run_config(path: str | Path, args: Sequence[str] = (), *, env: Mapping[str, 
     finally:
         for cleanup in reversed(context.cleanups):
             cleanup()
+    return context
+
+
+def run_config(path: str | Path, args: Sequence[str] = (), *, env: Mapping[str, str] | None = None,
+               progress: Callable[[int, str], Any] | None = None,
+               log: Callable[[str], None] | None = None, workers: int = 1, shard: tuple[int, int] | None = None,
+               executor: str = "pool", address: str | None = None) -> RunSummary:
+    """Run the config at ``path`` with command-line ``args`` (``<args:N>``); returns a summary.
+
+    ``progress(total, what)`` makes a progress bar per renderer; ``log`` receives one-line status messages.
+    A config with several scenes or keypoint chunks (``main.Initializer``), or ``workers`` > 1, or a
+    ``shard`` ``(i, n)`` runs as work units (see :mod:`hybridgen.run.runner`).
+    """
+    from .runner import run_sharded, sharding_plan
+
+    start = time.perf_counter()
+    config = load_config(path, args, env)
+    modules = build_modules(config)
+    plan = sharding_plan(config, modules, force=workers > 1 or shard is not None)
+    if plan is not None:
+        return run_sharded(plan, path, args, env, workers=workers, shard=shard, executor=executor, address=address,
+                           log=log or (lambda message: None), start=start)
+    context = execute(config, modules, progress=progress, log=log)
     return RunSummary(context.frames_rendered, time.perf_counter() - start, context.outputs)
