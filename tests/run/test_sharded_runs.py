@@ -123,3 +123,19 @@ def test_shard_subsets_then_index(gl_context, tmp_path, write_config, run_cli):
     assert (out / "data.hdf5").exists()
     code, _, err = run_cli("run", "-q", str(config), str(out), "--shard", "2/2")
     assert code == 2 and "0 <= i < N" in err
+
+
+def test_ray_executor_gives_the_same_bytes(gl_context, tmp_path, write_config):
+    """A real local Ray cluster (started by the run) executes the units; files equal the pool's."""
+    import pytest
+
+    pytest.importorskip("ray")
+    config = write_config(CONFIG.replace("number_of_scenes: 3", "number_of_scenes: 2"))
+    out = tmp_path / "out"
+    assert _cli(config, out).wait(timeout=300) == 0
+    reference = _digests(out)
+    _clear(out)
+    process = _cli(config, out, "--executor", "ray", "--workers", "2")
+    _, err = process.communicate(timeout=600)
+    assert process.returncode == 0, err[-2000:]
+    assert _digests(out) == reference
