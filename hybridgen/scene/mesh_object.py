@@ -51,6 +51,8 @@ class MeshObject:
             raise InputError(f"object '{self.name}' has {bad} vertices with NaN or inf coordinates")
         if self.faces.min() < 0 or self.faces.max() >= len(self.vertices):
             raise InputError(f"object '{self.name}' has face indices outside 0..{len(self.vertices) - 1}")
+        if not np.any(self.face_normals):
+            raise InputError(f"object '{self.name}' has only degenerate (zero-area) triangles")
         if self.vertex_normals is not None and not np.all(np.isfinite(self.vertex_normals)):
             raise InputError(f"object '{self.name}' has NaN or inf vertex normals")
         if not np.all(np.isfinite(self.local2world)):
