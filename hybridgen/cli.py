@@ -1,4 +1,5 @@
-"""Command line: ``hybridgen run CONFIG [ARGS...]``, ``modules [NAME]``, ``vis FILE... --save DIR``, ``--version``.
+"""Command line: ``hybridgen run CONFIG [ARGS...]``, ``modules [NAME]``, ``vis FILE... --save DIR``,
+``extract FILE... --output_dir DIR``, ``--version``.
 
 User errors (config, input, missing system libraries) print one line to stderr and exit with status 2;
 ``--debug`` shows the traceback instead.
@@ -67,6 +68,16 @@ def _cmd_vis(ns: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_extract(ns: argparse.Namespace) -> int:
+    from .io.extract import extract
+
+    result = extract(ns.files, ns.output_dir, ns.keys, ns.format, ns.depth_scale)
+    for note in result.notes:
+        print(f"hybridgen: note: {note}", file=sys.stderr)
+    print(f"hybridgen: wrote {len(result.files)} file(s) to {ns.output_dir}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="hybridgen", description=__doc__.splitlines()[0] if __doc__ else None)
     parser.add_argument("--version", action="version", version=f"hybridgen {__version__}")
@@ -89,6 +100,17 @@ def build_parser() -> argparse.ArgumentParser:
     vis.add_argument("--keys", nargs="+", help="keys to show (default: every image key)")
     vis.add_argument("--save", required=True, help="folder for the PNG files")
     vis.set_defaults(func=_cmd_vis)
+    ext = sub.add_parser("extract", help="write each keypoint's keys of HDF5 outputs as PNG / 16-bit PNG / EXR / npy "
+                         "files (depth and distance PNGs in mm)")
+    ext.add_argument("files", nargs="+", help="HDF5 files (single-file or BlenderProc <i>.hdf5 layout)")
+    ext.add_argument("--output_dir", required=True, help="folder for the extracted files")
+    ext.add_argument("--keys", nargs="+", help="keys to extract (default: every image key)")
+    ext.add_argument("--format", choices=("png", "npy", "exr"), default="png",
+                     help="png: 8-bit images, 16-bit ids, depth/distance as 16-bit mm, flow as 16-bit KITTI; "
+                     "npy: the stored arrays; exr: the stored floats (default: png)")
+    ext.add_argument("--depth_scale", type=float, default=1.0,
+                     help="png only: depth/distance PNG value * depth_scale = mm (default 1.0)")
+    ext.set_defaults(func=_cmd_extract)
     return parser
 
 

@@ -30,6 +30,8 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.segmap_renderer",
     "hybridgen.modules.rgb_renderer",
     "hybridgen.modules.hdf5_writer",
+    "hybridgen.modules.coco_writer",
+    "hybridgen.modules.bop_writer",
 )
 
 MODULES: dict[str, type["Module"]] = {}

@@ -1,0 +1,280 @@
+"""COCO instance annotations (BlenderProc's ``CocoAnnotationsWriter``): ``images/`` plus ``coco_annotations.json``.
+
+Per keypoint one image ``images/<prefix><image id, 6 digits>.png`` (or ``.jpg``) of the chosen key
+(``colors`` by default) and one annotation per visible instance with a non-zero ``category_id``:
+``segmentation`` (compressed RLE via pycocotools, or exact pixel-outline polygons), ``bbox`` ``[x, y, w, h]``
+(pixel indices, w/h in pixels), ``area`` (pixels), ``iscrowd`` 0. Masks are the exact instance map
+(``instance_segmaps``); categories come from the objects' ``category_id``, named by an optional label
+mapping (else by the first object of that category in view, as BlenderProc does). Objects whose
+``supercategory`` (or ``bop_dataset_name``) attribute differs from a requested ``supercategory`` are left out.
+
+With ``append`` an existing ``coco_annotations.json`` is extended: image ids continue after the highest one
+there, annotation ids after the highest annotation id, categories are merged by id. Images are staged
+under temporary names and the JSON file is replaced atomically only when the run commits; nothing is
+written or overwritten if rendering fails. No timestamps are written, so a run is reproducible byte for byte.
+"""
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+from ..errors import InputError
+from .atomic import prepare_output_dir
+from .frame_sink import PassLayout
+from .image_files import StagedFiles, jpeg_bytes, png_bytes, write_file
+from .mask_encoding import bbox_of, mask_to_polygons, require_pycocotools, rle_compressed
+
+ANNOTATIONS_FILE = "coco_annotations.json"
+MASK_ENCODINGS = ("rle", "polygon")
+COLOR_FORMATS = ("PNG", "JPEG")
+DEFAULT_SUPERCATEGORY = "coco_annotations"
+
+NEEDED_KEYS = {
+    "instance_segmaps": "add 'instance' to map_by of the renderer (renderer.SegMapRenderer or renderer.RgbRenderer)",
+    "instance_attribute_maps": "add 'instance' to map_by of the renderer (renderer.SegMapRenderer or "
+                               "renderer.RgbRenderer)",
+}
+
+
+def image_key_hint(key: str) -> str:
+    """How to make the image key ``key``."""
+    if key == "colors":
+        return "render color with renderer.RgbRenderer before this writer"
+    return f"make a renderer write '{key}', or set rgb_output_key to a key it writes"
+
+
+def load_label_mapping(value: Mapping[Any, Any] | str | Path | None) -> dict[int, str] | None:
+    """``{category_id: name}`` from a mapping, or from a CSV file with ``id`` and ``name`` columns (BlenderProc's
+    ``LabelIdMapping`` format)."""
+    if value is None:
+        return None
+    if isinstance(value, Mapping):
+        items = list(value.items())
+        where = "label_mapping"
+    else:
+        path = Path(value)
+        try:
+            with open(path, newline="", encoding="utf-8") as handle:
+                rows = list(csv.DictReader(handle))
+        except OSError as exc:
+            raise InputError(f"cannot read label mapping '{path}': {exc.strerror or exc}") from None
+        if not rows or "id" not in rows[0] or "name" not in rows[0]:
+            raise InputError(f"label mapping '{path}' needs a CSV header with 'id' and 'name' columns")
+        items = [(row["id"], row["name"]) for row in rows]
+        where = str(path)
+    mapping: dict[int, str] = {}
+    for key, name in items:
+        try:
+            category = int(str(key).strip())
+        except ValueError:
+            raise InputError(f"{where}: category id {key!r} is not an integer") from None
+        mapping[category] = str(name)
+    return mapping
+
+
+def load_existing(path: Path) -> dict[str, Any]:
+    """A COCO annotations file to append to, checked enough that appending cannot corrupt it."""
+    try:
+        content = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read '{path}' to append to it: {exc}") from None
+    except json.JSONDecodeError as exc:
+        raise InputError(f"cannot append to '{path}': it is not valid JSON ({exc.msg} at line {exc.lineno}, "
+                         f"column {exc.colno}); fix or remove it, or set append_to_existing_output: false") from None
+    problem = None
+    if not isinstance(content, dict):
+        problem = "it is not a JSON object"
+    else:
+        for section in ("images", "annotations", "categories"):
+            entries = content.get(section)
+            if not isinstance(entries, list) or not all(isinstance(e, dict) and isinstance(e.get("id"), int)
+                                                        for e in entries):
+                problem = f"'{section}' is not a list of entries with integer ids"
+                break
+    if problem:
+        raise InputError(f"cannot append to '{path}': {problem}; fix or remove it, or set "
+                         "append_to_existing_output: false")
+    return content
+
+
+class CocoWriter:
+    """Frame sink writing COCO annotations to ``output_dir`` (see the module documentation).
+
+    Needs per keypoint the image key and ``instance_segmaps`` + ``instance_attribute_maps``, from one or
+    several renderers. :meth:`finalize` commits, :meth:`abort` drops everything staged.
+    """
+
+    def __init__(self, output_dir: str | Path, *, image_key: str = "colors", mask_encoding: str = "rle",
+                 color_file_format: str = "PNG", jpg_quality: int = 95,
+                 supercategory: str = DEFAULT_SUPERCATEGORY, label_mapping: Mapping[int, str] | None = None,
+                 append: bool = False, file_prefix: str = "") -> None:
+        if mask_encoding not in MASK_ENCODINGS:
+            raise InputError(f"mask encoding must be one of {MASK_ENCODINGS}, got {mask_encoding!r}")
+        if color_file_format not in COLOR_FORMATS:
+            raise InputError(f"color_file_format must be one of {COLOR_FORMATS}, got {color_file_format!r}")
+        if mask_encoding == "rle":
+            require_pycocotools()
+        self.output_dir = prepare_output_dir(Path(output_dir))
+        self.path = self.output_dir / ANNOTATIONS_FILE
+        if self.path.exists() and not self.path.is_file():
+            raise InputError(f"'{self.path}' exists and is not a file")
+        self.existing = load_existing(self.path) if append and self.path.exists() else None
+        self.image_offset = 1 + max((e["id"] for e in self.existing["images"]), default=-1) if self.existing else 0
+        self.annotation_offset = max((e["id"] for e in self.existing["annotations"]), default=0) \
+            if self.existing else 0
+        self.image_key, self.mask_encoding = image_key, mask_encoding
+        self.extension = ".png" if color_file_format == "PNG" else ".jpg"
+        self.jpg_quality, self.supercategory = int(jpg_quality), supercategory
+        self.label_mapping = dict(label_mapping) if label_mapping is not None else None
+        self.file_prefix = file_prefix
+        self.count = 0
+        self.images: dict[int, dict[str, Any]] = {}
+        self.annotations: dict[int, list[dict[str, Any]]] = {}
+        self.categories: dict[int, dict[str, Any]] = {}
+        self._pending: dict[int, dict[str, Any]] = {}
+        self._staged = StagedFiles()
+        self._image_dir = self.output_dir / "images"
+
+    # ------------------------------------------------------------------ FrameSink
+    def begin(self, n_keypoints: int, layouts: list[PassLayout], camera_records: dict[str, np.ndarray],
+              attributes: dict[str, Any]) -> None:
+        """Check one renderer's keys (no stereo; the image key must be a uint8 image)."""
+        if "stereo_baseline" in attributes:
+            raise InputError("writer.CocoAnnotationsWriter does not support stereo renders (as in BlenderProc); "
+                             "render left and right as separate keypoints instead")
+        self.count = max(self.count, n_keypoints)
+        for layout in layouts:
+            if layout.key == self.image_key and (layout.dtype != "uint8" or len(layout.shape) not in (2, 3)):
+                raise InputError(f"COCO images need a uint8 image key; '{self.image_key}' is {layout.dtype} "
+                                 f"{layout.shape}")
+
+    def write(self, index: int, values: dict[str, Any]) -> None:
+        """Stage keypoint ``index``'s image and compute its annotations as soon as their inputs are there."""
+        if self.image_key in values:
+            self._write_image(index, np.asarray(values[self.image_key]))
+        pending = self._pending.setdefault(index, {})
+        for key in NEEDED_KEYS:
+            if key in values:
+                pending[key] = values[key]
+        if all(key in pending for key in NEEDED_KEYS):
+            self.annotations[index] = self._annotate(np.asarray(pending["instance_segmaps"]),
+                                                     pending["instance_attribute_maps"])
+            del self._pending[index]
+
+    def end(self) -> None:
+        """Nothing is buffered beyond what the next renderer completes."""
+
+    # ------------------------------------------------------------------ commit
+    def missing_keys(self) -> list[str]:
+        """Keys some keypoint never received."""
+        indices = range(self.count)
+        missing = [self.image_key] if any(i not in self.images for i in indices) else []
+        for key in NEEDED_KEYS:
+            if any(i not in self.annotations and key not in self._pending.get(i, {}) for i in indices):
+                missing.append(key)
+        return missing
+
+    def finalize(self) -> Path:
+        """Rename the staged images and write ``coco_annotations.json`` (merged with the existing one)."""
+        if self.count == 0:
+            raise InputError("no keypoint was rendered before the COCO writer")
+        missing = self.missing_keys()
+        if missing:
+            hints = {image_key_hint(self.image_key) if k == self.image_key else NEEDED_KEYS[k] for k in missing}
+            raise InputError(f"COCO annotations need {missing} for every keypoint: " + "; ".join(sorted(hints)))
+        content = self._content()
+        self._staged.commit()
+        write_file(self.path, json.dumps(content).encode("utf-8"), durable=True)
+        return self.path
+
+    def abort(self) -> None:
+        """Delete every staged image; the annotations file is untouched."""
+        self._staged.discard()
+
+    # ------------------------------------------------------------------ internals
+    def image_id(self, index: int) -> int:
+        return self.image_offset + index
+
+    def _write_image(self, index: int, image: np.ndarray) -> None:
+        self._staged.make_dir(self._image_dir)
+        name = f"{self.file_prefix}{self.image_id(index):06d}{self.extension}"
+        rgb = image if image.ndim == 3 else np.repeat(image[..., None], 3, axis=2)
+        data = png_bytes(image) if self.extension == ".png" else jpeg_bytes(rgb[..., :3], self.jpg_quality)
+        self._staged.add(self._image_dir / name, data)
+        self.images[index] = {"id": self.image_id(index), "file_name": f"images/{name}",
+                              "width": int(image.shape[1]), "height": int(image.shape[0])}
+
+    def _included(self, record: dict[str, Any]) -> bool:
+        own = record.get("bop_dataset_name", record.get("supercategory", DEFAULT_SUPERCATEGORY))
+        return self.supercategory in (own, DEFAULT_SUPERCATEGORY)
+
+    def _category(self, record: dict[str, Any]) -> int | None:
+        """The record's category id (registering the category), or None if it is not annotated."""
+        category = record.get("category_id")
+        if category is None:
+            raise InputError(f"writer.CocoAnnotationsWriter: object '{record.get('name')}' (instance "
+                             f"{record.get('idx')}) has no category_id: COCO annotations need one (set category_id "
+                             "on its loader or main.Initializer default_category_id)")
+        category = int(category)
+        if category == 0 or not self._included(record):
+            return None
+        if category not in self.categories:
+            if self.label_mapping is not None:
+                if category not in self.label_mapping:
+                    raise InputError(f"label_mapping has no name for category_id {category} (object "
+                                     f"'{record.get('name')}')")
+                name = self.label_mapping[category]
+            else:
+                name = str(record.get("name", category))
+            supercategory = record.get("bop_dataset_name", record.get("supercategory", DEFAULT_SUPERCATEGORY))
+            self.categories[category] = {"id": category, "name": name, "supercategory": supercategory}
+        return category
+
+    def _annotate(self, instance: np.ndarray, records: list[dict[str, Any]]) -> list[dict[str, Any]]:
+        """Annotations (without ids) of one keypoint's visible instances, by instance id."""
+        if isinstance(records, (str, bytes)):
+            records = json.loads(records)
+        by_id = {int(r["idx"]): r for r in records}
+        counts = np.bincount(instance.ravel(), minlength=1)
+        out = []
+        for idx in np.flatnonzero(counts):
+            if idx == 0:
+                continue
+            record = by_id.get(int(idx))
+            if record is None:
+                raise InputError(f"instance {idx} is in the instance map but not in instance_attribute_maps")
+            category = self._category(record)
+            if category is None:
+                continue
+            mask = instance == idx
+            if self.mask_encoding == "rle":
+                segmentation: Any = rle_compressed(mask)
+            else:
+                segmentation = mask_to_polygons(mask)
+            out.append({"category_id": category, "iscrowd": 0, "area": int(counts[idx]), "bbox": bbox_of(mask),
+                        "segmentation": segmentation, "width": int(mask.shape[1]), "height": int(mask.shape[0])})
+        return out
+
+    def _content(self) -> dict[str, Any]:
+        images = [self.images[i] for i in range(self.count)]
+        annotations = []
+        next_id = self.annotation_offset + 1
+        for index in range(self.count):
+            for annotation in self.annotations[index]:
+                annotations.append({"id": next_id, "image_id": self.image_id(index), **annotation})
+                next_id += 1
+        if self.existing is not None:
+            content = dict(self.existing)
+            known = {c["id"] for c in content["categories"]}
+            content["categories"] = content["categories"] + [c for i, c in sorted(self.categories.items())
+                                                             if i not in known]
+            content["images"] = content["images"] + images
+            content["annotations"] = content["annotations"] + annotations
+            return content
+        return {"info": {"description": self.supercategory, "version": "1.0", "contributor": "hybridgen"},
+                "licenses": [], "categories": [c for _, c in sorted(self.categories.items())],
+                "images": images, "annotations": annotations}
