@@ -3,9 +3,9 @@
 Per file: every image pass under its key (``colors``, ``depth``, ``distance``, ``<attr>_segmaps``, flow,
 ...), gzip-compressed; ``normals`` in the camera frame with **Blender axes** (x right, y up, z backwards:
 OpenCV's with y and z negated) encoded ``0.5 * n + 0.5``; JSON values (``instance_attribute_maps``,
-``object_records``) and ``cam_states`` (Blender-axes ``cam2world_matrix``, ``cam_K``, ``location``,
-``fov_x``/``fov_y``) as scalar byte strings, like BlenderProc's ``WriterUtility``. BlenderProc's viewer
-(``blenderproc vis hdf5``) opens them.
+``object_records``) and ``cam_states`` (Blender-axes ``cam2world`` - BlenderProc 2's name - and
+``cam2world_matrix`` - 1.x's -, ``cam_K``, ``location``, ``fov_x``/``fov_y``) as scalar byte strings,
+like BlenderProc's ``WriterUtility``. BlenderProc's viewer (``blenderproc vis hdf5``) opens them.
 
 Each file is written under a temporary name while renderers add keys to it and renamed by
 :meth:`finalize`; ``append`` continues the numbering after the highest ``<i>.hdf5`` already in the folder.
@@ -35,7 +35,8 @@ def next_index(directory: Path) -> int:
 def cam_state(K: np.ndarray, cam2world_cv: np.ndarray, width: int, height: int) -> dict[str, Any]:
     """BlenderProc's camera attributes of one keypoint (Blender camera axes)."""
     cam2world = opencv_to_blender(cam2world_cv)
-    return {"cam2world_matrix": cam2world.tolist(), "cam_K": np.asarray(K).tolist(),
+    return {"cam2world": cam2world.tolist(), "cam2world_matrix": cam2world.tolist(),
+            "cam_K": np.asarray(K).tolist(),
             "location": cam2world[:3, 3].tolist(),
             "fov_x": 2 * math.atan(width / (2 * K[0, 0])), "fov_y": 2 * math.atan(height / (2 * K[1, 1]))}
 
@@ -97,9 +98,10 @@ class BlenderProcHdf5Writer:
     def end(self) -> None:
         """Nothing is buffered between keypoints."""
 
-    def finalize(self, records: dict[str, Any] | None = None) -> list[Path]:
-        """Add ``cam_states`` and the JSON ``records`` (e.g. ``object_states``) to every keypoint's file and
-        rename them all to ``<i>.hdf5``."""
+    def finalize(self, records: dict[str, Any] | None = None, attributes: dict[str, Any] | None = None
+                 ) -> list[Path]:
+        """Add ``cam_states``, the JSON ``records`` (e.g. ``object_states``) and the run's ``attributes``
+        (seed, resolved config, ...) to every keypoint's file and rename them all to ``<i>.hdf5``."""
         paths = []
         K, cam2world = self._records.get("cam_K"), self._records.get("cam2world")
         for index in sorted(self._touched):
@@ -112,6 +114,8 @@ class BlenderProcHdf5Writer:
                     h5.create_dataset("cam_states", data=np.bytes_(json.dumps(state)))
                 for key, value in (records or {}).items():
                     h5.create_dataset(key, data=np.bytes_(json.dumps(value)))
+                for key, value in {**self._attributes, **(attributes or {})}.items():
+                    h5.attrs[key] = value
                 h5.create_dataset("hybridgen_version",
                                   data=np.bytes_(str(self._attributes.get("hybridgen_version", ""))))
             commit(self._temp(index), self.final_path(index))

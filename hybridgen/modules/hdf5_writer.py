@@ -58,6 +58,6 @@ class Hdf5Writer(Module):
                                      "color": list(light.color), "local2world": light.local2world.tolist()}
                                     for light in scene.lights]}
         if isinstance(self.writer, BlenderProcHdf5Writer):
-            context.outputs += self.writer.finalize(records)
+            context.outputs += self.writer.finalize(records, context.run_attributes())
         else:
             context.outputs.append(self.writer.finalize(records, context.run_attributes()))

@@ -10,6 +10,9 @@ One record per object whose full (amodal) silhouette covers at least one pixel c
     px_count_visib   visible pixels; px_count_all: amodal pixels; visib_fract = visib / all
 
 Amodal silhouettes come from drawing each object alone in the raster view - exact, not thresholded depth.
+Boxes and counts are of pixels inside the image, and box widths count pixels (max - min + 1); the BOP
+writer (:mod:`hybridgen.io.bop_writer`) follows the BOP toolkit instead (amodal counts beyond the image
+border, width = max - min).
 """
 from __future__ import annotations
 
