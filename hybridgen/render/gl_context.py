@@ -21,12 +21,48 @@ _lock = threading.Lock()
 _shared: dict[int, Any] = {}
 
 
+EGL_CUDA_DEVICE_NV = 0x323A
+
+
+def egl_device_for_cuda(cuda_index: int) -> int | None:
+    """The EGL device index whose ``EGL_CUDA_DEVICE_NV`` is CUDA device ``cuda_index`` (NVIDIA drivers), or
+    None when EGL cannot tell (no NVIDIA EGL, no such device). EGL enumerates devices in its own order."""
+    import ctypes
+
+    try:
+        egl = ctypes.CDLL("libEGL.so.1")
+        get_proc = egl.eglGetProcAddress
+        get_proc.restype = ctypes.c_void_p
+        get_proc.argtypes = [ctypes.c_char_p]
+        query_devices = ctypes.CFUNCTYPE(ctypes.c_uint, ctypes.c_int, ctypes.POINTER(ctypes.c_void_p),
+                                         ctypes.POINTER(ctypes.c_int))(get_proc(b"eglQueryDevicesEXT"))
+        query_attrib = ctypes.CFUNCTYPE(ctypes.c_uint, ctypes.c_void_p, ctypes.c_int,
+                                        ctypes.POINTER(ctypes.c_ssize_t))(get_proc(b"eglQueryDeviceAttribEXT"))
+    except (OSError, TypeError, AttributeError):
+        return None
+    count = ctypes.c_int(0)
+    devices = (ctypes.c_void_p * 32)()
+    if not query_devices(32, devices, ctypes.byref(count)):
+        return None
+    for index in range(count.value):
+        value = ctypes.c_ssize_t(-1)
+        if query_attrib(devices[index], EGL_CUDA_DEVICE_NV, ctypes.byref(value)) and value.value == cuda_index:
+            return index
+    return None
+
+
 def egl_device_index(device_index: int | None = None) -> int:
-    """The EGL device to use: the argument, else ``$HYBRIDGEN_EGL_DEVICE``, else 0."""
+    """The EGL device to use: the argument, else ``$HYBRIDGEN_EGL_DEVICE``, else the EGL device of the first
+    CUDA device this process may use (``$CUDA_VISIBLE_DEVICES``, as Ray and SLURM set it per worker), else 0."""
     if device_index is not None:
         return int(device_index)
     env = os.environ.get("HYBRIDGEN_EGL_DEVICE", "").strip()
     if not env:
+        visible = os.environ.get("CUDA_VISIBLE_DEVICES", "").split(",")[0].strip()
+        if visible.isdigit():
+            matched = egl_device_for_cuda(int(visible))
+            if matched is not None:
+                return matched
         return 0
     try:
         return int(env)

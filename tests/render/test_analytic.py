@@ -185,3 +185,14 @@ def test_mirrored_object_transform_keeps_labels(gl_context):
     b = hg.RasterView(mirrored).render(mirrored.camera.keypoints[0], ["depth", "normals"])
     np.testing.assert_allclose(a["depth"], b["depth"], rtol=1e-6)
     np.testing.assert_allclose(a["normals"], b["normals"], atol=1e-6)
+
+
+def test_egl_device_choice(monkeypatch):
+    from hybridgen.render.gl_context import egl_device_for_cuda, egl_device_index
+
+    monkeypatch.setenv("HYBRIDGEN_EGL_DEVICE", "3")
+    assert egl_device_index() == 3 and egl_device_index(1) == 1
+    monkeypatch.delenv("HYBRIDGEN_EGL_DEVICE")
+    monkeypatch.setenv("CUDA_VISIBLE_DEVICES", "0")
+    assert egl_device_for_cuda(0) is None  # llvmpipe has no CUDA device: falls back to EGL device 0
+    assert egl_device_index() == 0
