@@ -11,6 +11,7 @@ Results never depend on how units are spread over workers.
 """
 from __future__ import annotations
 
+import os
 import time
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass
@@ -53,10 +54,27 @@ def sharding_plan(config: ConfigFile, modules: list[Module], force: bool = False
     return ShardingPlan(scenes, chunk_size, Path(writer["output_dir"]), writer["file_name"])
 
 
+def limit_threads(threads: int) -> None:
+    """Give this worker process ``threads`` CPU threads for rasterizing (llvmpipe) and path tracing (Dr.Jit),
+    so that several workers share the cores instead of oversubscribing them. Call before rendering."""
+    os.environ["LP_NUM_THREADS"] = str(threads)  # read by Mesa when the GL context is created
+    os.environ["HYBRIDGEN_THREADS"] = str(threads)
+
+
+def _apply_thread_limit() -> None:
+    threads = os.environ.get("HYBRIDGEN_THREADS", "")
+    if threads.isdigit():
+        import drjit
+
+        if drjit.thread_count() != int(threads):
+            drjit.set_thread_count(int(threads))
+
+
 def run_unit(path: str, args: Sequence[str], env: Mapping[str, str] | None, unit: WorkUnit) -> tuple[int, int]:
     """Run one unit (in whatever process this is); returns (keypoints rendered, keypoints of its scene)."""
     from .pipeline import build_modules, execute
 
+    _apply_thread_limit()
     config = load_config(path, args, env)
     context = execute(config, build_modules(config), unit=unit)
     return context.frames_rendered, len(context.scene.camera)
@@ -96,8 +114,10 @@ class _Ray:
             raise SystemSetupError("--executor ray needs Ray: `.venv/bin/pip install 'ray[default]'`") from None
         self.ray = ray
         if not ray.is_initialized():
+            threads = str(max(1, (os.cpu_count() or 1) // workers))
             ray.init(address=address, num_cpus=None if address else workers, include_dashboard=False,
-                     log_to_driver=False)
+                     log_to_driver=False,
+                     runtime_env={"env_vars": {"LP_NUM_THREADS": threads, "HYBRIDGEN_THREADS": threads}})
         self.remote = ray.remote(run_unit)
         self.call = (path, list(args), dict(env) if env is not None else None)
 
@@ -128,7 +148,9 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
     elif workers == 1:
         pool = _Local(lambda unit: run_unit(path, args, env, unit))
     else:
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"))
+        threads = max(1, (os.cpu_count() or 1) // workers)
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"), initializer=limit_threads,
+                                   initargs=(threads,))
     mine = [s for s in range(plan.scenes) if s % count == index]
     pending: dict[Future, WorkUnit] = {}
     frames = skipped = 0
