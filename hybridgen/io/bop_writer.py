@@ -66,14 +66,19 @@ def bop_json_text(content: dict[int, Any]) -> str:
     return "{\n" + ",\n".join(lines) + ("\n" if lines else "") + "}"
 
 
-def load_bop_json(path: Path) -> dict[int, Any]:
-    """A per-image BOP JSON file (``{"<im_id>": ...}``) with integer keys; InputError if it is not one."""
+def _read_for_append(path: Path) -> Any:
+    """The parsed JSON of a file a chunk is appended to; InputError when it is missing or unreadable."""
     try:
-        content = json.loads(path.read_text(encoding="utf-8"))
+        return json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise InputError(f"cannot append: '{path}' is missing (an incomplete BOP chunk?)") from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise InputError(f"cannot append to '{path}': {exc}") from None
+
+
+def load_bop_json(path: Path) -> dict[int, Any]:
+    """A per-image BOP JSON file (``{"<im_id>": ...}``) with integer keys; InputError if it is not one."""
+    content = _read_for_append(path)
     if not isinstance(content, dict) or not all(str(k).isdigit() for k in content):
         raise InputError(f"cannot append to '{path}': not a BOP per-image JSON object")
     return {int(k): v for k, v in content.items()}
@@ -81,12 +86,7 @@ def load_bop_json(path: Path) -> dict[int, Any]:
 
 def load_coco_json(path: Path) -> dict[str, Any]:
     """An existing ``scene_gt_coco.json`` to extend."""
-    try:
-        content = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputError(f"cannot append: '{path}' is missing (an incomplete BOP chunk?)") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InputError(f"cannot append to '{path}': {exc}") from None
+    content = _read_for_append(path)
     if not isinstance(content, dict) or not all(isinstance(content.get(k), list)
                                                 for k in ("images", "annotations", "categories")):
         raise InputError(f"cannot append to '{path}': not a COCO annotations file")

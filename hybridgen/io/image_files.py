@@ -20,7 +20,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from ..errors import InputError, SystemSetupError
-from .atomic import commit, temporary_path
+from .atomic import commit, prepare_output_dir, temporary_path
 
 EXR_HINT = "EXR files are written with Mitsuba's Bitmap (the `mitsuba` package); it failed to import"
 
@@ -167,12 +167,7 @@ class StagedFiles:
             if folder.exists():
                 break
             missing.append(folder)
-        if directory.exists() and not directory.is_dir():
-            raise InputError(f"'{directory}' exists and is not a directory")
-        try:
-            directory.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise InputError(f"cannot create '{directory}': {exc.strerror or exc}") from None
+        prepare_output_dir(directory)
         self._made_dirs.extend(missing)
         return directory
 
