@@ -1,7 +1,8 @@
 """Contact sheets of HDF5 outputs: one PNG per keypoint with every image-like key side by side.
 
 Depth and distance get a colormap with a legend (metres, background black), normals are shown as
-``(n + 1) / 2`` RGB, segmentation maps get one distinct color per value (0 black), colors as stored.
+``(n + 1) / 2`` RGB, segmentation maps get one distinct color per value (0 black), optical flow as HSV
+(hue: direction, saturation: magnitude), colors as stored.
 """
 from __future__ import annotations
 
@@ -56,8 +57,19 @@ def _metric_tile(values: np.ndarray, unit: str) -> Image.Image:
     return tile
 
 
+def flow_colors(flow: np.ndarray) -> np.ndarray:
+    """Optical flow (H, W, 2) as colors: hue = direction, saturation = magnitude relative to the largest."""
+    magnitude = np.linalg.norm(flow, axis=-1)
+    hue = (np.arctan2(flow[..., 1], flow[..., 0]) / (2 * np.pi)) % 1.0
+    saturation = magnitude / max(float(magnitude.max()), 1e-9)
+    hsv = np.stack([hue * 255, saturation * 255, np.full_like(hue, 255)], axis=-1).astype(np.uint8)
+    return np.asarray(Image.fromarray(hsv, mode="HSV").convert("RGB"))
+
+
 def render_tile(key: str, value: np.ndarray) -> Image.Image | None:
     """An image of one keypoint's ``value`` of ``key``; None for keys that are not images."""
+    if value.ndim == 3 and value.shape[-1] == 2 and np.issubdtype(value.dtype, np.floating):
+        return Image.fromarray(flow_colors(value))
     if value.ndim == 3 and value.shape[-1] in (3, 4) and value.dtype == np.uint8:
         return Image.fromarray(value[..., :3])
     if key.startswith("normals") and value.ndim == 3:
