@@ -27,6 +27,8 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.surface_lighting",
     "hybridgen.modules.manipulators",
     "hybridgen.modules.object_placement",
+    "hybridgen.modules.physics_positioning",
+    "hybridgen.modules.object_swapper",
     "hybridgen.modules.segmap_renderer",
     "hybridgen.modules.rgb_renderer",
     "hybridgen.modules.hdf5_writer",
