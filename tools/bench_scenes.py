@@ -1,4 +1,7 @@
-"""Deterministic benchmark scenes shared by the tools (meshes in world coordinates, camera poses)."""
+"""Deterministic benchmark scenes shared by the tools (meshes in world coordinates, camera poses).
+
+The real meshes come from the ``pybullet`` wheel (its ``pybullet_data`` folder): ``pip install pybullet``.
+"""
 from __future__ import annotations
 
 from pathlib import Path
@@ -20,7 +23,7 @@ def pybullet_data_dir() -> Path:
 
 
 def objects_50(seed: int = 0) -> hg.Scene:
-    """50 objects (~140k triangles) on a floor: real meshes from pybullet_data (duck, bunny, teddy,
+    """50 objects (136,058 triangles) on a floor: real meshes from pybullet_data (duck, bunny, teddy,
     soccer ball, ...) mixed with primitives and the repository's knot, at random poses."""
     rng = np.random.default_rng(seed)
     data = pybullet_data_dir()
@@ -49,14 +52,36 @@ def objects_50(seed: int = 0) -> hg.Scene:
 
 
 def monastery() -> hg.Scene:
-    """pybullet_data's samurai_monastry.obj: a real 124,789-triangle scene mesh."""
+    """pybullet_data's samurai_monastry.obj: a real 124,789-triangle scene mesh (81 parts, nearly all open).
+
+    The file is +Y up (pybullet's samurai.urdf turns it by 90 degrees about X, as ``up_axis="Y"`` does)."""
     scene = hg.Scene()
-    for obj in hg.load_objects(pybullet_data_dir() / "samurai_monastry.obj", name="monastery", category_id=1):
+    for obj in hg.load_objects(pybullet_data_dir() / "samurai_monastry.obj", name="monastery", category_id=1,
+                               up_axis="Y"):
         scene.add(obj)
     return scene
 
 
-def dense_mesh() -> hg.Scene:
+def subdivided_real_mesh(levels: int = 3) -> hg.Scene:
+    """A real mesh made dense: pybullet_data's mini_cheetah body (22,384 triangles, closed, smooth normals)
+    split ``levels`` times into 4 (3: 1,432,576 triangles; same shape, midpoint normals), on a floor."""
+    import trimesh
+
+    body = hg.load_objects(pybullet_data_dir() / "mini_cheetah/meshes/mini_body.obj", name="mini_body")[0]
+    vertices, faces, normals = body.vertices, body.faces, body.vertex_normals
+    for _ in range(levels):
+        vertices, faces, attributes = trimesh.remesh.subdivide(vertices, faces, vertex_attributes={"normal": normals})
+        normals = attributes["normal"] / np.linalg.norm(attributes["normal"], axis=1, keepdims=True)
+    low, high = vertices.min(axis=0), vertices.max(axis=0)
+    scale = 3.0 / float((high - low).max())  # about 3 m long, resting on the floor
+    scene = hg.Scene()
+    scene.add(hg.MeshObject("mini_body_dense", vertices, faces, vertex_normals=normals, category_id=2,
+                            local2world=hg.object_pose([0, 0, -low[2] * scale], [0, 0, 0.4], scale)))
+    scene.add(hg.make_primitive("plane", 12.0, name="floor", category_id=1))
+    return scene
+
+
+def icosphere_dense() -> hg.Scene:
     """One 1,310,720-triangle mesh (an icosphere of 8 subdivisions, smooth normals) on a floor."""
     import trimesh
 
@@ -68,12 +93,18 @@ def dense_mesh() -> hg.Scene:
     return scene
 
 
-SCENES = {"50 objects": objects_50, "monastery (real)": monastery, "1.3M triangles": dense_mesh}
+SCENES = {"50 objects": objects_50, "monastery (real)": monastery, "1.4M real, subdiv.": subdivided_real_mesh}
+"""The default benchmark scenes."""
+EXTRA_SCENES = {"1.3M icosphere": icosphere_dense}
+"""Further scenes, chosen by name (``--scenes``)."""
+ALL_SCENES = SCENES | EXTRA_SCENES
 
 
 def orbit_poses(scene: hg.Scene, count: int, seed: int = 1) -> list[np.ndarray]:
-    """``count`` look-at poses around the scene's bounding box, outside it, looking at its centre."""
-    points = np.concatenate([o.world_vertices() for o in scene.objects])
+    """``count`` look-at poses around the bounding box of the scene's objects (the floor left out), outside
+    it, looking at its centre."""
+    framed = [o for o in scene.objects if o.name != "floor"] or scene.objects
+    points = np.concatenate([o.world_vertices() for o in framed])
     low, high = points.min(axis=0), points.max(axis=0)
     centre = (low + high) / 2
     radius = 0.6 * float(np.linalg.norm(high - low))

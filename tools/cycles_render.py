@@ -1,20 +1,71 @@
-"""Renders a scene exported by bench_color.py with Blender Cycles (bpy from PyPI) and prints seconds per
-keypoint as JSON. Runs inside its own virtual environment (bpy needs Python 3.11 and numpy < 2).
+"""Blender Cycles worker for tools/bench_color.py: renders an exported scene keypoint by keypoint, on request.
+
+Runs inside its own virtual environment (``bpy`` from PyPI needs Python 3.11 and numpy < 2), started by
+bench_color.py, which creates ``.venv-bpy`` on demand::
 
     .venv-bpy/bin/python tools/cycles_render.py SCENE.npz
+
+Protocol (one JSON object per line): after building the scene the worker answers
+``{"ready": true, "blender": ..., "setup_s": ...}``; then each request line on stdin,
+``{"index": i, "light_tree": bool, "seed": int, "save": path-or-null}``, is answered with
+``{"seconds": wall, "cpu_s": cpu}`` (the time of ``bpy.ops.render.render`` alone); ``{"quit": true}`` ends
+it with its peak RSS. Requests one at a time let the benchmark interleave Cycles with Mitsuba keypoint by
+keypoint, so both see the same machine noise; while waiting the worker is idle.
+
+Blender writes render progress to stdout, so the protocol goes through a private copy of the original
+stdout and fd 1 is pointed at stderr (which the benchmark discards).
 """
 from __future__ import annotations
 
 import json
+import os
+import resource
 import sys
 import time
 
 import bpy
+import mathutils
 import numpy as np
 
 
-def main(path: str) -> None:
-    data = np.load(path, allow_pickle=True)
+def _material(name: str, spec: dict) -> bpy.types.Material:
+    """Diffuse BSDF for hybridgen's diffuse materials (specular = metallic = 0, as its Mitsuba translation),
+    Principled BSDF otherwise; emissive ones add an Emission shader (Cycles emits from both sides, like
+    hybridgen's two-sided Mitsuba emitters)."""
+    material = bpy.data.materials.new(name)
+    if bpy.app.version < (5, 0, 0):  # always true from Blender 5 on (and deprecated)
+        material.use_nodes = True
+    nodes, links = material.node_tree.nodes, material.node_tree.links
+    nodes.clear()
+    output = nodes.new("ShaderNodeOutputMaterial")
+    color = (*spec["color"][:3], 1.0)
+    if spec["kind"] == "diffuse":
+        surface = nodes.new("ShaderNodeBsdfDiffuse")
+        surface.inputs["Color"].default_value = color
+        surface.inputs["Roughness"].default_value = 0.0
+    else:
+        surface = nodes.new("ShaderNodeBsdfPrincipled")
+        surface.inputs["Base Color"].default_value = color
+        surface.inputs["Roughness"].default_value = spec["roughness"]
+        surface.inputs["Metallic"].default_value = spec["metallic"]
+        surface.inputs["Specular IOR Level"].default_value = spec["specular"]
+    shader = surface.outputs["BSDF"]
+    emission = spec["emission"]
+    if max(emission) > 0:
+        emit = nodes.new("ShaderNodeEmission")
+        strength = max(emission)
+        emit.inputs["Color"].default_value = (*[c / strength for c in emission], 1.0)
+        emit.inputs["Strength"].default_value = strength
+        add = nodes.new("ShaderNodeAddShader")
+        links.new(shader, add.inputs[0])
+        links.new(emit.outputs["Emission"], add.inputs[1])
+        shader = add.outputs["Shader"]
+    links.new(shader, output.inputs["Surface"])
+    return material
+
+
+def build(path: str) -> tuple[bpy.types.Scene, bpy.types.Object, np.ndarray]:
+    data = np.load(path, allow_pickle=False)
     meta = json.loads(str(data["meta"]))
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
@@ -22,56 +73,78 @@ def main(path: str) -> None:
         vertices, faces = data[f"v{index}"], data[f"f{index}"]
         mesh = bpy.data.meshes.new(obj["name"])
         mesh.from_pydata(vertices.tolist(), [], faces.tolist())
-        mesh.update()
-        if obj["smooth"]:
+        if f"n{index}" in data:  # smooth shading with the same per-vertex normals Mitsuba gets
             mesh.shade_smooth()
-        material = bpy.data.materials.new(obj["name"])
-        material.use_nodes = True
-        bsdf = material.node_tree.nodes["Principled BSDF"]
-        bsdf.inputs["Base Color"].default_value = (*obj["color"][:3], 1.0)
-        bsdf.inputs["Roughness"].default_value = obj["roughness"]
-        if obj["emission"] > 0:
-            bsdf.inputs["Emission Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-            bsdf.inputs["Emission Strength"].default_value = obj["emission"]
-        mesh.materials.append(material)
+            mesh.normals_split_custom_set_from_vertices(data[f"n{index}"].tolist())
+        mesh.update()
+        mesh.materials.append(_material(obj["name"], obj))
         scene.collection.objects.link(bpy.data.objects.new(obj["name"], mesh))
     world = bpy.data.worlds.new("world")
-    world.use_nodes = True
+    if bpy.app.version < (5, 0, 0):
+        world.use_nodes = True
     world.node_tree.nodes["Background"].inputs["Color"].default_value = (*meta["world"], 1.0)
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 1.0
     scene.world = world
+
     width, height = meta["resolution"]
     K = np.array(meta["K"])
     camera_data = bpy.data.cameras.new("camera")
     camera_data.sensor_fit = "HORIZONTAL"
     camera_data.sensor_width = 36.0
     camera_data.lens = K[0, 0] * 36.0 / width
+    # Shifts are in units of the film width; K's principal point is in pixel-centre coordinates.
     camera_data.shift_x = -(K[0, 2] - (width - 1) / 2) / width
     camera_data.shift_y = (K[1, 2] - (height - 1) / 2) / width
     camera_data.clip_start, camera_data.clip_end = meta["clip"]
     camera = bpy.data.objects.new("camera", camera_data)
     scene.collection.objects.link(camera)
     scene.camera = camera
+
     scene.render.engine = "CYCLES"
     scene.cycles.device = "CPU"
     scene.cycles.samples = meta["spp"]
-    scene.cycles.use_denoising = False
     scene.cycles.use_adaptive_sampling = False
-    scene.cycles.max_bounces = meta["max_bounces"]
-    scene.cycles.diffuse_bounces = scene.cycles.glossy_bounces = meta["max_bounces"]
-    scene.cycles.min_light_bounces = meta["min_bounces"]
+    scene.cycles.use_denoising = False
+    bounces = meta["max_bounces"]  # Cycles' count: 0 = direct light only (Mitsuba max_depth = bounces + 2)
+    scene.cycles.max_bounces = bounces
+    scene.cycles.diffuse_bounces = scene.cycles.glossy_bounces = scene.cycles.transmission_bounces = bounces
+    scene.cycles.min_light_bounces = meta["min_bounces"]  # no Russian roulette before it, as Mitsuba's rr_depth
+    scene.cycles.pixel_filter_type = "BOX"  # hybridgen's film: one-pixel box filter
+    scene.cycles.filter_width = 1.0
+    scene.render.use_persistent_data = True  # keep the synced scene and BVH between renders (camera moves only)
     scene.render.threads_mode = "FIXED"
     scene.render.threads = meta["threads"]
     scene.render.resolution_x, scene.render.resolution_y = width, height
     scene.render.resolution_percentage = 100
-    scene.render.filepath = meta["output"]
-    times = []
-    for pose in data["poses"]:
-        blender_pose = pose @ np.diag([1.0, -1.0, -1.0, 1.0])  # OpenCV -> Blender camera axes
-        camera.matrix_world = [list(row) for row in blender_pose]
-        start = time.perf_counter()
+    scene.render.image_settings.file_format = "PNG"
+    scene.view_settings.view_transform = "Standard"  # plain sRGB, as hybridgen's colors
+    scene.view_settings.look = "None"
+    return scene, camera, data["poses"]
+
+
+def main(path: str) -> None:
+    protocol = os.fdopen(os.dup(1), "w", buffering=1)
+    os.dup2(2, 1)  # Blender's progress lines go to stderr
+    start = time.perf_counter()
+    scene, camera, poses = build(path)
+    protocol.write(json.dumps({"ready": True, "blender": bpy.app.version_string,
+                               "setup_s": time.perf_counter() - start}) + "\n")
+    for line in sys.stdin:
+        request = json.loads(line)
+        if request.get("quit"):
+            break
+        pose = np.asarray(poses[request["index"]]) @ np.diag([1.0, -1.0, -1.0, 1.0])  # OpenCV -> Blender axes
+        camera.matrix_world = mathutils.Matrix(pose.tolist())  # (a plain nested list would be read transposed)
+        scene.cycles.use_light_tree = bool(request["light_tree"])
+        scene.cycles.seed = int(request.get("seed", 0)) % 2**31  # Cycles' seed is an int32
+        cpu, wall = time.process_time(), time.perf_counter()
         bpy.ops.render.render(write_still=False)
-        times.append(time.perf_counter() - start)
-    print(json.dumps({"seconds": times, "blender": bpy.app.version_string}))
+        wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+        if request.get("save"):
+            bpy.data.images["Render Result"].save_render(request["save"], scene=scene)
+        protocol.write(json.dumps({"seconds": wall, "cpu_s": cpu}) + "\n")
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    protocol.write(json.dumps({"peak_rss_mib": peak}) + "\n")
 
 
 if __name__ == "__main__":
