@@ -1,4 +1,4 @@
-"""Reading a config file in the paper's shape: ``setup`` / ``global`` / ``modules`` (SPEC section 5)."""
+"""Reading a config file in the paper's shape: ``setup`` / ``global`` / ``modules`` (docs/conventions.md section 5)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field

@@ -1,4 +1,4 @@
-"""``<args:N>`` and ``<env:NAME>`` placeholders in config values (SPEC section 5).
+"""``<args:N>`` and ``<env:NAME>`` placeholders in config values (docs/conventions.md section 5).
 
 A placeholder may be a whole value or part of a string (``"<args:0>/meshes"``). Every missing one is
 reported at once, each with the config path where it is used.

@@ -1,4 +1,4 @@
-"""Atomic output files: write under a temporary name in the same folder, then rename (SPEC section 4)."""
+"""Atomic output files: write under a temporary name in the same folder, then rename (docs/conventions.md section 4)."""
 from __future__ import annotations
 
 import os

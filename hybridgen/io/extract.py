@@ -1,6 +1,6 @@
 """``hybridgen extract``: every keypoint's keys of HDF5 outputs as separate image / array files.
 
-Reads both layouts: the single file (keypoint axis first, SPEC section 4) and BlenderProc's one
+Reads both layouts: the single file (keypoint axis first, docs/conventions.md section 4) and BlenderProc's one
 ``<i>.hdf5`` per keypoint. Files are named ``<file stem>_<keypoint, 4 digits>_<key>.<ext>`` (single file) or
 ``<file stem>_<key>.<ext>`` (per-keypoint file); stereo keys get ``_left`` / ``_right``.
 

@@ -1,4 +1,4 @@
-"""BlenderProc-compatible output (SPEC section 4): one ``<i>.hdf5`` per keypoint, keys as BlenderProc writes.
+"""BlenderProc-compatible output (docs/conventions.md section 4): one ``<i>.hdf5`` per keypoint, BlenderProc keys.
 
 Per file: every image pass under its key (``colors``, ``depth``, ``distance``, ``<attr>_segmaps``, flow,
 ...), gzip-compressed; ``normals`` in the camera frame with **Blender axes** (x right, y up, z backwards:

@@ -1,4 +1,4 @@
-"""The default HDF5 output (SPEC section 4): one file, every pass a dataset with a leading keypoint axis.
+"""The default HDF5 output (docs/conventions.md section 4): one file, every pass a dataset with a leading keypoint axis.
 
 Chunks hold one keypoint each. Writing happens on a background thread, so keypoint i+1 renders while
 keypoint i is compressed (zlib releases the GIL) and written: gzip chunks are deflated here and stored

@@ -1,7 +1,7 @@
 """Image and array files for the dataset writers and ``hybridgen extract``: PNG (8 and 16 bit), JPEG, EXR, npy.
 
 Every file is written under a hidden temporary name in its folder and renamed when complete, so a file
-under its final name is always whole (SPEC section 4). :func:`write_file` renames at once;
+under its final name is always whole (docs/conventions.md section 4). :func:`write_file` renames at once;
 :class:`StagedFiles` keeps the temporary files until :meth:`StagedFiles.commit` renames them all (or
 :meth:`StagedFiles.discard` deletes them), for writers whose outputs only count once the run succeeded.
 Image files are renamed without ``fsync`` (a crash of the process never leaves a partial file under the

@@ -2,7 +2,7 @@
 exact pixel-outline polygons, boxes and areas.
 
 Coordinates are COCO's: pixel (u, v) covers the square [u, u+1] x [v, v+1] (our pixel centres, at integer
-(u, v) in SPEC section 2, sit at (u + 0.5, v + 0.5) here). Boxes are ``[x, y, w, h]`` in whole pixels, as
+(u, v) in docs/conventions.md section 2, sit at (u + 0.5, v + 0.5) here). Boxes are ``[x, y, w, h]`` in whole pixels, as
 BlenderProc and the BOP toolkit write them.
 """
 from __future__ import annotations

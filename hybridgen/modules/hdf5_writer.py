@@ -1,4 +1,4 @@
-"""``writer.Hdf5Writer``: the run's outputs as one HDF5 file (SPEC section 4)."""
+"""``writer.Hdf5Writer``: the run's outputs as one HDF5 file (docs/conventions.md section 4)."""
 from __future__ import annotations
 
 from pathlib import Path

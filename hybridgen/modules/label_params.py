@@ -1,4 +1,4 @@
-"""Label options shared by every renderer module (SPEC section 6), declared once."""
+"""Label options shared by every renderer module (docs/conventions.md section 6), declared once."""
 from __future__ import annotations
 
 import math

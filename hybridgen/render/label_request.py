@@ -16,7 +16,7 @@ MAP_BY_ALIASES = {"class": "category_id", "instance": "instance"}
 
 @dataclass
 class LabelRequest:
-    """Renderer options that select label passes (SPEC sections 3 and 6).
+    """Renderer options that select label passes (docs/conventions.md sections 3 and 6).
 
     ``map_by`` entries: ``class`` (``category_id_segmaps``), ``instance`` (``instance_segmaps`` plus the
     per-keypoint ``instance_attribute_maps``) or the name of a numeric object attribute ``a``

@@ -1,4 +1,4 @@
-"""Named label passes (SPEC section 3): dtype, per-keypoint shape, background, definition.
+"""Named label passes (docs/conventions.md section 3): dtype, per-keypoint shape, background, definition.
 
 A pass is computed from the raster view's per-keypoint :class:`RasterOutput`. Writers consume passes by
 name; adding a pass means adding one entry here.

@@ -1,4 +1,4 @@
-"""OpenGL projection from the shared pinhole K (SPEC section 2).
+"""OpenGL projection from the shared pinhole K (docs/conventions.md section 2).
 
 The camera frame is OpenCV's (z forward, y down). With this matrix the centre of pixel (u, v) maps to
 NDC ``(2(u + 0.5)/W - 1, 2(v + 0.5)/H - 1)``, which OpenGL rasterizes at window position (u + 0.5, v + 0.5):

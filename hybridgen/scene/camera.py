@@ -1,4 +1,4 @@
-"""The pinhole camera shared by the rasterizer and the path tracer (SPEC section 2).
+"""The pinhole camera shared by the rasterizer and the path tracer (docs/conventions.md section 2).
 
 Pixel (u, v) has its centre at integer coordinates; (0, 0) is the centre of the top-left pixel,
 u grows right, v down. Poses (keypoints) are ``cam2world`` 4x4 matrices in OpenCV camera axes
@@ -63,7 +63,7 @@ class Intrinsics:
 
     @classmethod
     def default(cls) -> "Intrinsics":
-        """SPEC defaults: 512 x 512, horizontal fov 0.691111 rad, clip 0.1..1000 m."""
+        """Default camera (docs/conventions.md section 2): 512 x 512, horizontal fov 0.691111 rad, clip 0.1..1000 m."""
         return cls.from_fov(DEFAULT_FOV)
 
     def resized(self, width: int | None = None, height: int | None = None) -> "Intrinsics":

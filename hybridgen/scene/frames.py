@@ -1,4 +1,4 @@
-"""Camera frame conventions and rotations (SPEC section 1).
+"""Camera frame conventions and rotations (docs/conventions.md section 1).
 
 World: right-handed, Z up, metres. Camera poses are ``cam2world`` 4x4 matrices in **OpenCV axes**
 (x right, y down, z forward). Blender camera axes are x right, y up, looking along -z; the two differ
@@ -97,7 +97,7 @@ def forward_to_rotation_blender(forward: Sequence[float], inplane_rot: float = 0
 
 
 def look_at_blender(location: Sequence[float], target: Sequence[float], inplane_rot: float = 0.0) -> np.ndarray:
-    """Blender-axes 3x3 camera rotation looking from ``location`` to ``target`` (SPEC section 1)."""
+    """Blender-axes 3x3 camera rotation looking from ``location`` to ``target`` (docs/conventions.md section 1)."""
     return forward_to_rotation_blender(np.asarray(target, float) - np.asarray(location, float), inplane_rot)
 
 

@@ -91,7 +91,7 @@ class MeshObject:
         return self.vertices @ self.local2world[:3, :3].T + self.local2world[:3, 3]
 
     def state(self) -> dict[str, Any]:
-        """JSON-ready pose record (SPEC section 4, ``object_states``)."""
+        """JSON-ready pose record (docs/conventions.md section 4, ``object_states``)."""
         record: dict[str, Any] = {"idx": self.instance_id, "name": self.name, "category_id": self.category_id}
         record.update({k: v for k, v in self.attributes.items() if _is_json_scalar(v)})
         record["local2world"] = self.local2world.tolist()

@@ -56,7 +56,7 @@ class Scene:
         raise KeyError(name)
 
     def require_category_ids(self, default: int | None = None) -> None:
-        """Give objects without ``category_id`` the default, or fail naming them (SPEC section 3)."""
+        """Give objects without ``category_id`` the default, or fail naming them (docs/conventions.md section 3)."""
         missing = [o for o in self.objects if o.category_id is None]
         if not missing:
             return

@@ -1,4 +1,4 @@
-"""SPEC section 4: the single-file HDF5 output, read back against the renderer's own values."""
+"""docs/conventions.md section 4: the single-file HDF5 output, read back against the renderer's own values."""
 from __future__ import annotations
 
 import hashlib

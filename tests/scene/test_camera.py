@@ -1,4 +1,4 @@
-"""SPEC section 2: intrinsics defaults and validation."""
+"""docs/conventions.md section 2: intrinsics defaults and validation."""
 import numpy as np
 import pytest
 

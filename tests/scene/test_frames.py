@@ -1,4 +1,4 @@
-"""SPEC section 1: frames, look-at, Euler, source frames."""
+"""docs/conventions.md section 1: frames, look-at, Euler, source frames."""
 import numpy as np
 import pytest
 
