@@ -1,21 +1,118 @@
-"""Atomic output files: write under a temporary name in the same folder, then rename (docs/conventions.md section 4)."""
+"""Atomic output files: write under an unpredictable temporary name in the same folder, then rename
+(docs/conventions.md, outputs).
+
+Temporary files are created with :func:`tempfile.mkstemp` (``O_CREAT | O_EXCL``, mode 0600, a random
+part in the name), so a symlink planted where a temporary file will be can never redirect a write: a
+fresh name is never an existing file. Every temporary file this process still owns is listed, so a
+signal handler can delete them (:func:`remove_live_temporaries`). Output paths built from config values
+go through :func:`confined_path` (no ``..``, no absolute paths, no NUL, names the filesystem accepts).
+"""
 from __future__ import annotations
 
+import errno
 import os
+import tempfile
 from pathlib import Path
 
 from ..errors import InputError
 
 TEMP_SUFFIX = ".incomplete"
+_RANDOM_PART = 8 + 2  # mkstemp's random characters plus the dots around them
+_LIVE: set[Path] = set()
+_PRUNE_AT = 4096
+
+
+def name_max(directory: Path) -> int:
+    """The longest file name (bytes) the filesystem of ``directory`` (or its nearest existing parent) accepts."""
+    for folder in (directory, *directory.parents):
+        try:
+            return int(os.pathconf(folder, "PC_NAME_MAX"))
+        except (OSError, ValueError):
+            continue
+    return 255
+
+
+def check_file_name(path: Path) -> Path:
+    """``path`` if its name is valid here (no NUL, not too long for the filesystem); else one-line InputError."""
+    text = str(path)
+    if "\0" in text:
+        raise InputError(f"output path {text!r} contains a NUL character")
+    limit = name_max(path.parent)
+    if len(os.fsencode(path.name)) > limit:
+        raise InputError(f"output file name '{path.name[:40]}...' is {len(os.fsencode(path.name))} bytes; this "
+                         f"filesystem allows {limit}")
+    return path
+
+
+def confined_path(output_dir: str | Path, relative: str | Path, what: str = "path") -> Path:
+    """``output_dir / relative``, refusing anything that would leave ``output_dir``: absolute paths, ``..``
+    parts, NUL characters, symlinked parents pointing outside, and names the filesystem cannot hold."""
+    text = str(relative)
+    if "\0" in text or "\0" in str(output_dir):
+        raise InputError(f"{what} {text!r} contains a NUL character")
+    rel = Path(text)
+    if rel.is_absolute() or ".." in rel.parts or text.strip() == "":
+        raise InputError(f"{what} must be a relative path inside output_dir without '..', got {text!r}")
+    base = Path(output_dir)
+    target = base / rel
+    resolved_base = base.resolve()
+    if not target.resolve().is_relative_to(resolved_base):
+        raise InputError(f"{what} {text!r} leads outside output_dir '{base}' (through a symlink)")
+    for part in rel.parts:
+        check_file_name(base / part)
+    return target
 
 
 def temporary_path(final: Path) -> Path:
-    """The name a file is written under until it is complete: hidden, same folder, same filesystem."""
-    return final.with_name(f".{final.name}.{os.getpid()}{TEMP_SUFFIX}")
+    """A new, empty, private file beside ``final`` to write into until it is complete (hidden, same
+    filesystem; its name is ``.<final name>.<random>.incomplete``, shortened to fit the filesystem).
+
+    The caller renames it with :func:`commit` or deletes it (:func:`discard`); files left behind by a
+    killed process are ignored by readers (hidden, ``.incomplete``)."""
+    final = check_file_name(Path(final))
+    room = name_max(final.parent) - _RANDOM_PART - len(TEMP_SUFFIX) - 1
+    stem = os.fsdecode(os.fsencode(final.name)[:room]) if room > 0 else ""
+    try:
+        fd, name = tempfile.mkstemp(prefix=f".{stem}.", suffix=TEMP_SUFFIX, dir=final.parent)
+    except UnicodeDecodeError:  # cut inside a multi-byte character: drop the final name from the temp name
+        fd, name = tempfile.mkstemp(prefix=".", suffix=TEMP_SUFFIX, dir=final.parent)
+    except OSError as exc:
+        raise InputError(f"cannot write in '{final.parent}': {exc.strerror or exc}") from None
+    os.close(fd)
+    temp = Path(name)
+    if len(_LIVE) >= _PRUNE_AT:
+        _LIVE.difference_update([p for p in _LIVE if not os.path.lexists(p)])
+    _LIVE.add(temp)
+    return temp
+
+
+def discard(temp: Path) -> None:
+    """Delete a temporary file (if it is still there) and forget it."""
+    _LIVE.discard(temp)
+    try:
+        os.unlink(temp)
+    except FileNotFoundError:
+        pass
+
+
+def remove_live_temporaries() -> int:
+    """Delete every temporary file this process created and has not committed; returns how many.
+    Safe to call from a signal handler's exit path."""
+    removed = 0
+    for temp in list(_LIVE):
+        try:
+            os.unlink(temp)
+            removed += 1
+        except OSError:
+            pass
+    _LIVE.clear()
+    return removed
 
 
 def prepare_output_dir(directory: Path) -> Path:
     """Create ``directory`` (and parents); a clear error if it is a file or not writable."""
+    if "\0" in str(directory):
+        raise InputError(f"output directory {str(directory)!r} contains a NUL character")
     if directory.exists() and not directory.is_dir():
         raise InputError(f"output directory '{directory}' exists and is not a directory")
     try:
@@ -28,7 +125,18 @@ def prepare_output_dir(directory: Path) -> Path:
 
 
 def commit(temp: Path, final: Path) -> None:
-    """Flush ``temp`` to disk and rename it to ``final`` (atomic on POSIX within one filesystem)."""
-    with open(temp, "rb+") as handle:
-        os.fsync(handle.fileno())
-    os.replace(temp, final)
+    """Flush ``temp`` to disk and rename it to ``final`` (atomic on POSIX within one filesystem).
+    A full disk is one line (InputError) and the temporary file is deleted."""
+    if final.is_dir():
+        discard(temp)
+        raise InputError(f"cannot write '{final}': a directory has that name")
+    try:
+        with open(temp, "rb+") as handle:
+            os.fsync(handle.fileno())
+        os.replace(temp, final)
+    except OSError as exc:
+        discard(temp)
+        if exc.errno == errno.ENOSPC:
+            raise InputError(f"no space left on the device writing '{final}'") from None
+        raise InputError(f"cannot write '{final}': {exc.strerror or exc}") from None
+    _LIVE.discard(temp)

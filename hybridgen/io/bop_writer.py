@@ -43,7 +43,8 @@ from ..errors import InputError
 from ..scene.camera import Intrinsics
 from ..scene.mesh_object import MeshObject
 from ..scene.scene import Scene
-from .atomic import prepare_output_dir
+from .atomic import confined_path, prepare_output_dir
+from .output_lock import hold_output_lock
 from .frame_sink import PassLayout
 from .image_files import StagedFiles, jpeg_bytes, png_bytes, write_file
 from .mask_encoding import bbox_of, rle_uncompressed
@@ -230,7 +231,7 @@ class BopWriter:
             raise InputError(f"color_file_format must be one of {COLOR_FORMATS}, got {color_file_format!r}")
         self.scene, self.select = scene, select
         self.output_dir = prepare_output_dir(Path(output_dir))
-        self.dataset_dir = self.output_dir / dataset if dataset else self.output_dir
+        self.dataset_dir = confined_path(self.output_dir, dataset, "dataset") if dataset else self.output_dir
         self.dataset_name = dataset or self.output_dir.resolve().name
         self.chunks_dir = self.dataset_dir / "train_pbr"
         for folder in (self.dataset_dir, self.chunks_dir):
@@ -244,7 +245,12 @@ class BopWriter:
         self.log = log or (lambda message: None)
         self.start_chunk, self.start_frame = 0, 0
         self.chunks: dict[int, _Chunk] = {}
-        self._find_start(append)
+        self._unlock = hold_output_lock(self.output_dir)  # ids and chunks stay ours until finalize/abort
+        try:
+            self._find_start(append)
+        except BaseException:
+            self._unlock()
+            raise
         self.count = 0
         self.camera: dict[str, np.ndarray] = {}
         self.depth_background = float("inf")
@@ -433,12 +439,14 @@ class BopWriter:
         for path, text in texts.items():
             write_file(path, text.encode("utf-8"), durable=True)
         self._amodal.release()
+        self._unlock()
         return self.dataset_dir
 
     def abort(self) -> None:
         """Delete everything staged (and the folders made for it); existing chunks stay as they were."""
         self._staged.discard()
         self._amodal.release()
+        self._unlock()
 
     def _json_texts(self) -> dict[Path, str]:
         texts: dict[Path, str] = {}

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import InputError
 from .atomic import prepare_output_dir
+from .output_lock import hold_output_lock
 from .frame_sink import PassLayout
 from .image_files import StagedFiles, jpeg_bytes, png_bytes, write_file
 from .mask_encoding import bbox_of, mask_to_polygons, require_pycocotools, rle_compressed
@@ -122,7 +123,12 @@ class CocoWriter:
         self.path = self.output_dir / ANNOTATIONS_FILE
         if self.path.exists() and not self.path.is_file():
             raise InputError(f"'{self.path}' exists and is not a file")
-        self.existing = load_existing(self.path) if append and self.path.exists() else None
+        self._unlock = hold_output_lock(self.output_dir)  # ids and image names stay ours until finalize/abort
+        try:
+            self.existing = load_existing(self.path) if append and self.path.exists() else None
+        except BaseException:
+            self._unlock()
+            raise
         self.image_offset = 1 + max((e["id"] for e in self.existing["images"]), default=-1) if self.existing else 0
         self.annotation_offset = max((e["id"] for e in self.existing["annotations"]), default=0) \
             if self.existing else 0
@@ -189,11 +195,13 @@ class CocoWriter:
         content = self._content()
         self._staged.commit()
         write_file(self.path, json.dumps(content).encode("utf-8"), durable=True)
+        self._unlock()
         return self.path
 
     def abort(self) -> None:
         """Delete every staged image; the annotations file is untouched."""
         self._staged.discard()
+        self._unlock()
 
     # ------------------------------------------------------------------ internals
     def image_id(self, index: int) -> int:

@@ -22,7 +22,8 @@ import h5py
 import numpy as np
 
 from ..scene.frames import opencv_to_blender
-from .atomic import commit, prepare_output_dir, temporary_path
+from .atomic import commit, discard, prepare_output_dir, temporary_path
+from .output_lock import hold_output_lock
 from .frame_sink import PassLayout
 
 
@@ -56,7 +57,9 @@ class BlenderProcHdf5Writer:
     def __init__(self, directory: str | Path, *, append: bool = False, compression: str = "gzip",
                  compression_level: int = 1) -> None:
         self.directory = prepare_output_dir(Path(directory))
+        self._unlock = hold_output_lock(self.directory)  # file numbers stay ours until finalize/abort
         self.offset = next_index(self.directory) if append else 0
+        self._temps: dict[int, Path] = {}
         self.compression = None if compression == "none" else compression
         self.level = compression_level if compression == "gzip" else None
         self._layouts: dict[str, PassLayout] = {}
@@ -69,7 +72,9 @@ class BlenderProcHdf5Writer:
         return self.directory / f"{index + self.offset}.hdf5"
 
     def _temp(self, index: int) -> Path:
-        return temporary_path(self.final_path(index))
+        if index not in self._temps:
+            self._temps[index] = temporary_path(self.final_path(index))
+        return self._temps[index]
 
     def begin(self, n_keypoints: int, layouts: list[PassLayout], camera_records: dict[str, np.ndarray],
               attributes: dict[str, Any]) -> None:
@@ -79,7 +84,7 @@ class BlenderProcHdf5Writer:
         self._attributes.update(attributes)
 
     def write(self, index: int, values: dict[str, Any]) -> None:
-        with h5py.File(self._temp(index), "a") as h5:
+        with h5py.File(self._temp(index), "a" if index in self._touched else "w") as h5:
             for key, value in values.items():
                 self._store(h5, key, value, index)
         self._touched.add(index)
@@ -118,13 +123,16 @@ class BlenderProcHdf5Writer:
                     h5.attrs[key] = value
                 h5.create_dataset("hybridgen_version",
                                   data=np.bytes_(str(self._attributes.get("hybridgen_version", ""))))
-            commit(self._temp(index), self.final_path(index))
+            commit(self._temps.pop(index), self.final_path(index))
             paths.append(self.final_path(index))
         self._touched.clear()
+        self._unlock()
         return paths
 
     def abort(self) -> None:
         """Delete every temporary file; no ``<i>.hdf5`` of this run appears."""
-        for index in self._touched:
-            self._temp(index).unlink(missing_ok=True)
+        for temp in self._temps.values():
+            discard(temp)
+        self._temps.clear()
         self._touched.clear()
+        self._unlock()

@@ -1,0 +1,125 @@
+"""One writer per output folder: an advisory ``fcntl.flock`` on ``<output_dir>/.hybridgen.lock``.
+
+A run holds the lock of every writer's folder from before its first module runs until it ends
+(:func:`output_lock` with ``wait=False``); a second run into the same folder gets one line naming the
+holder's pid and host. Writers that append to a folder (COCO, BlenderProc layout, BOP) also take the lock
+around their commit, where they hand out image ids and file numbers (``wait=True``: callers of the Python
+API queue behind each other instead of failing). Inside one process the lock is re-entrant.
+
+``flock`` is advisory and local to one machine's kernel for most network filesystems (NFS emulates it
+with ``fcntl`` locks since Linux 2.6.12); the lock file records ``pid host`` for the message. The file is
+removed on release; a process that acquired the lock checks that it locked the file still at that name,
+so removal never lets two holders in.
+"""
+from __future__ import annotations
+
+import errno
+import fcntl
+import os
+import socket
+from contextlib import ExitStack, contextmanager
+from pathlib import Path
+from typing import Callable, Iterable, Iterator
+
+from ..errors import InputError
+from .atomic import prepare_output_dir
+
+LOCK_NAME = ".hybridgen.lock"
+_HELD: dict[str, list[int]] = {}  # real path of the lock file -> [fd, depth]
+
+
+def _holder(path: Path) -> str:
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace").split()
+    except OSError:
+        return "another process"
+    return f"pid {text[0]} on {text[1]}" if len(text) >= 2 else "another process"
+
+
+def _acquire(path: Path, wait: bool) -> int:
+    while True:
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
+        except OSError as exc:
+            raise InputError(f"cannot lock output folder '{path.parent}': {exc.strerror or exc}") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | (0 if wait else fcntl.LOCK_NB))
+        except OSError as exc:
+            os.close(fd)
+            if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                raise InputError(f"output folder '{path.parent}' is in use by another hybridgen run "
+                                 f"({_holder(path)}); wait for it to finish or use another output_dir") from None
+            raise InputError(f"cannot lock output folder '{path.parent}': {exc.strerror or exc}") from None
+        try:
+            same = os.fstat(fd).st_ino == os.stat(path, follow_symlinks=False).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, f"{os.getpid()} {socket.gethostname()}\n".encode(), 0)
+            return fd
+        os.close(fd)  # the previous holder removed the file after we opened it: lock the new one
+
+
+def _enter(directory: str | Path, wait: bool) -> tuple[str, Path]:
+    folder = prepare_output_dir(Path(directory))
+    path = folder / LOCK_NAME
+    key = os.path.realpath(path)
+    if key in _HELD:
+        _HELD[key][1] += 1
+    else:
+        _HELD[key] = [_acquire(path, wait), 1]
+    return key, path
+
+
+def _leave(key: str, path: Path) -> None:
+    held = _HELD[key]
+    held[1] -= 1
+    if held[1] == 0:
+        del _HELD[key]
+        try:
+            os.unlink(path)
+        except OSError:
+            pass
+        os.close(held[0])
+
+
+@contextmanager
+def output_lock(directory: str | Path, *, wait: bool = False) -> Iterator[Path]:
+    """Hold the advisory lock of ``directory`` (created if missing) for the ``with`` block."""
+    key, path = _enter(directory, wait)
+    try:
+        yield path.parent
+    finally:
+        _leave(key, path)
+
+
+@contextmanager
+def output_locks(directories: Iterable[str | Path]) -> Iterator[None]:
+    """Hold the locks of several folders (each once, in a fixed order so two runs cannot deadlock)."""
+    unique = sorted({os.path.realpath(d) for d in directories})
+    with ExitStack() as stack:
+        for directory in unique:
+            stack.enter_context(output_lock(directory))
+        yield
+
+
+def held_by_this_process(directory: str | Path) -> bool:
+    """Whether this process holds ``directory``'s lock (writers use it to check they commit under it)."""
+    return os.path.realpath(Path(directory) / LOCK_NAME) in _HELD
+
+
+def hold_output_lock(directory: str | Path) -> Callable[[], None]:
+    """Take ``directory``'s lock now (one line if another run holds it) and return the function that
+    releases it (calling it again does nothing): for writers that hand out ids and file names from their
+    constructor to their commit."""
+    key, path = _enter(directory, wait=False)
+    released = False
+
+    def release() -> None:
+        nonlocal released
+        if not released:
+            released = True
+            _leave(key, path)
+
+    return release
