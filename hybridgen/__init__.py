@@ -21,9 +21,12 @@ import numpy as np
 from ._version import __version__
 from .errors import ConfigError, HybridgenError, InputError, SystemSetupError
 from .io.hdf5_single import Hdf5SingleFileWriter
+from .io.memory_sink import MemorySink
 from .io.mesh_loader import load_objects, object_pose
 from .render.label_request import LabelRequest
+from .render.path_trace import PathTraceSettings
 from .render.raster import RasterView
+from .render.render_color import render_color
 from .render.render_labels import render_labels
 from .run.pipeline import run_config
 from .scene import Camera, Intrinsics, Light, Material, MeshObject, Scene, World
@@ -38,7 +41,7 @@ def look_at(location: Sequence[float], target: Sequence[float], inplane_rot: flo
 
 __all__ = [
     "__version__", "Camera", "ConfigError", "Hdf5SingleFileWriter", "HybridgenError", "InputError", "Intrinsics",
-    "LabelRequest", "Light", "Material", "MeshObject", "RasterView", "Scene", "SystemSetupError", "World",
-    "blender_to_opencv", "load_objects", "look_at", "make_primitive", "object_pose", "opencv_to_blender",
-    "render_labels", "run_config",
+    "LabelRequest", "Light", "Material", "MemorySink", "MeshObject", "PathTraceSettings", "RasterView", "Scene", "SystemSetupError", "World",
+    "blender_to_opencv", "load_objects", "look_at", "make_pose", "make_primitive", "object_pose", "opencv_to_blender",
+    "render_color", "render_labels", "run_config",
 ]
