@@ -20,6 +20,7 @@ import numpy as np
 from ..errors import InputError
 from .atomic import commit, prepare_output_dir, temporary_path
 from .frame_sink import PassLayout
+from .integrity import seal
 
 COMPRESSIONS = ("gzip", "lzf", "none")
 _STOP = object()
@@ -87,6 +88,7 @@ class Hdf5SingleFileWriter:
             h5.create_dataset(key, data=json.dumps(value), dtype=h5py.string_dtype(), track_times=False)
         for key, value in (attributes or {}).items():
             h5.attrs[key] = value
+        seal(h5)  # content_sha256: resume and readers verify the file with it
         h5.close()
         self._file = None
         commit(self._temp, self.path)

@@ -1,0 +1,158 @@
+"""What made an output: the resolved config, the hybridgen version and the input files' contents.
+
+A fingerprint is a flat JSON object stored as the ``fingerprint`` attribute of every HDF5 file a run
+writes. Its keys are
+
+- ``hybridgen_version``;
+- ``config:<module>#<index>.<key path>`` for every leaf of the resolved config (after ``<args:N>`` and
+  environment substitution). Keys named ``output_dir`` are left out: where a run writes does not change
+  what it writes, so a moved output folder still resumes;
+- ``input:<path>`` -> SHA-256 of each file the config names (a string value that is an existing file, or
+  a glob that matches files, or the files directly in a named folder; relative to the working directory,
+  as modules read them), plus the MTL files an OBJ names and the texture files an MTL names.
+
+:func:`differing_keys` names what changed between two fingerprints, so a refused resume says which
+config keys or input files differ.
+"""
+from __future__ import annotations
+
+import glob
+import hashlib
+import json
+import re
+from pathlib import Path
+from typing import Any, Iterator
+
+from .._version import __version__
+from ..config.config_file import ConfigFile
+
+FINGERPRINT_ATTR = "fingerprint"
+IGNORED_KEYS = ("output_dir",)
+MAX_FOLDER_FILES = 10_000  # files hashed per named folder
+_LONG_VALUE = 200  # leaf values longer than this (in JSON) are stored as their SHA-256
+_MTLLIB = re.compile(rb"^\s*mtllib\s+(.+?)\s*$", re.MULTILINE)
+_MTL_MAPS = re.compile(rb"^\s*(?:map_\w+|bump|disp|decal|norm)\s+(?:-\S+(?:\s+[-\d.]+)*\s+)*(\S.*?)\s*$",
+                       re.MULTILINE)
+
+
+def _leaves(value: Any, prefix: str) -> Iterator[tuple[str, Any]]:
+    if isinstance(value, dict):
+        for key, item in value.items():
+            if str(key) in IGNORED_KEYS:
+                continue
+            yield from _leaves(item, f"{prefix}.{key}" if prefix else str(key))
+    elif isinstance(value, list) and any(isinstance(item, (dict, list)) for item in value):
+        for index, item in enumerate(value):
+            yield from _leaves(item, f"{prefix}[{index}]")
+    else:
+        yield prefix, value
+
+
+def _leaf_text(value: Any) -> str:
+    text = json.dumps(value, sort_keys=True, default=str)
+    return text if len(text) <= _LONG_VALUE else "sha256:" + hashlib.sha256(text.encode()).hexdigest()
+
+
+def file_sha256(path: Path) -> str:
+    """Hex SHA-256 of a file's bytes."""
+    with open(path, "rb") as handle:
+        return hashlib.file_digest(handle, "sha256").hexdigest()
+
+
+def _referenced_by(path: Path) -> list[Path]:
+    """Files an OBJ (its MTL libraries) or an MTL (its texture maps) names, relative to its folder."""
+    suffix = path.suffix.lower()
+    if suffix not in (".obj", ".mtl") or path.stat().st_size > 512 * 2**20:
+        return []
+    pattern = _MTLLIB if suffix == ".obj" else _MTL_MAPS
+    names = [m.group(1).decode("utf-8", "replace") for m in pattern.finditer(path.read_bytes())]
+    return [path.parent / name for name in names]
+
+
+def _candidate_files(text: str) -> list[Path]:
+    if "\0" in text or len(text) > 4096:
+        return []
+    try:
+        path = Path(text)
+        if path.is_file():
+            return [path]
+        if path.is_dir():
+            files = sorted(p for p in path.iterdir() if p.is_file() and not p.name.startswith("."))
+            return files[:MAX_FOLDER_FILES]
+    except (OSError, ValueError):
+        return []
+    if any(c in text for c in "*?["):
+        return [Path(p) for p in sorted(glob.glob(text, recursive=True))[:MAX_FOLDER_FILES] if Path(p).is_file()]
+    return []
+
+
+def input_files(config: ConfigFile) -> list[Path]:
+    """Every input file the config names (and the MTL / texture files those name), each once, in order."""
+    seen: dict[str, Path] = {}
+    queue = [path for _, value in _leaves(config.resolved, "") if isinstance(value, str)
+             for path in _candidate_files(value)]
+    while queue:
+        path = queue.pop(0)
+        key = str(path)
+        if key in seen or not path.is_file():
+            continue
+        seen[key] = path
+        try:
+            queue.extend(_referenced_by(path))
+        except OSError:
+            pass
+    return list(seen.values())
+
+
+def _config_leaves(config: ConfigFile) -> Iterator[tuple[str, Any]]:
+    for key, value in config.resolved.items():
+        if key == "modules" and isinstance(value, list):
+            for index, entry in enumerate(value):
+                name = entry.get("name", "?") if isinstance(entry, dict) else "?"
+                body = entry.get("config", {}) if isinstance(entry, dict) else entry
+                yield from _leaves(body, f"{name}#{index}")
+        else:
+            yield from _leaves(value, str(key))
+
+
+def run_fingerprint(config: ConfigFile) -> dict[str, str]:
+    """The fingerprint of a run of ``config`` (see the module documentation)."""
+    fingerprint = {"hybridgen_version": __version__}
+    for key, value in _config_leaves(config):
+        fingerprint[f"config:{key}"] = _leaf_text(value)
+    for path in input_files(config):
+        try:
+            fingerprint[f"input:{path}"] = file_sha256(path)
+        except OSError:
+            continue  # the module that reads it reports the problem
+    return fingerprint
+
+
+def fingerprint_text(fingerprint: dict[str, str]) -> str:
+    """The stored form: JSON with sorted keys (so equal fingerprints are equal bytes)."""
+    return json.dumps(fingerprint, sort_keys=True, separators=(",", ":"))
+
+
+def parse_fingerprint(value: Any) -> dict[str, str] | None:
+    """A stored fingerprint attribute back as a dict (None when absent or not one)."""
+    if value is None:
+        return None
+    try:
+        parsed = json.loads(value.decode() if isinstance(value, bytes) else str(value))
+    except (ValueError, UnicodeDecodeError):
+        return None
+    return parsed if isinstance(parsed, dict) else None
+
+
+def differing_keys(old: dict[str, str] | None, new: dict[str, str]) -> list[str]:
+    """The keys whose values differ (or exist in only one), without the ``config:`` prefix."""
+    if old is None:
+        return ["fingerprint (the file has none: made by an older hybridgen or another tool)"]
+    keys = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
+    return [k.removeprefix("config:") for k in keys]
+
+
+def describe_difference(keys: list[str], limit: int = 6) -> str:
+    """``a, b, c and 4 more`` for a one-line message."""
+    shown = ", ".join(keys[:limit])
+    return shown + (f" and {len(keys) - limit} more" if len(keys) > limit else "")
