@@ -15,11 +15,13 @@ ASSETS = Path(__file__).resolve().parents[1] / "configs" / "assets"
 
 def _write_obj(path: Path, vertices: np.ndarray, normals: np.ndarray | None, uvs: np.ndarray,
                faces: np.ndarray, material: str) -> None:
+    # OBJ files are +Y up (Blender's importer reads them with axis_forward -Z, axis_up Y): world (x, y, z)
+    # is written as (x, z, -y), so the object loads back Z-up exactly as modelled here.
     lines = [f"mtllib {path.stem}.mtl", f"o {path.stem}"]
-    lines += [f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in vertices]
+    lines += [f"v {x:.6f} {z:.6f} {-y + 0.0:.6f}" for x, y, z in vertices]
     lines += [f"vt {u:.6f} {v:.6f}" for u, v in uvs]
     if normals is not None:
-        lines += [f"vn {x:.6f} {y:.6f} {z:.6f}" for x, y, z in normals]
+        lines += [f"vn {x:.6f} {z:.6f} {-y + 0.0:.6f}" for x, y, z in normals]
     lines.append(f"usemtl {material}")
     for tri in faces + 1:
         if normals is not None:

@@ -2,9 +2,19 @@
 
 A pose entry is ``{location, rotation: {format, value, inplane_rot}}`` (format ``euler``: Blender XYZ
 angles of a Blender-axes camera, radians; ``look_at``: a target point; ``forward_vec``: a view
-direction) or ``{cam2world_matrix, source_frame}`` (Blender axes ``[X, -Y, -Z]`` unless
-``source_frame`` says otherwise). Text files hold one pose per line; ``file_format`` names what the
-numbers of a line are, e.g. ``"location rotation/value"`` (``_`` skips one number).
+direction) or ``{cam2world_matrix}`` (a Blender-axes camera). Text files hold one pose per line;
+``file_format`` names what the numbers of a line are, e.g. ``"location rotation/value"`` (``_`` skips
+one number).
+
+``source_frame`` (a module key, as in BlenderProc, or a per-pose key) means what it means in BlenderProc
+(docs/conventions.md section 1): three axis names ``X, Y, Z, -X, -Y, -Z`` saying, for each axis of the
+given frame, which Blender axis it is. Default ``[X, Y, Z]``. For ``cam2world_matrix`` it names the
+**camera** axes of the given matrix: ``[X, -Y, -Z]`` declares an OpenCV cam2world (BlenderProc's BOP
+loader, its 1.x camera interface up to 1.11 and ``change_source_coordinate_frame_of_transformation_matrix``;
+1.12's camera interface multiplies from the left instead, which agrees for its only example, an identity
+matrix). For ``location`` and ``rotation/value`` it names the axes the numbers are given in, converted
+point-wise as BlenderProc's camera interface does: ``[X, -Z, Y]`` turns a Y-up file's ``(1, 2, 3)`` into
+``(1, -3, 2)``.
 """
 from __future__ import annotations
 
@@ -16,14 +26,37 @@ import numpy as np
 
 from ..errors import ConfigError, InputError
 from ..scene.camera import Intrinsics
-from ..scene.frames import (euler_xyz_to_matrix, forward_to_rotation_blender, look_at_blender, make_pose,
-                            source_frame_matrix)
+from ..scene.frames import BLENDER_TO_OPENCV, euler_xyz_to_matrix, forward_to_rotation_blender, look_at_blender, \
+    make_pose
 from .schema import closest
 
 ROTATION_FORMATS = ("euler", "look_at", "forward_vec")
 POSE_KEYS = ("location", "rotation", "cam2world_matrix", "source_frame")
 FILE_FIELDS = {"location": 3, "rotation/value": 3, "rotation/inplane_rot": 1, "cam2world_matrix": 16, "_": 1}
-BLENDER_FRAME = ("X", "-Y", "-Z")
+BLENDER_FRAME = ("X", "Y", "Z")
+"""BlenderProc's default ``source_frame``: the numbers are Blender's own axes."""
+OPENCV_FRAME = ("X", "-Y", "-Z")
+"""``source_frame`` of an OpenCV camera (x right, y down, z forward) in Blender camera axes."""
+_AXES = {"X": 0, "Y": 1, "Z": 2}
+
+
+def source_frame_axes(frame: Any, key: str = "source_frame") -> np.ndarray:
+    """3x3 ``T`` with row i = the Blender axis (signed unit vector) that axis i of ``frame`` is.
+
+    A point given in ``frame`` is ``T @ p`` in Blender's axes (BlenderProc's ``change_coordinate_frame_of_point``).
+    """
+    if not isinstance(frame, (list, tuple)) or len(frame) != 3:
+        raise ConfigError(f"needs 3 axes like [X, -Y, -Z], got {frame!r}", key=key)
+    rows = np.zeros((3, 3))
+    for i, axis in enumerate(frame):
+        text = str(axis).strip().upper()
+        name = text.lstrip("+-")
+        if name not in _AXES:
+            raise ConfigError(f"axis {axis!r} is not one of X, Y, Z, -X, -Y, -Z", key=key)
+        rows[i, _AXES[name]] = -1.0 if text.startswith("-") else 1.0
+    if abs(abs(np.linalg.det(rows)) - 1.0) > 1e-9:
+        raise ConfigError(f"axes {list(frame)} repeat an axis", key=key)
+    return rows
 
 
 def _numbers(value: Any, count: int, key: str) -> np.ndarray:
@@ -43,8 +76,12 @@ def _merge(defaults: dict[str, Any], entry: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def pose_from_entry(entry: Any, where: str = "cam_poses[0]", defaults: dict[str, Any] | None = None) -> np.ndarray:
-    """OpenCV-axes 4x4 cam2world of one pose entry; ConfigError names the offending key."""
+def pose_from_entry(entry: Any, where: str = "cam_poses[0]", defaults: dict[str, Any] | None = None,
+                    source_frame: Any = None) -> np.ndarray:
+    """OpenCV-axes 4x4 cam2world of one pose entry; ConfigError names the offending key.
+
+    ``source_frame`` is the module's (BlenderProc's meaning, see the module doc); the entry's own wins.
+    """
     if not isinstance(entry, dict):
         raise ConfigError(f"a pose is a mapping with location/rotation or cam2world_matrix, got {entry!r}", key=where)
     entry = _merge(defaults or {}, entry)
@@ -52,11 +89,8 @@ def pose_from_entry(entry: Any, where: str = "cam_poses[0]", defaults: dict[str,
         if key not in POSE_KEYS:
             raise ConfigError(f"unknown pose key{closest(key, POSE_KEYS)}; known: {list(POSE_KEYS)}",
                               key=f"{where}.{key}")
-    frame = entry.get("source_frame", list(BLENDER_FRAME))
-    try:
-        to_cv = source_frame_matrix(frame)
-    except ValueError as exc:
-        raise ConfigError(str(exc), key=f"{where}.source_frame") from None
+    frame = entry.get("source_frame", source_frame if source_frame is not None else list(BLENDER_FRAME))
+    axes = source_frame_axes(frame, f"{where}.source_frame" if "source_frame" in entry else "source_frame")
     if "cam2world_matrix" in entry:
         if "location" in entry or "rotation" in entry:
             raise ConfigError("give either cam2world_matrix or location + rotation, not both", key=where)
@@ -65,10 +99,12 @@ def pose_from_entry(entry: Any, where: str = "cam_poses[0]", defaults: dict[str,
         if not np.allclose(rot @ rot.T, np.eye(3), atol=1e-5) or not np.allclose(matrix[3], [0, 0, 0, 1]):
             raise ConfigError("must be a rigid transform (orthonormal rotation, last row 0 0 0 1)",
                               key=f"{where}.cam2world_matrix")
-        return matrix @ to_cv
+        blender_axes = np.eye(4)
+        blender_axes[:3, :3] = axes.T  # the given camera's axis i is Blender camera axis axes[i]
+        return matrix @ blender_axes @ BLENDER_TO_OPENCV
     if "location" not in entry:
         raise ConfigError("a pose needs 'location' (with 'rotation') or 'cam2world_matrix'", key=where)
-    location = _numbers(entry["location"], 3, f"{where}.location")
+    location = axes @ _numbers(entry["location"], 3, f"{where}.location")
     rotation = entry.get("rotation", {"value": [0.0, 0.0, 0.0]})
     if isinstance(rotation, list):
         rotation = {"format": "euler", "value": rotation}
@@ -84,7 +120,7 @@ def pose_from_entry(entry: Any, where: str = "cam_poses[0]", defaults: dict[str,
                           key=f"{where}.rotation.format")
     if "value" not in rotation:
         raise ConfigError("required key is missing", key=f"{where}.rotation.value")
-    value = _numbers(rotation["value"], 3, f"{where}.rotation.value")
+    value = axes @ _numbers(rotation["value"], 3, f"{where}.rotation.value")
     inplane = float(_numbers(rotation.get("inplane_rot", 0.0), 1, f"{where}.rotation.inplane_rot")[0])
     try:
         if fmt == "euler":
@@ -95,7 +131,7 @@ def pose_from_entry(entry: Any, where: str = "cam_poses[0]", defaults: dict[str,
             rot = forward_to_rotation_blender(value, inplane)
     except ValueError as exc:
         raise ConfigError(str(exc), key=f"{where}.rotation.value") from None
-    return make_pose(rot, location) @ to_cv
+    return make_pose(rot, location) @ BLENDER_TO_OPENCV
 
 
 def parse_file_format(file_format: str) -> list[tuple[str, int]]:
@@ -111,7 +147,8 @@ def parse_file_format(file_format: str) -> list[tuple[str, int]]:
     return fields
 
 
-def poses_from_file(path: str | Path, file_format: str, defaults: dict[str, Any] | None = None) -> list[np.ndarray]:
+def poses_from_file(path: str | Path, file_format: str, defaults: dict[str, Any] | None = None,
+                    source_frame: Any = None) -> list[np.ndarray]:
     """One cam2world per non-empty, non-comment line of ``path``."""
     fields = parse_file_format(file_format)
     width = sum(n for _, n in fields)
@@ -143,7 +180,7 @@ def poses_from_file(path: str | Path, file_format: str, defaults: dict[str, Any]
                 target = target.setdefault(parent, {})
             target[leaf] = chunk[0] if count == 1 else chunk
         try:
-            poses.append(pose_from_entry(entry, f"{path}:{number}", defaults))
+            poses.append(pose_from_entry(entry, f"{path}:{number}", defaults, source_frame))
         except ConfigError as exc:
             raise InputError(f"{exc.key}: {exc.detail}") from None
     return poses

@@ -1,14 +1,27 @@
-"""Mesh files -> scene objects, through trimesh (obj+mtl, ply, stl, glb/gltf, off).
+"""Mesh files -> scene objects, read the way Blender's importers (which BlenderProc uses) read them.
 
-``LOADERS`` maps a file suffix to the trimesh file type and the file's native up axis. glTF is +Y up by
-its specification, so it is turned to hybridgen's +Z up, as Blender's importer does; the other formats are
-taken as they are unless ``up_axis`` says otherwise. A file with several parts (OBJ groups or materials,
-glTF nodes) gives one object per part.
+``LOADERS`` maps a file suffix to the trimesh file type and the file's native up axis:
+
+- OBJ: +Y up (Blender's importer: ``axis_forward=-Z, axis_up=Y``), turned to hybridgen's +Z up, and split
+  by its ``o`` objects (Blender's ``split_mode`` ON). Each object is named as Blender names it: the text
+  after ``o`` (faces before any ``o`` take the file's stem); sections that repeat an ``o`` name are one
+  object, as in Blender. Each object keeps its own materials.
+- PLY, STL, OFF: taken as stored (Blender's PLY and STL importers do not turn them).
+- glTF/GLB: +Y up by its specification, turned to +Z up as Blender's glTF importer does.
+
+The turn is baked into the vertices and normals (as Blender does), so an object's ``local2world`` is only
+the pose given to the loader. ``up_axis`` ("Y" or "Z") overrides the format's native axis.
+
+hybridgen objects carry one material each: an OBJ object whose faces use several materials becomes one
+hybridgen object per material, all with the object's Blender name (``attributes["material_part"]`` names
+the material) - a name selector picks all of them, as it would pick the one Blender object.
 """
 from __future__ import annotations
 
+import io
+import re
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Callable, Iterable, Sequence
 
 import numpy as np
 
@@ -18,17 +31,25 @@ from ..scene.material import Material
 from ..scene.mesh_object import MeshObject
 
 LOADERS: dict[str, tuple[str, str]] = {
-    ".obj": ("obj", "Z"),
+    ".obj": ("obj", "Y"),
     ".ply": ("ply", "Z"),
     ".stl": ("stl", "Z"),
     ".off": ("off", "Z"),
     ".glb": ("glb", "Y"),
     ".gltf": ("gltf", "Y"),
 }
-"""Suffix -> (trimesh file type, native up axis)."""
+"""Suffix -> (trimesh file type, native up axis as Blender's importer reads the format)."""
 
 Y_UP_TO_Z_UP = np.array([[1.0, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1]])
-"""Rotation of +90 degrees about X: a +Y-up file's up axis becomes +Z."""
+"""Rotation of +90 degrees about X: a +Y-up file's up axis becomes +Z ((x, y, z) -> (x, -z, y))."""
+
+BLENDER_NAME_BYTES = 63
+"""Blender truncates object names to 63 bytes."""
+
+_SENTINEL = "__hybridgen_object_{}__"
+_SENTINEL_RE = re.compile(r"__hybridgen_object_(\d+)__")
+
+Notify = Callable[[str], None]
 
 
 def object_pose(location: Sequence[float] = (0, 0, 0), rotation: Sequence[float] = (0, 0, 0),
@@ -40,18 +61,94 @@ def object_pose(location: Sequence[float] = (0, 0, 0), rotation: Sequence[float]
     return make_pose(euler_xyz_to_matrix(rotation) @ np.diag(factors), location)
 
 
+def blender_name(text: str) -> str:
+    """An object name as Blender stores it: words joined by one space, at most 63 UTF-8 bytes."""
+    name = " ".join(text.split())
+    return name.encode("utf-8")[:BLENDER_NAME_BYTES].decode("utf-8", errors="ignore")
+
+
+def unique_blender_name(name: str, taken: Iterable[str]) -> str:
+    """``name``, or Blender's next free ``name.001``, ``name.002`` ... when ``name`` is taken."""
+    used = set(taken)
+    if name not in used:
+        return name
+    base = re.sub(r"\.\d{3}$", "", name)
+    number = 1
+    while f"{base}.{number:03d}" in used:
+        number += 1
+    return f"{base}.{number:03d}"
+
+
 def _has_loaded_normals(geometry: Any) -> bool:
     # trimesh keeps normals read from the file in its cache; computed ones are only made on access.
     cache = getattr(getattr(geometry, "_cache", None), "cache", {})
     return "vertex_normals" in cache
 
 
-def load_objects(path: str | Path, *, name: str | None = None, category_id: int | None = None,
-                 local2world: np.ndarray | None = None, up_axis: str = "auto",
-                 attributes: dict[str, Any] | None = None) -> list[MeshObject]:
-    """Read a mesh file into one :class:`MeshObject` per part, posed by ``local2world`` (metres)."""
+def tag_obj_objects(text: str, default_name: str) -> tuple[str, list[str]]:
+    """OBJ text with every ``o`` line replaced by a numbered marker, and the Blender names by number.
+
+    Faces before the first ``o`` belong to an object named ``default_name`` (Blender uses the file name);
+    an ``o`` name that comes again continues the same object, as Blender's importer does.
+    """
+    names: list[str] = []
+    index_of: dict[str, int] = {}
+
+    def number(name: str) -> int:
+        if name not in index_of:
+            index_of[name] = len(names)
+            names.append(name)
+        return index_of[name]
+
+    lines = text.replace("\r\n", "\n").replace("\\\n", "").split("\n")
+    out = [f"o {_SENTINEL.format(number(blender_name(default_name)))}"]
+    for line in lines:
+        stripped = line.lstrip()
+        if stripped.startswith("o ") or stripped.startswith("o\t") or stripped == "o":
+            name = blender_name(stripped[1:]) or blender_name(default_name)
+            out.append(f"o {_SENTINEL.format(number(name))}")
+        else:
+            out.append(line)
+    return "\n".join(out), names
+
+
+def _read_scene(file: Path, file_type: str) -> tuple[Any, list[str] | None]:
+    """The trimesh scene of ``file``; for OBJ also the Blender object names its parts are tagged with."""
     import trimesh
 
+    if file_type != "obj":
+        return trimesh.load(str(file), file_type=file_type, force="scene", process=False), None
+    text = file.read_text(encoding="utf-8", errors="replace")
+    tagged, names = tag_obj_objects(text, file.stem)
+    resolver = trimesh.resolvers.FilePathResolver(str(file))
+    scene = trimesh.load(io.BytesIO(tagged.encode("utf-8")), file_type="obj", resolver=resolver, force="scene",
+                         process=False, split_objects=True, group_material=True)
+    return scene, names
+
+
+def _part_object_name(node: str, geometry_name: str, obj_names: list[str] | None) -> str:
+    if obj_names is None:
+        return str(node)
+    match = _SENTINEL_RE.search(str(geometry_name)) or _SENTINEL_RE.search(str(node))
+    if match is None:  # not expected: every face lies after a marker
+        return obj_names[0]
+    return obj_names[int(match.group(1))]
+
+
+def _up_matrix(up: str) -> np.ndarray:
+    return Y_UP_TO_Z_UP if up == "Y" else np.eye(4)
+
+
+def load_objects(path: str | Path, *, name: str | None = None, category_id: int | None = None,
+                 local2world: np.ndarray | None = None, up_axis: str = "auto",
+                 attributes: dict[str, Any] | None = None, notify: Notify | None = None) -> list[MeshObject]:
+    """Read a mesh file into one :class:`MeshObject` per object (per material of it, see the module doc).
+
+    ``local2world`` (metres) poses every object; the file's own node transforms (glTF) are kept under it.
+    Without ``name`` objects are named as Blender names them (OBJ ``o`` names, glTF node names, else the
+    file stem); with ``name`` a single object is ``name`` and several are ``<name>.<Blender name>``.
+    ``notify`` receives one line for what Blender would do differently (an object with several materials).
+    """
     file = Path(path)
     suffix = file.suffix.lower()
     if suffix not in LOADERS:
@@ -59,45 +156,69 @@ def load_objects(path: str | Path, *, name: str | None = None, category_id: int 
     if not file.is_file():
         raise InputError(f"mesh file not found: '{file}'")
     file_type, native_up = LOADERS[suffix]
-    up = native_up if up_axis == "auto" else up_axis.upper()
+    up = native_up if up_axis == "auto" else str(up_axis).upper()
     if up not in ("Y", "Z"):
         raise InputError(f"up_axis must be 'auto', 'Y' or 'Z', got {up_axis!r}")
     try:
-        loaded = trimesh.load(str(file), file_type=file_type, force="scene", process=False)
+        loaded, obj_names = _read_scene(file, file_type)
     except Exception as exc:
         raise InputError(f"cannot read mesh '{file}': {type(exc).__name__}: {exc}") from None
+    import trimesh
+
     base = np.eye(4) if local2world is None else np.asarray(local2world, dtype=np.float64)
-    if up == "Y":
-        base = base @ Y_UP_TO_Z_UP
-    parts = []
+    turn = _up_matrix(up)
+    parts: list[tuple[str, Any, np.ndarray]] = []
     for node in loaded.graph.nodes_geometry:
         transform, geometry_name = loaded.graph[node]
         geometry = loaded.geometry[geometry_name]
         if not isinstance(geometry, trimesh.Trimesh) or len(geometry.faces) == 0:
             continue
-        parts.append((str(node), geometry, np.asarray(transform, dtype=np.float64)))
+        part_name = _part_object_name(node, geometry_name, obj_names)
+        parts.append((part_name, geometry, np.asarray(transform, dtype=np.float64)))
     if not parts:
         raise InputError(f"mesh '{file}' contains no triangles")
+    if obj_names is not None:  # keep the file's object order (trimesh lists them last-first)
+        order = {n: i for i, n in enumerate(obj_names)}
+        parts.sort(key=lambda part: order[part[0]])
+    distinct = list(dict.fromkeys(p[0] for p in parts))
+    counts = {n: sum(1 for p in parts if p[0] == n) for n in distinct}
+    split = [n for n in distinct if counts[n] > 1]
+    if split and notify is not None:
+        notify(f"mesh '{file}': object(s) {', '.join(repr(n) for n in split[:5])} use several materials; "
+               "hybridgen objects carry one material each, so each becomes one object per material with the "
+               "same name (attribute 'material_part')")
     objects = []
     for part_name, geometry, transform in parts:
         if name is None:
-            obj_name = part_name if len(parts) > 1 else file.stem
+            obj_name = part_name if (obj_names is not None or len(distinct) > 1) else file.stem
         else:
-            obj_name = name if len(parts) == 1 else f"{name}.{part_name}"
+            obj_name = name if len(distinct) == 1 else f"{name}.{part_name}"
         uv = getattr(geometry.visual, "uv", None)
+        # Blender bakes the axis turn into the vertices; node transforms are conjugated into the new axes.
+        rotation = turn[:3, :3]
+        with np.errstate(invalid="ignore", over="ignore"):  # NaN/inf input is reported by MeshObject below
+            vertices = np.asarray(geometry.vertices, dtype=np.float64) @ rotation.T
+            normals = (np.asarray(geometry.vertex_normals, dtype=np.float64) @ rotation.T
+                       if _has_loaded_normals(geometry) else None)
+        extra = {"material_part": _material_name(geometry)} if counts[part_name] > 1 else {}
         try:
             obj = MeshObject(
                 name=obj_name,
-                vertices=np.asarray(geometry.vertices),
+                vertices=vertices,
                 faces=np.asarray(geometry.faces),
-                vertex_normals=np.asarray(geometry.vertex_normals) if _has_loaded_normals(geometry) else None,
+                vertex_normals=normals,
                 uvs=None if uv is None else np.asarray(uv, dtype=np.float64),
                 material=Material.from_trimesh_visual(geometry.visual, fallback_name=obj_name),
                 category_id=category_id,
-                attributes={"source_path": str(file), **(attributes or {})},
-                local2world=base @ transform,
+                attributes={"source_path": str(file), **extra, **(attributes or {})},
+                local2world=base @ turn @ transform @ turn.T,
             )
         except InputError as exc:
             raise InputError(f"mesh '{file}': {exc}") from None
         objects.append(obj)
     return objects
+
+
+def _material_name(geometry: Any) -> str:
+    material = getattr(geometry.visual, "material", None)
+    return str(getattr(material, "name", None) or "")

@@ -23,6 +23,8 @@ class CameraLoader(Module):
         Param("file_format", "str", "location rotation/value",
               doc="fields of a pose file line: location, rotation/value, rotation/inplane_rot, "
               "cam2world_matrix, _ (skip one number)"),
+        Param("source_frame", "list", ["X", "Y", "Z"], doc="axes the poses are given in, named in Blender's "
+              "axes (BlenderProc's meaning; [X, -Y, -Z]: OpenCV cam2world matrices), see hybridgen.config.camera_poses"),
         Param("default_cam_param", "dict", {}, doc="values merged into every pose, e.g. {rotation: {format: "
               "look_at}} for a file of location + target lines"),
     )
@@ -34,9 +36,10 @@ class CameraLoader(Module):
             camera.intrinsics = intrinsics_from_config(cfg["intrinsics"])
         defaults = cfg["default_cam_param"]
         entries = self.value(context, "cam_poses")
-        poses = [pose_from_entry(e, f"cam_poses[{i}]", defaults) for i, e in enumerate(entries)]
+        frame = cfg["source_frame"]
+        poses = [pose_from_entry(e, f"cam_poses[{i}]", defaults, frame) for i, e in enumerate(entries)]
         if cfg["path"] is not None:
-            poses += poses_from_file(cfg["path"], cfg["file_format"], defaults)
+            poses += poses_from_file(cfg["path"], cfg["file_format"], defaults, frame)
         if not poses:
             raise ConfigError("no camera poses: give cam_poses entries or a pose file 'path'", key="cam_poses")
         for pose in poses:

@@ -31,6 +31,8 @@ class CameraSampler(Module):
         Param("cam_poses", "list", sampleable=True, doc=f"entries with keys {', '.join(ENTRY_KEYS)}; "
               "proximity_checks: {min, max [m], avg: {min, max}, var: {min, max}, no_background}; "
               "min_coverage: {selector, fraction} (image fraction the selected objects must cover)"),
+        Param("source_frame", "list", ["X", "Y", "Z"], doc="axes the poses are given in, named in Blender's "
+              "axes (BlenderProc's meaning; [X, -Y, -Z]: OpenCV cam2world matrices), see hybridgen.config.camera_poses"),
         Param("max_tries", "int", 10000, doc="candidate poses per entry before giving up", check=positive),
         Param("check_width", "int", 64, "px", "width of the low-resolution check image", check=positive),
         Param("on_failure", "str", "error", choices=("error", "warn"),
@@ -60,7 +62,7 @@ class CameraSampler(Module):
                 pose_part = {k: v for k, v in entry.items() if k in POSE_ONLY}
 
                 def propose(part: dict[str, Any] = pose_part, at: str = where) -> Any:
-                    return pose_from_entry(draw(part, draw_ctx), at)
+                    return pose_from_entry(draw(part, draw_ctx), at, source_frame=cfg["source_frame"])
 
                 poses, report = sample_camera_poses(context.scene, propose, count, cfg["max_tries"], checks,
                                                     check_width=cfg["check_width"], view=view, report=report)

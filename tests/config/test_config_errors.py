@@ -232,7 +232,7 @@ def test_pose_entry_formats_agree():
     blender = make_pose(look_at_blender([1, 2, 3], target, 0.3), [1, 2, 3])
     from_matrix = pose_from_entry({"cam2world_matrix": blender.tolist()})
     np.testing.assert_allclose(from_matrix, look, atol=1e-12)
-    cv_matrix = pose_from_entry({"cam2world_matrix": look.tolist(), "source_frame": ["X", "Y", "Z"]})
+    cv_matrix = pose_from_entry({"cam2world_matrix": look.tolist(), "source_frame": ["X", "-Y", "-Z"]})
     np.testing.assert_allclose(cv_matrix, look, atol=1e-12)
     from hybridgen.scene.frames import euler_xyz_to_matrix
     angles = [1.1, 0.0, 0.4]

@@ -21,9 +21,9 @@ def test_formats_load_with_same_world_geometry(tmp_path, suffix):
     path = tmp_path / f"box{suffix}"
     mesh.export(path)
     pose = hg.object_pose([1, 2, 3], [0, 0, np.pi / 2], 2.0)
-    # glTF files are +Y up by specification; the loader turns them to +Z up unless told otherwise
+    # OBJ and glTF files are +Y up (Blender's importers); the loader turns them to +Z up unless told otherwise
     objects = hg.load_objects(path, name="b", category_id=7, local2world=pose,
-                              up_axis="Z" if suffix == ".glb" else "auto")
+                              up_axis="Z" if suffix in (".glb", ".obj") else "auto")
     assert len(objects) == 1 and objects[0].name == "b" and objects[0].category_id == 7
     world = objects[0].world_vertices()
     expected = mesh.vertices @ (pose[:3, :3].T) + pose[:3, 3]
@@ -46,8 +46,10 @@ def test_obj_with_normals_materials_and_parts(tmp_path):
         "mtllib two.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvn 0 0 1\n"
         "usemtl red\nf 1//1 2//1 3//1\nusemtl green\nf 2//1 4//1 3//1\n")
     objects = hg.load_objects(tmp_path / "two.obj", name="pair", category_id=1)
+    # one Blender object with two materials: one hybridgen object per material, both with the object's name
     assert len(objects) == 2
-    assert all(o.name.startswith("pair.") for o in objects)
+    assert [o.name for o in objects] == ["pair", "pair"]
+    assert sorted(o.attributes["material_part"] for o in objects) == ["green", "red"]
     assert all(o.vertex_normals is not None for o in objects)
     colors = sorted(tuple(np.round(o.material.base_color[:3], 3)) for o in objects)
     assert colors == [(0.0, 1.0, 0.0), (1.0, 0.0, 0.0)]
@@ -57,7 +59,7 @@ def test_flat_mesh_has_no_vertex_normals(tmp_path):
     (tmp_path / "tri.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
     (obj,) = hg.load_objects(tmp_path / "tri.obj")
     assert obj.vertex_normals is None and obj.name == "tri"
-    np.testing.assert_allclose(obj.face_normals, [[0, 0, 1]])
+    np.testing.assert_allclose(obj.face_normals, [[0, -1, 0]], atol=1e-12)  # file +Z is Blender's -Y (Y-up OBJ)
 
 
 def test_unsupported_and_bad_indices(tmp_path):
