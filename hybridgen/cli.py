@@ -40,7 +40,8 @@ def _cmd_run(ns: argparse.Namespace) -> int:
             raise InputError(f"--shard takes i/N (e.g. 0/4), got {ns.shard!r}") from None
         shard = (index, count)
     summary = run_config(ns.config, ns.args, progress=_progress_factory(not ns.quiet), log=log, workers=ns.workers,
-                         shard=shard, executor=ns.executor, address=ns.address)
+                         shard=shard, executor=ns.executor, address=ns.address, restart=ns.restart,
+                         force_resume=ns.force_resume, max_tasks_per_child=ns.max_tasks_per_child)
     outputs = ", ".join(str(p) for p in summary.outputs) or "(no output file)"
     rate = summary.frames / summary.seconds if summary.seconds > 0 else 0.0
     print(f"hybridgen: {summary.frames} keypoint(s) in {summary.seconds:.2f} s ({rate:.1f}/s) -> {outputs}")
@@ -91,6 +92,13 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--shard", help="i/N: run only the scenes with scene %% N == i (external schedulers)")
     run.add_argument("--executor", default="pool", choices=("pool", "ray"), help="where work units run")
     run.add_argument("--address", help="Ray cluster address (with --executor ray); default: a local cluster")
+    run.add_argument("--restart", action="store_true",
+                     help="discard existing outputs of this config (shards, data.hdf5) instead of resuming")
+    run.add_argument("--force-resume", action="store_true",
+                     help="reuse existing outputs that verify even if another config or other inputs made them "
+                     "(the result then mixes both)")
+    run.add_argument("--max-tasks-per-child", type=int, default=25,
+                     help="work units a pool worker renders before it is replaced (bounds memory growth)")
     run.set_defaults(func=_cmd_run)
     modules = sub.add_parser("modules", help="list modules and their parameters")
     modules.add_argument("name", nargs="?", help="show one module")

@@ -9,7 +9,7 @@ writes. Its keys are
   what it writes, so a moved output folder still resumes;
 - ``input:<path>`` -> SHA-256 of each file the config names (a string value that is an existing file, or
   a glob that matches files, or the files directly in a named folder; relative to the working directory,
-  as modules read them), plus the MTL files an OBJ names and the texture files an MTL names.
+  else to the config's folder, as modules read them), plus the MTL files an OBJ names and the texture files an MTL names.
 
 :func:`differing_keys` names what changed between two fingerprints, so a refused resume says which
 config keys or input files differ.
@@ -69,11 +69,13 @@ def _referenced_by(path: Path) -> list[Path]:
     return [path.parent / name for name in names]
 
 
-def _candidate_files(text: str) -> list[Path]:
+def _candidate_files(text: str, folder: Path) -> list[Path]:
     if "\0" in text or len(text) > 4096:
         return []
     try:
-        path = Path(text)
+        path = Path(text).expanduser()
+        if not path.exists() and (folder / path).exists():
+            path = folder / path  # modules fall back to the config's folder (docs/conventions.md section 5)
         if path.is_file():
             return [path]
         if path.is_dir():
@@ -89,8 +91,9 @@ def _candidate_files(text: str) -> list[Path]:
 def input_files(config: ConfigFile) -> list[Path]:
     """Every input file the config names (and the MTL / texture files those name), each once, in order."""
     seen: dict[str, Path] = {}
+    folder = Path(config.path).resolve().parent
     queue = [path for _, value in _leaves(config.resolved, "") if isinstance(value, str)
-             for path in _candidate_files(value)]
+             for path in _candidate_files(value, folder)]
     while queue:
         path = queue.pop(0)
         key = str(path)

@@ -9,9 +9,13 @@ from typing import Any, Callable, Mapping, Sequence
 from ..config.config_file import ConfigFile, load_config
 from ..config.registry import get_module
 from ..config.schema import validate_config
-from ..errors import ConfigError, HybridgenError
+from ..errors import ConfigError, HybridgenError, InputError
+from ..io.output_lock import output_locks
 from ..modules.base import Module
 from .context import RunContext
+from .fingerprint import FINGERPRINT_ATTR, fingerprint_text, run_fingerprint
+from .runner import DEFAULT_MAX_TASKS_PER_CHILD
+from .signals import stop_on_signals
 from .units import WorkUnit
 
 
@@ -31,6 +35,7 @@ def build_modules(config: ConfigFile) -> list[Module]:
         try:
             cls = get_module(entry.name)
             values = validate_config(cls.param_table(), entry.config, config.global_all)
+            resolve_module_paths(cls.params, values, config.path)
         except ConfigError as exc:
             raise exc.located(file=config.path, module=entry.name, index=entry.index) from None
         modules.append(cls(values, entry.index))
@@ -64,9 +69,11 @@ def _check_order(modules: list[Module], file: str) -> None:
 
 def execute(config: ConfigFile, modules: list[Module], *, unit: WorkUnit | None = None,
             progress: Callable[[int, str], Any] | None = None,
-            log: Callable[[str], None] | None = None) -> RunContext:
-    """Prepare, then run every module in order (for ``unit``: one work unit of a sharded run)."""
+            log: Callable[[str], None] | None = None, attributes: Mapping[str, Any] | None = None) -> RunContext:
+    """Prepare, then run every module in order (for ``unit``: one work unit of a sharded run).
+    ``attributes`` (e.g. the run's ``fingerprint``) are recorded in every output file."""
     context = RunContext(config=config, progress=progress, unit=unit)
+    context.attributes.update(attributes or {})
     if log is not None:
         context.log = log
     try:
@@ -85,24 +92,61 @@ def execute(config: ConfigFile, modules: list[Module], *, unit: WorkUnit | None 
     return context
 
 
+def writer_folders(modules: list[Module]) -> list[Path]:
+    """The output folders of the config's writer modules (each is locked for the run)."""
+    return [Path(m.config["output_dir"]) for m in modules
+            if m.module_name.startswith("writer.") and isinstance(m.config.get("output_dir"), str)]
+
+
+def single_file_output(modules: list[Module]) -> Path | None:
+    """The final path of a ``writer.Hdf5Writer`` with ``layout: single``, if the config has exactly one."""
+    writers = [m for m in modules if m.module_name == "writer.Hdf5Writer" and m.config["layout"] == "single"]
+    if len(writers) != 1:
+        return None
+    return Path(writers[0].config["output_dir"]) / writers[0].config["file_name"]
+
+
 def run_config(path: str | Path, args: Sequence[str] = (), *, env: Mapping[str, str] | None = None,
                progress: Callable[[int, str], Any] | None = None,
                log: Callable[[str], None] | None = None, workers: int = 1, shard: tuple[int, int] | None = None,
-               executor: str = "pool", address: str | None = None) -> RunSummary:
+               executor: str = "pool", address: str | None = None, restart: bool = False,
+               force_resume: bool = False, max_tasks_per_child: int = DEFAULT_MAX_TASKS_PER_CHILD) -> RunSummary:
     """Run the config at ``path`` with command-line ``args`` (``<args:N>``); returns a summary.
 
     ``progress(total, what)`` makes a progress bar per renderer; ``log`` receives one-line status messages.
     A config with several scenes or keypoint chunks (``main.Initializer``), or ``workers`` > 1, or a
     ``shard`` ``(i, n)`` runs as work units (see :mod:`hybridgen.run.runner`).
+
+    Every writer's folder is locked for the run (a second run into it gets one line). Existing outputs
+    are reused only when they verify and carry this run's fingerprint; one made by another config or other
+    inputs is an error naming the differing keys unless ``restart`` (discard it) or ``force_resume`` (keep
+    it). SIGTERM stops the run (workers included) and exits 143, SIGINT 130; temporary files are deleted.
     """
-    from .runner import run_sharded, sharding_plan
+    from .runner import ResumePolicy, check_existing, run_sharded, sharding_plan
 
     start = time.perf_counter()
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise InputError(f"--workers must be an integer >= 1, got {workers!r}")
+    if restart and force_resume:
+        raise InputError("--restart and --force-resume exclude each other")
+    say = log or (lambda message: None)
     config = load_config(path, args, env)
     modules = build_modules(config)
     plan = sharding_plan(config, modules, force=workers > 1 or shard is not None)
-    if plan is not None:
-        return run_sharded(plan, path, args, env, workers=workers, shard=shard, executor=executor, address=address,
-                           log=log or (lambda message: None), start=start)
-    context = execute(config, modules, progress=progress, log=log)
+    fingerprint = run_fingerprint(config)
+    policy = ResumePolicy(fingerprint_text(fingerprint), fingerprint, restart=restart, force=force_resume)
+    single = single_file_output(modules)
+    if single is not None and single.is_dir():
+        raise InputError(f"'{single}' is a directory; the output file cannot be written there")
+    with stop_on_signals(), output_locks(writer_folders(modules)):
+        if plan is not None:
+            return run_sharded(plan, path, args, env, workers=workers, shard=shard, executor=executor,
+                               address=address, log=say, start=start, policy=policy,
+                               max_tasks_per_child=max_tasks_per_child)
+        if single is not None and not restart and check_existing(single, policy, say):
+            say(f"'{single}' is complete and verified (same config and inputs): nothing to do; "
+                "--restart renders it again")
+            return RunSummary(0, time.perf_counter() - start, [single])
+        context = execute(config, modules, progress=progress, log=log,
+                          attributes={FINGERPRINT_ATTR: policy.fingerprint_text})
     return RunSummary(context.frames_rendered, time.perf_counter() - start, context.outputs)

@@ -1,10 +1,19 @@
-"""Sharded runs: work units executed in this process, on a process pool or on Ray; crash-safe and resumable.
+"""Sharded runs: work units executed in this process, on a process pool or on Ray; crash-safe, verified
+resume.
 
 Units are (scene, keypoint chunk) pairs (:mod:`hybridgen.run.units`). Each writes its own complete file
-``<output_dir>/shards/scene_SSSSSS_chunk_CCCCC.hdf5`` under a temporary name and renames it when done; a
-unit whose file exists is complete and skipped, so rerunning the same command resumes after a crash or a
-kill. How many chunks a scene has is known once its first chunk ran (it records ``scene_keypoints``).
-When every unit of every scene exists, ``<output_dir>/data.hdf5`` is (re)built over them
+``<output_dir>/shards/scene_SSSSSS_chunk_CCCCC.hdf5`` under a temporary name and renames it when done. Every
+shard carries the run's fingerprint (:mod:`hybridgen.run.fingerprint`) and a digest of its content
+(:mod:`hybridgen.io.integrity`). Rerunning the same command resumes: a shard is reused only when its
+fingerprint equals this run's and its content verifies; an unreadable, truncated, empty or damaged shard
+counts as missing and is rendered again; a shard made by another config or other inputs stops the run with
+one line naming the differing keys (``--restart`` discards the folder's shards, ``--force-resume`` keeps
+shards that verify whatever made them).
+
+How many chunks a scene has is known once its first chunk ran (it records ``scene_keypoints``). Units are
+generated lazily and at most ``2 x workers`` are in flight, so memory does not grow with
+``number_of_scenes``; pool workers are replaced after ``max_tasks_per_child`` units (bounded growth of
+long runs). When every unit of every scene exists, ``<output_dir>/data.hdf5`` is (re)built over them
 (:mod:`hybridgen.run.shard_index`). ``--shard i/N`` runs only the scenes with ``scene % N == i``, for
 external schedulers (SLURM arrays, indexed jobs); the run that completes the last unit builds the index.
 Results never depend on how units are spread over workers.
@@ -12,21 +21,29 @@ Results never depend on how units are spread over workers.
 from __future__ import annotations
 
 import os
+import socket
 import time
+from collections import deque
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 from multiprocessing import get_context
 from pathlib import Path
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any, Callable, Iterator, Mapping, Sequence
 
 import h5py
 
 from ..config.config_file import ConfigFile, load_config
 from ..errors import ConfigError, InputError, SystemSetupError
+from ..io.atomic import prepare_output_dir
+from ..io.integrity import verify
 from ..modules.base import Module
-from .units import WorkUnit, chunk_count
+from .fingerprint import FINGERPRINT_ATTR, describe_difference, differing_keys, parse_fingerprint
+from .signals import die_with_parent
+from .units import SHARD_FOLDER, WorkUnit, chunk_count
 
 EXECUTORS = ("pool", "ray")
+DEFAULT_MAX_TASKS_PER_CHILD = 25
+RAY_CONNECT_TIMEOUT_S = 10.0
 
 
 @dataclass(frozen=True)
@@ -37,6 +54,17 @@ class ShardingPlan:
     chunk_size: int
     output_dir: Path
     file_name: str
+
+
+@dataclass(frozen=True)
+class ResumePolicy:
+    """What to do with existing outputs: ``restart`` discards them, ``force`` keeps intact ones made by
+    another config; ``fingerprint`` is this run's (JSON text) and the dict it encodes."""
+
+    fingerprint_text: str
+    fingerprint: dict[str, str]
+    restart: bool = False
+    force: bool = False
 
 
 def sharding_plan(config: ConfigFile, modules: list[Module], force: bool = False) -> ShardingPlan | None:
@@ -54,11 +82,15 @@ def sharding_plan(config: ConfigFile, modules: list[Module], force: bool = False
     return ShardingPlan(scenes, chunk_size, Path(writer["output_dir"]), writer["file_name"])
 
 
-def limit_threads(threads: int) -> None:
+def limit_threads(threads: int, parent_pid: int | None = None) -> None:
     """Give this worker process ``threads`` CPU threads for rasterizing (llvmpipe) and path tracing (Dr.Jit),
-    so that several workers share the cores instead of oversubscribing them. Call before rendering."""
+    so that several workers share the cores instead of oversubscribing them. Call before rendering.
+    With ``parent_pid`` (pool workers) the process also stops when that parent does (see
+    :func:`hybridgen.run.signals.die_with_parent`)."""
     os.environ["LP_NUM_THREADS"] = str(threads)  # read by Mesa when the GL context is created
     os.environ["HYBRIDGEN_THREADS"] = str(threads)
+    if parent_pid is not None:
+        die_with_parent(parent_pid)
 
 
 def _apply_thread_limit() -> None:
@@ -70,19 +102,54 @@ def _apply_thread_limit() -> None:
             drjit.set_thread_count(int(threads))
 
 
-def run_unit(path: str, args: Sequence[str], env: Mapping[str, str] | None, unit: WorkUnit) -> tuple[int, int]:
-    """Run one unit (in whatever process this is); returns (keypoints rendered, keypoints of its scene)."""
+def run_unit(path: str, args: Sequence[str], env: Mapping[str, str] | None, unit: WorkUnit,
+             fingerprint: str | None = None) -> tuple[int, int]:
+    """Run one unit (in whatever process this is); returns (keypoints rendered, keypoints of its scene).
+    ``fingerprint`` (the parent's, JSON) is recorded in the unit's file."""
     from .pipeline import build_modules, execute
 
     _apply_thread_limit()
     config = load_config(path, args, env)
-    context = execute(config, build_modules(config), unit=unit)
+    attributes = {FINGERPRINT_ATTR: fingerprint} if fingerprint is not None else None
+    context = execute(config, build_modules(config), unit=unit, attributes=attributes)
     return context.frames_rendered, len(context.scene.camera)
 
 
 def _scene_keypoints(shard: Path) -> int:
     with h5py.File(shard, "r") as h5:
         return int(h5.attrs["scene_keypoints"])
+
+
+def check_existing(path: Path, policy: ResumePolicy, log: Callable[[str], None]) -> bool:
+    """Whether the output at ``path`` can be reused: True when it verifies and was made by this run's
+    fingerprint (or ``policy.force``); False when it is missing or damaged (it is rendered again); a
+    one-line InputError when it is intact but was made by something else."""
+    if not path.exists() and not path.is_symlink():
+        return False
+    problem = verify(path)
+    if problem is not None:
+        log(f"{path}: {problem}; rendering it again")
+        return False
+    with h5py.File(path, "r") as h5:
+        stored = parse_fingerprint(h5.attrs.get(FINGERPRINT_ATTR))
+    keys = differing_keys(stored, policy.fingerprint)
+    if not keys or policy.force:
+        return True
+    raise InputError(f"'{path}' was made by a different config or different inputs (differs: "
+                     f"{describe_difference(keys)}); rerun with --restart to discard the existing output, or "
+                     "--force-resume to keep it")
+
+
+def discard_outputs(plan: ShardingPlan) -> int:
+    """``--restart``: delete the plan's shards and index; returns how many files were removed."""
+    removed = 0
+    shards = plan.output_dir / SHARD_FOLDER
+    candidates = list(shards.glob("scene_*_chunk_*.hdf5")) if shards.is_dir() else []
+    for path in [*candidates, plan.output_dir / plan.file_name]:
+        if path.is_file() or path.is_symlink():
+            path.unlink()
+            removed += 1
+    return removed
 
 
 class _Local:
@@ -96,83 +163,148 @@ class _Local:
         try:
             future.set_result(self.task(unit))
         except BaseException as exc:  # surfaced by the scheduler
+            if isinstance(exc, (KeyboardInterrupt, SystemExit)):
+                raise
             future.set_exception(exc)
         return future
 
-    def shutdown(self) -> None:
+    def shutdown(self, interrupted: bool = False) -> None:
         pass
 
 
-class _Ray:
-    """Runs units as Ray tasks (each Ray worker process keeps its GL context and Mitsuba between tasks)."""
+class _Pool:
+    """A spawn-context process pool whose workers die with this process and are replaced after
+    ``max_tasks_per_child`` units."""
 
-    def __init__(self, path: str, args: Sequence[str], env: Mapping[str, str] | None, address: str | None,
-                 workers: int) -> None:
+    def __init__(self, call: tuple[Any, ...], workers: int, max_tasks_per_child: int) -> None:
+        threads = max(1, (os.cpu_count() or 1) // workers)
+        self.call = call
+        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"), initializer=limit_threads,
+                                        initargs=(threads, os.getpid()), max_tasks_per_child=max_tasks_per_child)
+
+    def submit(self, unit: WorkUnit) -> Future:
+        return self.pool.submit(run_unit, *self.call[:3], unit, self.call[3])
+
+    def shutdown(self, interrupted: bool = False) -> None:
+        if not interrupted:
+            self.pool.shutdown()
+            return
+        processes = list((self.pool._processes or {}).values())  # noqa: SLF001 - no public handle
+        for process in processes:
+            if process.is_alive():
+                process.terminate()
+        for process in processes:
+            process.join(timeout=10)
+            if process.is_alive():
+                process.kill()
+                process.join(timeout=5)
+        self.pool.shutdown(wait=False, cancel_futures=True)
+
+
+def _check_reachable(address: str) -> None:
+    """One line instead of a hang when a Ray address (``host:port`` or ``ray://host:port``) answers nothing."""
+    if address in ("auto", "local"):
+        return
+    hostport = address.split("://", 1)[-1].rsplit("/", 1)[0]
+    host, _, port = hostport.rpartition(":")
+    if not host or not port.isdigit():
+        raise InputError(f"--address must be host:port or ray://host:port, got {address!r}")
+    try:
+        socket.create_connection((host, int(port)), timeout=RAY_CONNECT_TIMEOUT_S).close()
+    except OSError as exc:
+        raise InputError(f"cannot reach the Ray cluster at {address} within {RAY_CONNECT_TIMEOUT_S:.0f} s: "
+                         f"{exc.strerror or exc}") from None
+
+
+class _Ray:
+    """Runs units as Ray tasks (each Ray worker process keeps its GL context and Mitsuba between tasks).
+    A local cluster started here binds 127.0.0.1 only and is stopped with the run."""
+
+    def __init__(self, call: tuple[Any, ...], address: str | None, workers: int) -> None:
         try:
             import ray
         except ImportError:
             raise SystemSetupError("--executor ray needs Ray: `.venv/bin/pip install 'ray[default]'`") from None
         self.ray = ray
+        self.started = False
         if not ray.is_initialized():
             threads = str(max(1, (os.cpu_count() or 1) // workers))
-            ray.init(address=address, num_cpus=None if address else workers, include_dashboard=False,
-                     log_to_driver=False,
-                     runtime_env={"env_vars": {"LP_NUM_THREADS": threads, "HYBRIDGEN_THREADS": threads}})
+            runtime_env = {"env_vars": {"LP_NUM_THREADS": threads, "HYBRIDGEN_THREADS": threads}}
+            if address:
+                _check_reachable(address)
+                ray.init(address=address, include_dashboard=False, log_to_driver=False, runtime_env=runtime_env)
+            else:
+                ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False, runtime_env=runtime_env,
+                         _node_ip_address="127.0.0.1")
+            self.started = True
         self.remote = ray.remote(run_unit)
-        self.call = (path, list(args), dict(env) if env is not None else None)
+        self.call = call
 
     def submit(self, unit: WorkUnit) -> Future:
-        return self.remote.remote(*self.call, unit).future()
+        return self.remote.remote(*self.call[:3], unit, self.call[3]).future()
 
-    def shutdown(self) -> None:
-        pass
+    def shutdown(self, interrupted: bool = False) -> None:
+        if self.started:
+            self.ray.shutdown()
+
+
+def _scene_units(scenes: int, index: int, count: int, chunk_size: int) -> Iterator[WorkUnit]:
+    for scene in range(index, scenes, count):
+        yield WorkUnit(scene, 0, chunk_size)
 
 
 def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: Mapping[str, str] | None, *,
                 workers: int, shard: tuple[int, int] | None, executor: str, address: str | None,
-                log: Callable[[str], None], start: float) -> Any:
+                log: Callable[[str], None], start: float, policy: ResumePolicy,
+                max_tasks_per_child: int = DEFAULT_MAX_TASKS_PER_CHILD) -> Any:
     """Execute the plan's missing units, then build the index when all exist. Returns a RunSummary."""
     from .pipeline import RunSummary
 
     if executor not in EXECUTORS:
         raise InputError(f"executor must be one of {EXECUTORS}, got {executor!r}")
-    if workers < 1:
-        raise InputError(f"--workers must be >= 1, got {workers}")
+    if max_tasks_per_child < 1:
+        raise InputError(f"--max-tasks-per-child must be >= 1, got {max_tasks_per_child}")
     index, count = shard or (0, 1)
     if not 0 <= index < count:
         raise InputError(f"--shard i/N needs 0 <= i < N, got {index}/{count}")
-    (plan.output_dir / "shards").mkdir(parents=True, exist_ok=True)
-    path = str(path)
+    prepare_output_dir(plan.output_dir / SHARD_FOLDER)
+    if policy.restart:
+        removed = discard_outputs(plan)
+        if removed:
+            log(f"--restart: discarded {removed} existing file(s)")
+    call = (str(path), list(args), dict(env) if env is not None else None, policy.fingerprint_text)
     if executor == "ray":
-        pool: Any = _Ray(path, args, env, address, workers)
+        pool: Any = _Ray(call, address, workers)
     elif workers == 1:
-        pool = _Local(lambda unit: run_unit(path, args, env, unit))
+        pool = _Local(lambda unit: run_unit(*call[:3], unit, call[3]))
     else:
-        threads = max(1, (os.cpu_count() or 1) // workers)
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"), initializer=limit_threads,
-                                   initargs=(threads,))
-    mine = [s for s in range(plan.scenes) if s % count == index]
+        pool = _Pool(call, workers, max_tasks_per_child)
+    scene_units = _scene_units(plan.scenes, index, count, plan.chunk_size)
+    ready: deque[WorkUnit] = deque()  # later chunks of scenes whose first chunk is known
     pending: dict[Future, WorkUnit] = {}
+    window = 2 * workers
     frames = skipped = 0
 
-    def schedule(unit: WorkUnit) -> None:
+    def expand(unit: WorkUnit, total: int) -> None:
+        ready.extend(WorkUnit(unit.scene, chunk, plan.chunk_size) for chunk in range(1, chunk_count(total, plan.chunk_size)))
+
+    def refill() -> None:
         nonlocal skipped
-        if unit.shard_path(plan.output_dir).exists():
-            skipped += 1
-            if unit.chunk == 0:
-                expand(unit.scene, _scene_keypoints(unit.shard_path(plan.output_dir)))
-            return
-        future = pool.submit(unit) if not isinstance(pool, ProcessPoolExecutor) else \
-            pool.submit(run_unit, path, list(args), dict(env) if env is not None else None, unit)
-        pending[future] = unit
+        while len(pending) < window:
+            unit = ready.popleft() if ready else next(scene_units, None)
+            if unit is None:
+                return
+            target = unit.shard_path(plan.output_dir)
+            if check_existing(target, policy, log):
+                skipped += 1
+                if unit.chunk == 0:
+                    expand(unit, _scene_keypoints(target))
+                continue
+            pending[pool.submit(unit)] = unit
 
-    def expand(scene: int, total: int) -> None:
-        for chunk in range(1, chunk_count(total, plan.chunk_size)):
-            schedule(WorkUnit(scene, chunk, plan.chunk_size))
-
+    interrupted = True
     try:
-        for scene in mine:
-            schedule(WorkUnit(scene, 0, plan.chunk_size))
+        refill()
         while pending:
             done, _ = wait(list(pending), return_when=FIRST_COMPLETED)
             for future in done:
@@ -181,19 +313,21 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
                 frames += rendered
                 log(f"unit {unit.name}: {rendered} keypoint(s)")
                 if unit.chunk == 0:
-                    expand(unit.scene, total)
+                    expand(unit, total)
+            refill()
+        interrupted = False
     finally:
-        pool.shutdown()
+        pool.shutdown(interrupted)
     outputs = []
     shards = complete_shards(plan)
     if shards is not None:
         from .shard_index import build_index
 
-        outputs.append(build_index(plan.output_dir / plan.file_name, shards))
+        outputs.append(build_index(plan.output_dir / plan.file_name, shards, policy.fingerprint_text))
     else:
         log(f"shard {index}/{count} done; data.hdf5 is built once every scene's units exist")
     if skipped:
-        log(f"resumed: {skipped} unit(s) were already complete")
+        log(f"resumed: {skipped} unit(s) were already complete and verified")
     return RunSummary(frames, time.perf_counter() - start, outputs)
 
 
@@ -202,11 +336,11 @@ def complete_shards(plan: ShardingPlan) -> list[Path] | None:
     shards = []
     for scene in range(plan.scenes):
         first = WorkUnit(scene, 0, plan.chunk_size).shard_path(plan.output_dir)
-        if not first.exists():
+        if not first.is_file():
             return None
         for chunk in range(chunk_count(_scene_keypoints(first), plan.chunk_size)):
             path = WorkUnit(scene, chunk, plan.chunk_size).shard_path(plan.output_dir)
-            if not path.exists():
+            if not path.is_file():
                 return None
             shards.append(path)
     return shards

@@ -10,16 +10,37 @@ so the same shards give the same bytes.
 """
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Any
 
 import h5py
 import numpy as np
 
+from ..errors import InputError
 from ..io.atomic import commit, temporary_path
+from ..io.integrity import DIGEST_ATTR, seal
+from .fingerprint import FINGERPRINT_ATTR
 
 SCENE_RECORDS = ("object_states", "light_states")
-UNIT_ATTRIBUTES = ("scene_index", "chunk_index", "scene_keypoints")
+UNIT_ATTRIBUTES = ("scene_index", "chunk_index", "scene_keypoints", FINGERPRINT_ATTR, DIGEST_ATTR)
+SHARD_DIGESTS_ATTR = "shard_digests"
+
+
+def _text(value: Any) -> str:
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def fill_value(dtype: Any) -> np.ndarray | None:
+    """What a virtual dataset reads where a source is missing: NaN for floats (never valid data), -1 for
+    signed integers (no valid id), nothing special for unsigned ones (every value is valid data: readers
+    must call :func:`check_index_sources`)."""
+    dtype = np.dtype(dtype)
+    if dtype.kind == "f":
+        return np.array(np.nan, dtype)
+    if dtype.kind == "i":
+        return np.array(-1, dtype)
+    return None
 
 
 def _virtual(h5: h5py.File, key: str, pieces: list[tuple[str, int, int, tuple[int, ...]]], dtype: Any,
@@ -28,6 +49,9 @@ def _virtual(h5: h5py.File, key: str, pieces: list[tuple[str, int, int, tuple[in
     total = sum(count for _, _, count, _ in pieces)
     dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
     dcpl.set_obj_track_times(False)
+    fill = fill_value(dtype)
+    if fill is not None:
+        dcpl.set_fill_value(fill)
     for filename, offset, count, source_shape in pieces:
         target = h5py.h5s.create_simple((total, *tail))
         target.select_hyperslab((offset,) + (0,) * len(tail), (count, *tail))
@@ -38,8 +62,10 @@ def _virtual(h5: h5py.File, key: str, pieces: list[tuple[str, int, int, tuple[in
                     dcpl=dcpl)
 
 
-def build_index(path: Path, shards: list[Path]) -> Path:
-    """Write ``path`` over ``shards`` (already in scene, chunk order); returns ``path``."""
+def build_index(path: Path, shards: list[Path], fingerprint: str | None = None) -> Path:
+    """Write ``path`` over ``shards`` (already in scene, chunk order); returns ``path``. The index records
+    each shard's ``content_sha256`` (attribute ``shard_digests``, JSON: relative path -> digest) and the
+    run's ``fingerprint``; it is sealed itself (:func:`hybridgen.io.integrity.seal`)."""
     opened = [h5py.File(shard, "r") for shard in shards]
     try:
         counts = [len(f["keypoint_index"]) for f in opened]
@@ -71,8 +97,77 @@ def build_index(path: Path, shards: list[Path]) -> Path:
                     index.attrs[key] = value
             index.attrs["number_of_scenes"] = len(first_chunks)
             index.attrs["layout"] = "sharded: virtual datasets over shards/*.hdf5"
+            digests = {str(Path(shard).relative_to(path.parent)): _text(f.attrs.get(DIGEST_ATTR, ""))
+                       for shard, f in zip(shards, opened)}
+            index.attrs[SHARD_DIGESTS_ATTR] = json.dumps(digests, sort_keys=True)
+            if fingerprint is not None:
+                index.attrs[FINGERPRINT_ATTR] = fingerprint
+            seal(index)
     finally:
         for f in opened:
             f.close()
     commit(temp, path)
     return path
+
+
+def virtual_sources(h5: h5py.File) -> list[str]:
+    """The distinct source file names (as stored, relative to the index's folder) of ``h5``'s virtual datasets."""
+    names: dict[str, None] = {}
+    for key in h5:
+        dset = h5[key]
+        if isinstance(dset, h5py.Dataset) and dset.is_virtual:
+            for source in dset.virtual_sources():
+                names.setdefault(source.file_name, None)
+    return list(names)
+
+
+def check_index_sources(path: str | Path, h5: h5py.File | None = None, *, deep: bool = False) -> None:
+    """Raise one-line :class:`InputError` unless every shard the index at ``path`` reads from exists, opens
+    and carries the ``content_sha256`` the index recorded when it was built (``deep``: also recompute each
+    shard's digest, reading all of it). Files without virtual datasets pass at once.
+
+    For readers of HDF5 outputs (``vis``, ``extract``, :mod:`hybridgen.data`): call it right after opening a
+    file (pass the open ``h5`` to avoid reopening); virtual datasets over missing shards would otherwise
+    read fill values without any error.
+    """
+    from ..io.integrity import verify
+
+    path = Path(path)
+    own = h5 is None
+    handle = h5py.File(path, "r") if own else h5
+    try:
+        sources = virtual_sources(handle)
+        if not sources:
+            return
+        recorded = json.loads(_text(handle.attrs[SHARD_DIGESTS_ATTR])) if SHARD_DIGESTS_ATTR in handle.attrs else {}
+    finally:
+        if own:
+            handle.close()
+    missing, replaced = [], []
+    for name in sources:
+        source = path.parent / name
+        if not source.is_file():
+            missing.append(name)
+            continue
+        try:
+            with h5py.File(source, "r") as shard:
+                digest = _text(shard.attrs.get(DIGEST_ATTR, ""))
+        except OSError:
+            replaced.append(name)
+            continue
+        expected = recorded.get(name)
+        if (expected is not None and digest != expected) or (deep and verify(source) is not None):
+            replaced.append(name)
+    if missing or replaced:
+        parts = []
+        if missing:
+            parts.append(f"{len(missing)} missing ({_some(missing)})")
+        if replaced:
+            parts.append(f"{len(replaced)} unreadable or not the ones it was built over ({_some(replaced)})")
+        raise InputError(f"'{path}' is an index over {len(sources)} shard file(s) beside it and "
+                         f"{' and '.join(parts)}; copy the whole output folder (with shards/) or rerun the "
+                         "config to complete it")
+
+
+def _some(names: list[str], limit: int = 3) -> str:
+    return ", ".join(names[:limit]) + (f" and {len(names) - limit} more" if len(names) > limit else "")
