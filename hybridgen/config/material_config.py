@@ -7,6 +7,7 @@ from typing import Any
 
 from ..errors import ConfigError
 from ..scene.material import Material
+from .paths import locate_input
 from .schema import closest
 
 _UNIT_KEYS = ("roughness", "metallic", "specular", "transmission", "alpha")
@@ -55,5 +56,5 @@ def apply_material_config(material: Material, config: dict[str, Any]) -> Materia
         else:
             if not isinstance(value, str) or not value:
                 raise ConfigError(f"must be a non-empty string, got {value!r}", key=f"material.{key}")
-            values[key] = value
+            values[key] = locate_input(value) if key == "base_color_texture" else value
     return dataclasses.replace(material, **values)

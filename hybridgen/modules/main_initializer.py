@@ -25,7 +25,7 @@ class Initializer(Module):
               check=_color_check),
         Param("world_strength", "float", 1.0, doc="multiplies the world background (color or HDRI)",
               check=lambda v: None if v >= 0 else "must be >= 0"),
-        Param("hdri_path", "path|null", None, doc="HDR environment map (.exr/.hdr) lighting the scene"),
+        Param("hdri_path", "path|null", None, doc="HDRI file (.exr/.hdr): the environment map lighting the scene"),
         Param("hdri_rotation", "float", 0.0, "rad", "rotation of the environment map about world +Z"),
         Param("number_of_scenes", "int", 1, doc="scene variations: every module runs once per scene, each scene "
               "with its own seed (SeedSequence(seed).spawn); more than 1 writes shards (see README)",

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..config.paths import resolve_input
 from ..config.registry import register_module
 from ..config.schema import Param, positive
 from ..errors import InputError
@@ -78,7 +79,8 @@ class ObjectSwapper(SelectingModule):
         """(candidates, the scene objects among them)."""
         candidates: list[MeshObject] = []
         for index, entry in enumerate(self.config["pool"]):
-            objects = load_objects(entry["path"], name=entry.get("name"), category_id=entry.get("category_id"),
+            path = resolve_input(entry["path"], f"pool[{index}].path", noun="mesh file")
+            objects = load_objects(path, name=entry.get("name"), category_id=entry.get("category_id"),
                                    up_axis=entry.get("up_axis", "auto"), attributes=entry.get("attributes"))
             if len(objects) != 1:
                 raise InputError(f"pool[{index}] '{entry['path']}' has {len(objects)} parts; the swapper replaces "

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence
 
 from ..config.config_file import ConfigFile, load_config
+from ..config.paths import config_folder, resolve_module_paths
 from ..config.registry import get_module
 from ..config.schema import validate_config
 from ..errors import ConfigError, HybridgenError, InputError
@@ -77,15 +78,17 @@ def execute(config: ConfigFile, modules: list[Module], *, unit: WorkUnit | None 
     if log is not None:
         context.log = log
     try:
-        for phase in ("prepare", "run"):
-            for module in modules:
-                try:
-                    getattr(module, phase)(context)
-                except ConfigError as exc:
-                    raise exc.located(file=config.path, module=module.module_name, index=module.index) from None
-                except HybridgenError as exc:
-                    raise type(exc)(f"{config.path}: module '{module.module_name}' (#{module.index}): {exc}") \
-                        from None
+        with config_folder(config.path):  # relative input paths fall back to the config's folder
+            for phase in ("prepare", "run"):
+                for module in modules:
+                    try:
+                        getattr(module, phase)(context)
+                    except ConfigError as exc:
+                        raise exc.located(file=config.path, module=module.module_name, index=module.index) \
+                            from None
+                    except HybridgenError as exc:
+                        raise type(exc)(f"{config.path}: module '{module.module_name}' (#{module.index}): {exc}") \
+                            from None
     finally:
         for cleanup in reversed(context.cleanups):
             cleanup()

@@ -2,12 +2,12 @@
 (ShellSampler, DiskSampler), radians for rotations (UniformSO3 returns Blender XYZ Euler angles); metres."""
 from __future__ import annotations
 
-import glob as globmod
 import math
 from typing import Any, Sequence
 
 import numpy as np
 
+from ..config.paths import describe_glob_miss, glob_inputs
 from .registry import DrawContext, register_sampler
 
 
@@ -190,8 +190,9 @@ def color(ctx: DrawContext, min: Sequence[float] = (0, 0, 0, 1), max: Sequence[f
 
 @register_sampler("sampler.Path", "PathSampler")
 def path(ctx: DrawContext, path: str) -> str:
-    """A random file among those matching the glob ``path`` (sorted, so the draw is reproducible)."""
-    matches = sorted(globmod.glob(path, recursive=True))
+    """A random file among those matching the glob ``path`` (sorted, so the draw is reproducible), relative
+    to the working directory or, when nothing matches there, to the config's folder."""
+    matches = glob_inputs(path)  # from the working directory, else the config's folder
     if not matches:
-        raise ValueError(f"no file matches {path!r}")
+        raise ValueError(describe_glob_miss(path))
     return matches[int(ctx.rng.integers(len(matches)))]
