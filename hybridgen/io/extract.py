@@ -32,7 +32,9 @@ import numpy as np
 
 from ..errors import InputError
 from ..render.tonemap import to_srgb8
+from ..run.shard_index import check_index_sources
 from .atomic import prepare_output_dir
+from .integrity import DIGEST_ATTR, verify
 from .image_files import json_bytes, npy_bytes, png_bytes, write_exr_file, write_file
 
 FORMATS = ("png", "npy", "exr")
@@ -149,11 +151,17 @@ def _open(path: Path) -> h5py.File:
     if path.is_dir():
         raise InputError(f"'{path}' is a directory, not an HDF5 file")
     try:
-        return h5py.File(path, "r")
+        h5 = h5py.File(path, "r")
     except FileNotFoundError:
         raise InputError(f"'{path}' does not exist") from None
     except OSError as exc:
-        raise InputError(f"cannot open '{path}' as HDF5: {exc}") from None
+        raise InputError(f"cannot open '{path}' as HDF5: {str(exc).splitlines()[0] if str(exc) else exc}") from None
+    try:
+        check_index_sources(path, h5)  # a sharded index over missing shards would read fill values
+    except BaseException:
+        h5.close()
+        raise
+    return h5
 
 
 def extract(files: Sequence[str | Path], output_dir: str | Path, keys: Sequence[str] | None = None,
@@ -172,6 +180,10 @@ def extract(files: Sequence[str | Path], output_dir: str | Path, keys: Sequence[
     for path in paths:
         with _open(path) as h5:
             source = inspect(path, h5)
+            sealed = DIGEST_ATTR in h5.attrs
+        problem = verify(path) if sealed else None  # a damaged chunk fails here, before any file is written
+        if problem is not None:
+            raise InputError(f"'{path}': {problem}")
         chosen = list(keys) if keys else source.images
         missing = [k for k in chosen if k not in source.keys]
         if missing:
