@@ -15,7 +15,6 @@ import contextlib
 import contextvars
 import glob
 import os
-import re
 from pathlib import Path
 from typing import Iterable, Iterator
 
@@ -88,15 +87,25 @@ def describe_glob_miss(pattern: str, config_path: str | Path | None = None) -> s
     return f"no file matches '{pattern}' (tried {' and '.join(places)})"
 
 
+def not_found(noun: str, value: str | Path) -> str:
+    """``"<noun> not found: '<value>'"``, plus both places tried when a config run looked in its folder too."""
+    text = f"{noun} not found: '{value}'"
+    folder = _CONFIG_FOLDER.get()
+    if folder is None or os.path.isabs(value):
+        return text
+    return (f"{text} (tried {Path.cwd() / value} from the working directory and {folder / value} from the "
+            "config's folder)")
+
+
 def resolve_module_paths(params: Iterable[Param], values: dict[str, object], config_path: str | Path) -> None:
     """Resolve, in place, every input path parameter of one module's validated ``values``.
 
     Parameters typed ``path`` (alone or in a union), other than :data:`OUTPUT_KEYS`, holding a string are
-    inputs. A missing file's error begins with the noun its doc starts with ("mesh file not found: ...").
+    inputs. One found in neither place stays as given: the code reading it reports it with :func:`not_found`
+    (after its own checks, such as the file format).
     """
     for param in params:
         value = values.get(param.name)
         if param.name in OUTPUT_KEYS or "path" not in param.type.split("|") or not isinstance(value, str):
             continue
-        noun = re.match(r"\s*((?:[\w-]+ ){0,2}file)\b", param.doc)
-        values[param.name] = resolve_input(value, param.name, config_path, noun.group(1) if noun else "file")
+        values[param.name] = locate_input(value, config_path)

@@ -25,6 +25,7 @@ from typing import Any, Callable, Iterable, Sequence
 
 import numpy as np
 
+from ..config.paths import not_found
 from ..errors import InputError
 from ..scene.frames import euler_xyz_to_matrix, make_pose
 from ..scene.material import Material
@@ -154,7 +155,7 @@ def load_objects(path: str | Path, *, name: str | None = None, category_id: int 
     if suffix not in LOADERS:
         raise InputError(f"mesh '{file}': unsupported format '{suffix}'; supported: {', '.join(LOADERS)}")
     if not file.is_file():
-        raise InputError(f"mesh file not found: '{file}'")
+        raise InputError(not_found("mesh file", file))
     file_type, native_up = LOADERS[suffix]
     up = native_up if up_axis == "auto" else str(up_axis).upper()
     if up not in ("Y", "Z"):

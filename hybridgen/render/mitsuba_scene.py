@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from ..config.paths import not_found
 from ..errors import InputError
 from ..scene.light import Light
 from ..scene.material import Material
@@ -43,7 +44,7 @@ def _texture(material: Material, owner: str) -> dict[str, Any]:
     if isinstance(texture, (str, Path)):
         path = Path(texture)
         if not path.is_file():
-            raise InputError(f"object '{owner}': texture file not found: '{path}'")
+            raise InputError(f"object '{owner}': {not_found('texture file', path)}")
         return {"type": "bitmap", "filename": str(path)}
     array = np.ascontiguousarray(np.asarray(texture)[..., :3])
     if array.dtype != np.uint8 or array.ndim != 3:
@@ -179,7 +180,7 @@ def world_dict(world: World) -> dict[str, Any]:
     if world.hdri_path:
         path = Path(world.hdri_path)
         if not path.is_file():
-            raise InputError(f"HDRI file not found: '{path}'")
+            raise InputError(not_found("HDRI file", path))
         rotation = np.eye(4)
         c, s = math.cos(world.hdri_rotation), math.sin(world.hdri_rotation)
         rotation[:2, :2] = [[c, -s], [s, c]]

@@ -76,9 +76,9 @@ def test_missing_file_names_both_places(tmp_path, run_cli, monkeypatch):
     assert code == 2
     line = err.strip()
     assert "\n" not in line and "mesh file not found: 'assets/block.ply'" in line
-    assert "module 'loader.ObjLoader'" in line and "key 'path'" in line
+    assert "module 'loader.ObjLoader'" in line
     assert str(tmp_path / "assets" / "block.ply") in line and str(project / "assets" / "block.ply") in line
-    assert not (tmp_path / "out").exists()
+    assert not (tmp_path / "out" / "data.hdf5").exists()
 
 
 def test_shipped_configs_resolve_from_any_working_directory(tmp_path, monkeypatch):
@@ -111,8 +111,12 @@ def test_path_sampler_globs_beside_the_config(tmp_path, monkeypatch):
         path(ctx, "textures/*.png")
 
 
-def test_build_error_is_a_config_error(tmp_path, monkeypatch):
-    (tmp_path / "scene.yaml").write_text(CONFIG)
+def test_missing_texture_names_both_places(tmp_path, monkeypatch):
+    from hybridgen.config.paths import config_folder, not_found
+
     monkeypatch.chdir(tmp_path)
-    with pytest.raises(ConfigError, match="from the config's folder"):
-        build_modules(load_config(tmp_path / "scene.yaml", ["out"]))
+    assert not_found("texture file", "t/wood.png") == "texture file not found: 't/wood.png'"  # Python API: as given
+    with config_folder(tmp_path / "project" / "scene.yaml"):
+        message = not_found("texture file", "t/wood.png")
+    assert message == (f"texture file not found: 't/wood.png' (tried {tmp_path}/t/wood.png from the working "
+                       f"directory and {tmp_path}/project/t/wood.png from the config's folder)")
