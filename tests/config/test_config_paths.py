@@ -26,7 +26,7 @@ modules:
       intrinsics: {resolution_x: 32, resolution_y: 24, fov: 0.8}
       cam_poses: [{location: [0, 0, 5], rotation: {format: look_at, value: [0, 0, 0]}}]
   - name: renderer.SegMapRenderer
-    config: {map_by: [class]}
+    config: {map_by: [class], render_depth: true}
   - name: writer.Hdf5Writer
 """
 
