@@ -69,6 +69,18 @@ def _cmd_vis(ns: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_gallery(ns: argparse.Namespace) -> int:
+    from .io.gallery import build_gallery
+
+    page = build_gallery(ns.output, keys=ns.keys, limit=ns.limit)
+    print(f"hybridgen: gallery written to {page}")
+    if ns.open:
+        import webbrowser
+
+        webbrowser.open(page.resolve().as_uri())
+    return 0
+
+
 def _cmd_extract(ns: argparse.Namespace) -> int:
     from .io.extract import extract
 
@@ -108,6 +120,13 @@ def build_parser() -> argparse.ArgumentParser:
     vis.add_argument("--keys", nargs="+", help="keys to show (default: every image key)")
     vis.add_argument("--save", required=True, help="folder for the PNG files")
     vis.set_defaults(func=_cmd_vis)
+    gallery = sub.add_parser("gallery", help="write a static HTML page of an output folder (OUT/gallery/index.html): "
+                             "thumbnails of every pass, legends, click to enlarge, scene/keypoint filters")
+    gallery.add_argument("output", help="output folder (data.hdf5 or BlenderProc <i>.hdf5 files) or HDF5 file")
+    gallery.add_argument("--open", action="store_true", help="open the page in the default web browser")
+    gallery.add_argument("--keys", nargs="+", help="passes to show (default: every image key)")
+    gallery.add_argument("--limit", type=int, help="show only the first N keypoints")
+    gallery.set_defaults(func=_cmd_gallery)
     ext = sub.add_parser("extract", help="write each keypoint's keys of HDF5 outputs as PNG / 16-bit PNG / EXR / npy "
                          "files (depth and distance PNGs in mm)")
     ext.add_argument("files", nargs="+", help="HDF5 files (single-file or BlenderProc <i>.hdf5 layout)")
