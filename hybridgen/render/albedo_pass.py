@@ -96,5 +96,8 @@ class AlbedoPass:
         for resource in self._resources:
             resource.release()
         self._resources = []
+        if self.program is not None:
+            self.program.release()
+            self.program = None
         if self._fbo is not None:
             self._fbo.release()
