@@ -64,6 +64,7 @@ class SingleFileLayout:
             self.keys = [k for k, d in h5.items() if isinstance(d, h5py.Dataset) and d.ndim >= 1
                          and d.shape[0] == self.count and k not in SCENE_RECORDS + POSITION_KEYS]
             self.text_keys = {k for k in self.keys if h5py.check_string_dtype(h5[k].dtype) is not None}
+            self.encoded = {k for k in self.keys if "encoding" in h5[k].attrs}  # compact storage, decoded on read
             self.scene_keys = [k for k in SCENE_RECORDS if k in h5]
             self.attributes = {k: decode_attribute(v) for k, v in h5.attrs.items()}
             scenes = [int(s) for s in np.unique(h5["scene_index"][()])] if self.sharded else [0]
@@ -97,6 +98,10 @@ class SingleFileLayout:
                 item[key] = decode_text(dset[self.scene_slot[scene]] if dset.ndim else dset[()])
             elif key in self.text_keys:
                 item[key] = decode_text(h5[key][index])
+            elif key in self.encoded:
+                from ..io.label_encoding import decode_dataset
+
+                item[key] = decode_dataset(h5[key], index)
             else:
                 item[key] = h5[key][index]
         item["scene_index"], item["keypoint_index"] = scene, keypoint

@@ -83,6 +83,8 @@ def build_index(path: Path, shards: list[Path], fingerprint: str | None = None) 
                 pieces = [(str(Path(shard).relative_to(path.parent)), int(offsets[i]), counts[i], f[key].shape)
                           for i, (shard, f) in enumerate(zip(shards, opened))]
                 _virtual(index, key, pieces, first.dtype, first.shape[1:])
+                for name, value in first.attrs.items():  # how the pass is stored (encoding), read by decoders
+                    index[key].attrs[name] = value
             scenes = np.concatenate([[f.attrs["scene_index"]] * c for f, c in zip(opened, counts)]).astype(np.int64)
             index.create_dataset("scene_index", data=scenes, track_times=False)
             first_chunks = {}

@@ -32,7 +32,10 @@ def _assert_equal(a: dict, b: dict, keys) -> None:
         value = a[key].numpy() if hasattr(a[key], "numpy") else a[key]  # a DataLoader gives tensors
         if isinstance(value, np.ndarray):
             assert value.dtype == b[key].dtype, key
-            np.testing.assert_array_equal(value, b[key], err_msg=f"{key} of {_key(a)}")
+            if key == "normals":  # a written file may hold them as octahedral codes (error < 1e-4 rad)
+                np.testing.assert_allclose(value, b[key], atol=2e-4, err_msg=f"{key} of {_key(a)}")
+            else:
+                np.testing.assert_array_equal(value, b[key], err_msg=f"{key} of {_key(a)}")
         else:
             assert value == b[key], key
 

@@ -37,10 +37,11 @@ def _run(tmp_path: Path, name: str, **options) -> tuple[Path, Path]:
     return config, out
 
 
-def _assert_same_sample(got: dict, expected: dict, *, normals_atol: float = 0.0) -> None:
+def _assert_same_sample(got: dict, expected: dict, *, normals_atol: float = 2e-4) -> None:
+    """Exact, but for normals: the single file may store them as octahedral codes (error < 1e-4 rad)."""
     for key, (dtype, shape) in DOCUMENTED.items():
         assert got[key].dtype == dtype and got[key].shape == shape, (key, got[key].dtype, got[key].shape)
-        if key == "normals" and normals_atol:
+        if key == "normals":
             np.testing.assert_allclose(got[key], expected[key], atol=normals_atol, err_msg=key)
         elif key == "cam2world":
             np.testing.assert_allclose(got[key], expected[key], atol=1e-12, err_msg=key)
