@@ -28,6 +28,7 @@ demo: setup
 	@echo "preview images: output/quickstart/preview/"
 
 test: setup
+	@bash tools/install_system_deps.sh --test
 	$(BIN)/python -m pytest -q
 
 bench: setup
