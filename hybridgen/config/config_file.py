@@ -11,6 +11,7 @@ import yaml
 from ..errors import ConfigError
 from .placeholders import resolve_placeholders
 from .schema import closest
+from .yaml_safety import MAX_CONFIG_BYTES, load_yaml, read_limited
 
 TOP_LEVEL_KEYS = ("setup", "global", "modules", "version")
 
@@ -59,13 +60,13 @@ def load_config(path: str | Path, args: Sequence[str] = (), env: Mapping[str, st
     """Parse ``path``, check its shape, resolve placeholders and the ``setup.pip`` requirements."""
     file = str(path)
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        text = read_limited(path, MAX_CONFIG_BYTES, "config file").decode("utf-8")
     except FileNotFoundError:
         raise ConfigError("config file not found", file=file) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError(f"cannot read config file: {exc}", file=file) from None
     try:
-        raw = yaml.load(text, Loader=_StrictLoader)  # noqa: S506 - a SafeLoader subclass
+        raw = load_yaml(text, _StrictLoader, file)  # bounded depth and alias expansion (yaml_safety)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""

@@ -18,7 +18,7 @@ class Initializer(Module):
 
     params = (
         Param("seed", "int", DEFAULT_SEED, doc="root seed; same config + seed = same bytes",
-              check=lambda v: None if v >= 0 else "must be >= 0"),
+              check=lambda v: None if 0 <= v < 2**63 else f"must be in [0, 2**63) (stored as int64), got {v}"),
         Param("default_category_id", "int|null", None,
               doc="category_id for objects that have none (otherwise class segmentation fails naming them)"),
         Param("horizon_color", "list", [0.05, 0.05, 0.05], doc="world background radiance, linear RGB",

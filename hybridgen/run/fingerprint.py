@@ -9,7 +9,8 @@ writes. Its keys are
   what it writes, so a moved output folder still resumes;
 - ``input:<path>`` -> SHA-256 of each file the config names (a string value that is an existing file, or
   a glob that matches files, or the files directly in a named folder; relative to the working directory,
-  else to the config's folder, as modules read them), plus the MTL files an OBJ names and the texture files an MTL names.
+  else to the config's folder, as modules read them), plus the MTL files an OBJ names and the texture
+  files an MTL names.
 
 :func:`differing_keys` names what changed between two fingerprints, so a refused resume says which
 config keys or input files differ.

@@ -286,7 +286,8 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
     frames = skipped = 0
 
     def expand(unit: WorkUnit, total: int) -> None:
-        ready.extend(WorkUnit(unit.scene, chunk, plan.chunk_size) for chunk in range(1, chunk_count(total, plan.chunk_size)))
+        chunks = range(1, chunk_count(total, plan.chunk_size))
+        ready.extend(WorkUnit(unit.scene, chunk, plan.chunk_size) for chunk in chunks)
 
     def refill() -> None:
         nonlocal skipped
