@@ -1,19 +1,49 @@
-"""Command line: ``hybridgen run CONFIG [ARGS...]``, ``modules [NAME]``, ``vis FILE... --save DIR``,
-``extract FILE... --output_dir DIR``, ``--version``.
+"""The ``hybridgen`` command line.
 
-User errors (config, input, missing system libraries) print one line to stderr and exit with status 2;
-``--debug`` shows the traceback instead.
+Commands: ``run`` (a config), ``modules`` (what a config may use; ``--schema`` for editors), ``vis``
+(contact sheets), ``gallery`` (an HTML page of an output), ``extract`` (image/array files). Global options
+(``--debug``, ``-v``, ``-q``, ``--json``) go before or after the command.
+
+Messages go through :mod:`logging` (logger ``hybridgen``, see :mod:`hybridgen.logs`). User errors (config,
+input, missing system libraries) are one line on stderr and exit status 2; ``--debug`` shows the
+traceback instead. With ``--json`` the last line on stdout is one JSON object summarising the command
+(``"status": "ok"`` or ``"error"``), for schedulers and scripts.
 """
 from __future__ import annotations
 
 import argparse
+import json
 import sys
+import time
+from pathlib import Path
 from typing import Any, Sequence
 
 from ._version import __version__
 from .errors import HybridgenError, InputError
+from .logs import LOGGER, configure, level_for, log_line
 
 EXIT_USER_ERROR = 2
+EXIT_INTERRUPTED = 130
+
+DESCRIPTION = """\
+hybridgen generates synthetic training data: path-traced color (Mitsuba 3) and exact rasterized labels
+(depth, distance, normals, segmentation, ...) for the camera keypoints of scenes built by a YAML config in
+BlenderProc's format. Conventions: docs/conventions.md in the repository."""
+
+EPILOG = """\
+examples:
+  hybridgen run configs/quickstart.yaml output/quickstart      render a config (<args:0> = output folder)
+  hybridgen run CONFIG OUT --workers 4 --json                  in parallel, one JSON summary line at the end
+  hybridgen modules loader.ObjLoader                           one module's parameters
+  hybridgen modules --schema config.schema.json                a JSON Schema for editors
+  hybridgen vis output/quickstart/data.hdf5 --save preview/    contact sheets
+  hybridgen gallery output/quickstart --open                   an HTML page of every pass
+
+Errors print one line naming file, module and key and exit with status 2 (--debug: the traceback)."""
+
+
+class _HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """Keeps the description's and epilog's own line breaks; wraps option help at the terminal width."""
 
 
 def _progress_factory(enabled: bool) -> Any:
@@ -28,82 +58,140 @@ def _progress_factory(enabled: bool) -> Any:
     return make
 
 
-def _cmd_run(ns: argparse.Namespace) -> int:
+def _say(ns: argparse.Namespace, text: str) -> None:
+    """A command's result line: on stdout, or (with ``--json``, whose stdout is the JSON line) logged."""
+    if ns.json:
+        LOGGER.info(text)
+    else:
+        print(f"hybridgen: {text}", flush=True)
+
+
+def _parse_shard(text: str | None) -> tuple[int, int] | None:
+    if not text:
+        return None
+    try:
+        index, count = (int(v) for v in text.split("/"))
+    except ValueError:
+        raise InputError(f"--shard takes i/N (e.g. 0/4), got {text!r}") from None
+    return index, count
+
+
+def _cmd_run(ns: argparse.Namespace) -> dict[str, Any]:
     from .run.pipeline import run_config
 
-    log = None if ns.quiet else (lambda message: print(f"hybridgen: {message}", file=sys.stderr, flush=True))
-    shard = None
-    if ns.shard:
-        try:
-            index, count = (int(v) for v in ns.shard.split("/"))
-        except ValueError:
-            raise InputError(f"--shard takes i/N (e.g. 0/4), got {ns.shard!r}") from None
-        shard = (index, count)
-    summary = run_config(ns.config, ns.args, progress=_progress_factory(not ns.quiet), log=log, workers=ns.workers,
-                         shard=shard, executor=ns.executor, address=ns.address, restart=ns.restart,
-                         force_resume=ns.force_resume, max_tasks_per_child=ns.max_tasks_per_child)
+    summary = run_config(ns.config, ns.args, progress=_progress_factory(not ns.quiet), log=log_line,
+                         workers=ns.workers, shard=_parse_shard(ns.shard), executor=ns.executor,
+                         address=ns.address, restart=ns.restart, force_resume=ns.force_resume,
+                         max_tasks_per_child=ns.max_tasks_per_child)
     outputs = ", ".join(str(p) for p in summary.outputs) or "(no output file)"
     rate = summary.frames / summary.seconds if summary.seconds > 0 else 0.0
-    print(f"hybridgen: {summary.frames} keypoint(s) in {summary.seconds:.2f} s ({rate:.1f}/s) -> {outputs}")
-    return 0
+    _say(ns, f"{summary.frames} keypoint(s) in {summary.seconds:.2f} s ({rate:.1f}/s) -> {outputs}")
+    return {"config": str(ns.config), "args": list(ns.args), "keypoints": summary.frames,
+            "seconds": round(summary.seconds, 3), "keypoints_per_second": round(rate, 3),
+            "outputs": [str(p) for p in summary.outputs]}
 
 
-def _cmd_modules(ns: argparse.Namespace) -> int:
+def _cmd_modules(ns: argparse.Namespace) -> dict[str, Any]:
+    from .config.module_listing import describe_modules, describe_samplers, module_records
     from .config.registry import all_modules, get_module
 
+    if ns.schema is not None:
+        return _write_schema(ns)
     modules = {ns.name: get_module(ns.name)} if ns.name else all_modules()
-    for name, cls in modules.items():
-        doc = (cls.__doc__ or "").strip().splitlines()[0] if cls.__doc__ else ""
-        print(f"{name}: {doc}")
-        for param in cls.params:
-            print(f"    {param.describe()}")
-        print()
-    return 0
+    if not ns.json:
+        print(describe_modules(modules))
+        if not ns.name:
+            print(describe_samplers())
+    return {"modules": module_records(modules)}
 
 
-def _cmd_vis(ns: argparse.Namespace) -> int:
+def _write_schema(ns: argparse.Namespace) -> dict[str, Any]:
+    from .config.json_schema import config_schema
+    from .io.atomic import commit, temporary_path
+
+    text = json.dumps(config_schema(), indent=1) + "\n"
+    if ns.schema == "-":
+        sys.stdout.write(text)
+        return {"schema": "-"}
+    target = Path(ns.schema)
+    if target.parent != Path("") and not target.parent.is_dir():
+        raise InputError(f"--schema: folder '{target.parent}' does not exist")
+    temp = temporary_path(target)
+    temp.write_text(text)
+    commit(temp, target)
+    _say(ns, f"JSON Schema of the config format written to {target}")
+    return {"schema": str(target)}
+
+
+def _cmd_vis(ns: argparse.Namespace) -> dict[str, Any]:
     from .io.visualize import save_contact_sheets
 
     written = save_contact_sheets(ns.files, ns.save, ns.keys)
-    print(f"hybridgen: wrote {len(written)} contact sheet(s) to {ns.save}")
-    return 0
+    _say(ns, f"wrote {len(written)} contact sheet(s) to {ns.save}")
+    return {"files": [str(p) for p in written]}
 
 
-def _cmd_gallery(ns: argparse.Namespace) -> int:
+def _cmd_gallery(ns: argparse.Namespace) -> dict[str, Any]:
     from .io.gallery import build_gallery
 
     page = build_gallery(ns.output, keys=ns.keys, limit=ns.limit)
-    print(f"hybridgen: gallery written to {page}")
+    _say(ns, f"gallery written to {page}")
     if ns.open:
         import webbrowser
 
         webbrowser.open(page.resolve().as_uri())
-    return 0
+    return {"page": str(page)}
 
 
-def _cmd_extract(ns: argparse.Namespace) -> int:
+def _cmd_extract(ns: argparse.Namespace) -> dict[str, Any]:
     from .io.extract import extract
 
     result = extract(ns.files, ns.output_dir, ns.keys, ns.format, ns.depth_scale)
     for note in result.notes:
-        print(f"hybridgen: note: {note}", file=sys.stderr)
-    print(f"hybridgen: wrote {len(result.files)} file(s) to {ns.output_dir}")
-    return 0
+        LOGGER.warning("note: %s", note)
+    _say(ns, f"wrote {len(result.files)} file(s) to {ns.output_dir}")
+    return {"files": [str(p) for p in result.files]}
+
+
+def _add_global_options(parser: argparse.ArgumentParser, *, in_command: bool) -> None:
+    """``--debug -v -q --json``; inside a command they default to 'not given' so that the values given
+    before the command stay (``hybridgen --debug run ...`` and ``hybridgen run ... --debug`` are the same)."""
+    unset: dict[str, Any] = {"default": argparse.SUPPRESS} if in_command else {}
+    group = parser.add_argument_group("global options (before or after the command)")
+    group.add_argument("--debug", action="store_true", help="show the traceback of an error", **unset)
+    group.add_argument("-v", "--verbose", action="count", help="more messages (debug level); repeatable",
+                       **(unset or {"default": 0}))
+    group.add_argument("-q", "--quiet", action="store_true",
+                       help="on stderr only warnings and errors (no progress bars, no status messages)", **unset)
+    group.add_argument("--json", action="store_true",
+                       help="end with one JSON summary line on stdout (status, outputs, timings)", **unset)
+
+
+def _command(sub: Any, name: str, summary: str, description: str) -> argparse.ArgumentParser:
+    parser = sub.add_parser(name, help=summary, description=description, formatter_class=_HelpFormatter)
+    _add_global_options(parser, in_command=True)
+    return parser
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="hybridgen", description=__doc__.splitlines()[0] if __doc__ else None)
+    parser = argparse.ArgumentParser(prog="hybridgen", description=DESCRIPTION, epilog=EPILOG,
+                                     formatter_class=_HelpFormatter)
     parser.add_argument("--version", action="version", version=f"hybridgen {__version__}")
-    parser.add_argument("--debug", action="store_true", help="show tracebacks of errors")
-    sub = parser.add_subparsers(dest="command", required=True)
-    run = sub.add_parser("run", help="run a config: hybridgen run CONFIG [ARGS...] (ARGS fill <args:N>)")
+    _add_global_options(parser, in_command=False)
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    run = _command(sub, "run", "run a config and write its outputs",
+                   "Run CONFIG; the values after it fill <args:0>, <args:1>, ... in the config.\n"
+                   "Rerunning the same command resumes: complete work units are verified and kept.")
     run.add_argument("config", help="YAML config file")
-    run.add_argument("args", nargs="*", help="values for <args:0>, <args:1>, ...")
-    run.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
-    run.add_argument("--workers", type=int, default=1, help="processes running work units in parallel")
-    run.add_argument("--shard", help="i/N: run only the scenes with scene %% N == i (external schedulers)")
-    run.add_argument("--executor", default="pool", choices=("pool", "ray"), help="where work units run")
-    run.add_argument("--address", help="Ray cluster address (with --executor ray); default: a local cluster")
+    run.add_argument("args", nargs="*", help="values for <args:0>, <args:1>, ... (e.g. the output folder)")
+    run.add_argument("--workers", type=int, default=1, help="processes running work units in parallel (default 1)")
+    run.add_argument("--shard", metavar="I/N",
+                     help="run only the scenes with scene %% N == I (for SLURM arrays and indexed jobs)")
+    run.add_argument("--executor", default="pool", choices=("pool", "ray"),
+                     help="where work units run: a local process pool (default) or Ray")
+    run.add_argument("--address", help="address of a running Ray cluster (with --executor ray; default: "
+                     "start a local one)")
     run.add_argument("--restart", action="store_true",
                      help="discard existing outputs of this config (shards, data.hdf5) instead of resuming")
     run.add_argument("--force-resume", action="store_true",
@@ -112,23 +200,34 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--max-tasks-per-child", type=int, default=25,
                      help="work units a pool worker renders before it is replaced (bounds memory growth)")
     run.set_defaults(func=_cmd_run)
-    modules = sub.add_parser("modules", help="list modules and their parameters")
-    modules.add_argument("name", nargs="?", help="show one module")
+
+    modules = _command(sub, "modules", "list modules, their parameters and the samplers",
+                       "List every module a config may name, with each parameter's type, unit, default, allowed\n"
+                       "choices and whether it may be a sampler; then the samplers with their parameters.")
+    modules.add_argument("name", nargs="?", help="show only this module")
+    modules.add_argument("--schema", nargs="?", const="-", metavar="FILE",
+                         help="write a JSON Schema of the config format to FILE (or stdout) for editors")
     modules.set_defaults(func=_cmd_modules)
-    vis = sub.add_parser("vis", help="save a contact sheet PNG per keypoint of HDF5 outputs")
-    vis.add_argument("files", nargs="+", help="HDF5 files written by hybridgen")
+
+    vis = _command(sub, "vis", "save a contact sheet PNG per keypoint of HDF5 outputs",
+                   "Save one PNG per keypoint showing its color and label passes side by side.")
+    vis.add_argument("files", nargs="+", help="HDF5 files written by hybridgen (either layout)")
     vis.add_argument("--keys", nargs="+", help="keys to show (default: every image key)")
     vis.add_argument("--save", required=True, help="folder for the PNG files")
     vis.set_defaults(func=_cmd_vis)
-    gallery = sub.add_parser("gallery", help="write a static HTML page of an output folder (OUT/gallery/index.html): "
-                             "thumbnails of every pass, legends, click to enlarge, scene/keypoint filters")
+
+    gallery = _command(sub, "gallery", "write a static HTML page of an output folder",
+                       "Write OUT/gallery/index.html: thumbnails of every pass of every keypoint with legends,\n"
+                       "click to enlarge, filters by scene and keypoint. No server or network needed.")
     gallery.add_argument("output", help="output folder (data.hdf5 or BlenderProc <i>.hdf5 files) or HDF5 file")
     gallery.add_argument("--open", action="store_true", help="open the page in the default web browser")
     gallery.add_argument("--keys", nargs="+", help="passes to show (default: every image key)")
     gallery.add_argument("--limit", type=int, help="show only the first N keypoints")
     gallery.set_defaults(func=_cmd_gallery)
-    ext = sub.add_parser("extract", help="write each keypoint's keys of HDF5 outputs as PNG / 16-bit PNG / EXR / npy "
-                         "files (depth and distance PNGs in mm)")
+
+    ext = _command(sub, "extract", "write the keys of HDF5 outputs as PNG, EXR or npy files",
+                   "Write each keypoint's keys as files: PNG (8-bit images, 16-bit ids, depth and distance as\n"
+                   "16-bit millimetres), EXR (the stored floats) or npy (the stored arrays).")
     ext.add_argument("files", nargs="+", help="HDF5 files (single-file or BlenderProc <i>.hdf5 layout)")
     ext.add_argument("--output_dir", required=True, help="folder for the extracted files")
     ext.add_argument("--keys", nargs="+", help="keys to extract (default: every image key)")
@@ -141,21 +240,33 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _json_line(ns: argparse.Namespace, status: str, started: float, **fields: Any) -> None:
+    record = {"status": status, "command": ns.command, "version": __version__,
+              "wall_seconds": round(time.perf_counter() - started, 3), **fields}
+    print(json.dumps(record, sort_keys=False), flush=True)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    argv = list(sys.argv[1:] if argv is None else argv)
-    debug = "--debug" in argv
-    parser = build_parser()
-    ns = parser.parse_args(argv)
+    ns = build_parser().parse_args(list(sys.argv[1:] if argv is None else argv))
+    configure(level_for(ns.verbose, ns.quiet))
+    started = time.perf_counter()
     try:
-        return int(ns.func(ns))
+        result = ns.func(ns)
     except HybridgenError as exc:
-        if debug:
+        if ns.debug:
             raise
-        print(f"hybridgen: error: {exc}", file=sys.stderr)
+        LOGGER.error("%s", exc)
+        if ns.json:
+            _json_line(ns, "error", started, exit_code=EXIT_USER_ERROR, error=str(exc))
         return EXIT_USER_ERROR
     except KeyboardInterrupt:
-        print("hybridgen: interrupted; no output was committed for unfinished writers", file=sys.stderr)
-        return 130
+        LOGGER.error("interrupted; no output was committed for unfinished writers")
+        if ns.json:
+            _json_line(ns, "interrupted", started, exit_code=EXIT_INTERRUPTED)
+        return EXIT_INTERRUPTED
+    if ns.json:
+        _json_line(ns, "ok", started, **result)
+    return 0
 
 
 if __name__ == "__main__":
