@@ -1,6 +1,7 @@
 """Reading a config file in the paper's shape: ``setup`` / ``global`` / ``modules`` (docs/conventions.md section 5)."""
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from importlib import metadata
 from pathlib import Path
@@ -9,11 +10,16 @@ from typing import Any, Mapping, Sequence
 import yaml
 
 from ..errors import ConfigError
+from .blenderproc import (BLENDER_PYTHON_PACKAGES, BLENDER_SETUP_KEYS, GLOBAL_IGNORED, translate_module)
+from .blenderproc import finish as finish_translation
+from .notices import notice
 from .placeholders import resolve_placeholders
 from .schema import closest
 from .yaml_safety import MAX_CONFIG_BYTES, load_yaml, read_limited
 
 TOP_LEVEL_KEYS = ("setup", "global", "modules", "version")
+SUPPORTED_VERSIONS = (1, 2, 3)
+"""BlenderProc 1.x config format versions (v1.0 configs have none; v1.12 write ``version: 3``)."""
 
 
 class _StrictLoader(yaml.SafeLoader):
@@ -57,7 +63,13 @@ class ConfigFile:
 
 
 def load_config(path: str | Path, args: Sequence[str] = (), env: Mapping[str, str] | None = None) -> ConfigFile:
-    """Parse ``path``, check its shape, resolve placeholders and the ``setup.pip`` requirements."""
+    """Parse ``path``, check its shape, resolve placeholders and the ``setup.pip`` requirements.
+
+    BlenderProc 1.x configs are read as they are (see :mod:`hybridgen.config.blenderproc`): ``module:`` or
+    ``name:``, ``version``, the Initializer's ``config.global`` (v3) or a top-level ``global`` (v1), Blender
+    ``setup`` keys (ignored with one notice, their placeholders never resolved), BlenderProc module names
+    and keys. Every difference is one notice line (an error with ``--strict``).
+    """
     file = str(path)
     try:
         text = read_limited(path, MAX_CONFIG_BYTES, "config file").decode("utf-8")
@@ -79,38 +91,95 @@ def load_config(path: str | Path, args: Sequence[str] = (), env: Mapping[str, st
         if key not in TOP_LEVEL_KEYS:
             raise ConfigError(f"unknown top-level key{closest(key, TOP_LEVEL_KEYS)}; known: "
                               f"{list(TOP_LEVEL_KEYS)}", file=file, key=str(key))
-    resolved = resolve_placeholders(raw, args, env, file=file)
+    version = raw.get("version")
+    if version is not None and (not isinstance(version, int) or isinstance(version, bool) or
+                                version not in SUPPORTED_VERSIONS):
+        raise ConfigError(f"config format version {version!r} is not one of {list(SUPPORTED_VERSIONS)} "
+                          "(BlenderProc 1.x)", file=file, key="version")
+    # Blender's own setup keys are set aside before placeholders are resolved: an <env:USER> in
+    # blender_install_path must not stop a run that never uses it.
+    raw_setup = _mapping(raw.get("setup"), file, "setup")
+    blender_setup = {k: raw_setup[k] for k in raw_setup if k in BLENDER_SETUP_KEYS}
+    to_resolve = dict(raw)
+    if "setup" in raw:
+        to_resolve["setup"] = {k: v for k, v in raw_setup.items() if k not in blender_setup}
+    resolved = resolve_placeholders(to_resolve, args, env, file=file)
     config = ConfigFile(path=file, text=text, resolved=resolved)
     config.setup = _mapping(resolved.get("setup"), file, "setup")
     for key in config.setup:
         if key not in ("pip",):
-            raise ConfigError(f"unknown setup key{closest(key, ['pip'])}; known: ['pip']", file=file,
-                              key=f"setup.{key}")
+            raise ConfigError(f"unknown setup key{closest(key, ['pip', *BLENDER_SETUP_KEYS])}; known: "
+                              f"{['pip', *BLENDER_SETUP_KEYS]}", file=file, key=f"setup.{key}")
+    if blender_setup:
+        notice(f"ignored: {', '.join(blender_setup)} locate Blender; hybridgen renders without Blender",
+               file=file, key="setup")
     _check_pip(config.setup.get("pip", []), file)
     global_section = _mapping(resolved.get("global"), file, "global")
+    family_globals: dict[str, dict[str, Any]] = {}
     for key in global_section:
         if key != "all":
-            raise ConfigError("only 'global.all' is supported", file=file, key=f"global.{key}")
+            if "." in str(key) or not isinstance(global_section[key], dict):
+                raise ConfigError("'global' holds 'all' and module families (e.g. 'renderer') with their "
+                                  "settings", file=file, key=f"global.{key}")
+            family_globals[str(key)] = {}
+            for name, value in global_section[key].items():
+                if name in GLOBAL_IGNORED:
+                    notice(f"ignored: {GLOBAL_IGNORED[name]}", file=file, key=f"global.{key}.{name}")
+                else:
+                    family_globals[str(key)][name] = value
     config.global_all = _mapping(global_section.get("all"), file, "global.all")
     entries = resolved.get("modules")
     if not isinstance(entries, list) or not entries:
-        raise ConfigError("'modules' must be a non-empty list of {name: ..., config: {...}}", file=file,
+        raise ConfigError("'modules' must be a non-empty list of {module: ..., config: {...}}", file=file,
                           key="modules")
+    blenderproc_form = version is not None or bool(blender_setup) or any(
+        isinstance(e, dict) and "module" in e for e in entries)
+    state: dict[str, Any] = {"blenderproc": blenderproc_form}
     for index, entry in enumerate(entries):
-        if not isinstance(entry, dict):
-            raise ConfigError(f"modules[{index}] must be a mapping with 'name' and 'config'", file=file,
-                              key=f"modules[{index}]")
-        name = entry.get("name")
-        extra = [k for k in entry if k not in ("name", "config")]
-        if extra:
-            raise ConfigError(f"unknown key{closest(extra[0], ['name', 'config'])}; a module entry has 'name' "
-                              "and 'config'", file=file, module=str(name), index=index, key=str(extra[0]))
-        if not isinstance(name, str) or not name:
-            raise ConfigError("every module needs a 'name'", file=file, index=index, key="name",
-                              module=f"modules[{index}]")
-        module_config = _mapping(entry.get("config"), file, "config", module=name, index=index)
-        config.modules.append(ModuleEntry(name, module_config, index))
+        name, module_config = _module_entry(entry, index, file)
+        family = family_globals.get(name.split(".", 1)[0])
+        if family:  # BlenderProc v1: global.<family> settings are defaults for that family's modules
+            module_config = {**family, **module_config}
+        if name == "main.Initializer" and "global" in module_config:  # BlenderProc v3: the run's global
+            module_config = dict(module_config)
+            initializer_global = _mapping(module_config.pop("global"), file, "config.global", module=name,
+                                          index=index)
+            config.global_all = {**config.global_all, **initializer_global}
+
+        def note(message: str, key: str, name: str = name, index: int = index) -> None:
+            notice(message, file=file, module=name, index=index, key=key)
+
+        try:
+            translated = translate_module(name, module_config, note, state)
+        except ConfigError as exc:
+            raise exc.located(file=file, module=name, index=index) from None
+        for target, target_config in translated:
+            config.modules.append(ModuleEntry(target, target_config, index))
+    finish_translation(config.modules, state, config.global_all.get("output_dir"))
+    for key in [k for k in config.global_all if k in GLOBAL_IGNORED]:
+        notice(f"ignored: {GLOBAL_IGNORED[key]}", file=file, key=f"global.{key}")
+        del config.global_all[key]
     return config
+
+
+def _module_entry(entry: Any, index: int, file: str) -> tuple[str, dict[str, Any]]:
+    """``(name, config)`` of one ``modules`` item, written with ``module:`` (BlenderProc v3) or ``name:``."""
+    if not isinstance(entry, dict):
+        raise ConfigError(f"modules[{index}] must be a mapping with 'module' (or 'name') and 'config'", file=file,
+                          key=f"modules[{index}]")
+    if "module" in entry and "name" in entry and entry["module"] != entry["name"]:
+        raise ConfigError(f"'module' ({entry['module']!r}) and 'name' ({entry['name']!r}) differ; give one",
+                          file=file, index=index, key="module", module=f"modules[{index}]")
+    name = entry.get("module", entry.get("name"))
+    extra = [k for k in entry if k not in ("module", "name", "config")]
+    if extra:
+        raise ConfigError(f"unknown key{closest(extra[0], ['module', 'name', 'config'])}; a module entry has "
+                          "'module' (or 'name') and 'config'", file=file, module=str(name), index=index,
+                          key=str(extra[0]))
+    if not isinstance(name, str) or not name:
+        raise ConfigError("every module needs a 'name' (or BlenderProc's 'module')", file=file, index=index, key="name",
+                          module=f"modules[{index}]")
+    return name, _mapping(entry.get("config"), file, "config", module=name, index=index)
 
 
 def _mapping(value: Any, file: str, key: str, *, module: str | None = None, index: int | None = None) -> dict:
@@ -123,16 +192,33 @@ def _mapping(value: Any, file: str, key: str, *, module: str | None = None, inde
 
 
 def _check_pip(packages: Any, file: str) -> None:
-    """``setup.pip`` lists distributions the config needs: they are checked, never installed."""
+    """``setup.pip`` lists distributions the config needs: they are checked, never installed.
+
+    Packages BlenderProc configs install into Blender's Python (h5py, pypng, scikit-image ...) and entries
+    that are not plain requirements (URLs, ``-f`` options) are a notice when missing; any other missing
+    package (a plugin's) is an error.
+    """
     if not isinstance(packages, list) or not all(isinstance(p, str) for p in packages):
         raise ConfigError("must be a list of package names", file=file, key="setup.pip")
-    missing = []
+    missing, blender_only = [], []
     for spec in packages:
-        name = spec.split("[")[0].split("=")[0].split("<")[0].split(">")[0].split("~")[0].strip()
-        try:
-            metadata.version(name)
-        except metadata.PackageNotFoundError:
+        text = spec.strip()
+        plain = re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*(\[[^\]]*\])?\s*([<>=!~].*)?", text)
+        name = re.split(r"[\[<>=!~\s]", text, maxsplit=1)[0] if plain else text
+        if plain:
+            try:
+                metadata.version(name)
+                continue
+            except metadata.PackageNotFoundError:
+                pass
+        key = re.sub(r"[-_.]+", "-", name).lower()
+        if not plain or key in BLENDER_PYTHON_PACKAGES or key.replace("-", "_") in BLENDER_PYTHON_PACKAGES:
+            blender_only.append(spec)
+        else:
             missing.append(spec)
+    if blender_only:
+        notice(f"not installed, and not needed by hybridgen's modules (BlenderProc installs them into "
+               f"Blender's Python): {', '.join(blender_only)}", file=file, key="setup.pip")
     if missing:
         raise ConfigError(f"package(s) not installed: {', '.join(missing)}; install them with "
                           f"`.venv/bin/pip install {' '.join(missing)}` (hybridgen never installs packages)",

@@ -34,6 +34,9 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.hdf5_writer",
     "hybridgen.modules.coco_writer",
     "hybridgen.modules.bop_writer",
+    "hybridgen.modules.floor_extractor",
+    "hybridgen.modules.world_manipulator",
+    "hybridgen.modules.state_writers",
 )
 
 MODULES: dict[str, type["Module"]] = {}
@@ -71,6 +74,13 @@ def _load_all() -> None:
             register_module(entry.name)(cls)
 
 
+def module_aliases() -> dict[str, str]:
+    """BlenderProc module names hybridgen reads as one of its own modules: alias -> module name."""
+    from .blenderproc import ALIASES
+
+    return dict(sorted(ALIASES.items()))
+
+
 def all_modules() -> dict[str, type["Module"]]:
     """Every registered module, built-ins and plugins, by name."""
     _load_all()
@@ -82,6 +92,11 @@ def get_module(name: object) -> type["Module"]:
     _load_all()
     if not isinstance(name, str) or not name:
         raise ConfigError(f"module 'name' must be a non-empty string, got {name!r}", key="name")
+    from .blenderproc import ALIASES, UNAVAILABLE
+
+    if name in UNAVAILABLE:
+        raise ConfigError(f"not available in hybridgen: {UNAVAILABLE[name]}", key="name")
+    name = ALIASES.get(name, name)
     if name not in MODULES:
         raise ConfigError(f"unknown module '{name}'{closest(name, MODULES)}; `hybridgen modules` lists them",
                           key="name")

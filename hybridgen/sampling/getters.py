@@ -47,6 +47,8 @@ def _attribute(obj: Any, key: str) -> Any:
         return obj.name
     if key in ("category_id", "instance_id"):
         return getattr(obj, key)
+    if key == "material_name":  # BlenderProc's getter.Material selects by material name
+        return obj.material.name
     name = key[3:] if key.startswith("cp_") else key
     return obj.attributes.get(name, _MISSING)
 

@@ -75,14 +75,18 @@ def _check_shell(p: dict[str, Any]) -> None:
 @register_sampler("sampler.Shell", "ShellSampler", validate=_check_shell)
 def shell(ctx: DrawContext, center: Sequence[float], radius_min: float, radius_max: float,
           elevation_min: float = -90.0, elevation_max: float = 90.0, azimuth_min: float = -180.0,
-          azimuth_max: float = 180.0, uniform_volume: bool = False) -> np.ndarray:
+          azimuth_max: float = 180.0, uniform_volume: bool = False, uniform_elevation: bool = False) -> np.ndarray:
     """A point between two spheres, within elevation/azimuth ranges (degrees; elevation from the XY plane).
 
-    Directions are uniform on the sphere's band; the radius is uniform (or uniform by volume)."""
+    Directions are uniform on the sphere's band (or, with ``uniform_elevation`` as in BlenderProc, the
+    elevation angle is uniform in degrees); the radius is uniform (or uniform by volume)."""
     _check_shell(dict(radius_min=radius_min, radius_max=radius_max, elevation_min=elevation_min,
                       elevation_max=elevation_max, azimuth_min=azimuth_min, azimuth_max=azimuth_max))
     rng = ctx.rng
-    z = rng.uniform(math.sin(math.radians(elevation_min)), math.sin(math.radians(elevation_max)))
+    if uniform_elevation:
+        z = math.sin(math.radians(rng.uniform(elevation_min, elevation_max)))
+    else:
+        z = rng.uniform(math.sin(math.radians(elevation_min)), math.sin(math.radians(elevation_max)))
     azimuth = math.radians(rng.uniform(azimuth_min, azimuth_max))
     horizontal = math.sqrt(max(0.0, 1 - z * z))
     direction = np.array([horizontal * math.cos(azimuth), horizontal * math.sin(azimuth), z])
@@ -182,10 +186,15 @@ def _check_color(p: dict[str, Any]) -> None:
 
 
 @register_sampler("sampler.Color", "ColorSampler", validate=_check_color)
-def color(ctx: DrawContext, min: Sequence[float] = (0, 0, 0, 1), max: Sequence[float] = (1, 1, 1, 1)) -> np.ndarray:
-    """An RGB(A) color uniform per channel in [min, max]."""
+def color(ctx: DrawContext, min: Sequence[float] = (0, 0, 0, 1), max: Sequence[float] = (1, 1, 1, 1),
+          grey: bool = False) -> np.ndarray:
+    """An RGB(A) color uniform per channel in [min, max]; ``grey`` (BlenderProc's): one draw, from the first
+    channel's range, for R, G and B."""
     _check_color({"min": min, "max": max})
-    return ctx.rng.uniform(np.asarray(min, float), np.asarray(max, float))
+    drawn = ctx.rng.uniform(np.asarray(min, float), np.asarray(max, float))
+    if grey:
+        drawn[:3] = drawn[0]
+    return drawn
 
 
 @register_sampler("sampler.Path", "PathSampler")

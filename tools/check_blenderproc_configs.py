@@ -1,0 +1,203 @@
+"""Validate (and run) every example config of a BlenderProc checkout with hybridgen, unchanged.
+
+    .venv/bin/python tools/check_blenderproc_configs.py PATH [--tag v1.12.0] [--run] [--only SUBSTRING]
+
+PATH is a BlenderProc working tree (its ``examples/`` is read) or a bare git mirror, read at ``--tag``
+(``git ls-tree`` + ``git show``; nothing of BlenderProc is stored in this repository). For each
+``examples/**/*.yaml`` the tool makes stand-in inputs for its ``<args:N>`` from the config's ``# Args:``
+line (a Y-up OBJ with several ``o`` objects, a camera pose file, an output folder ...), then
+
+- validates: hybridgen reads the config and every module's keys (``load_config`` + ``build_modules``);
+- with ``--run``, runs the valid ones end to end on the stand-ins.
+
+Each config gets one line: ``valid``/``ran``, ``unavailable: <why>`` (a module needing Blender or a withdrawn
+dataset) or ``invalid: <the error line>``. Notices are counted, not printed. Exit status 0 always; the
+summary line gives the counts.
+"""
+from __future__ import annotations
+
+import argparse
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+
+STANDIN_OBJ = """# stand-in scene: a floor and two objects, +Y up as OBJ files are
+mtllib scene.mtl
+o Plane
+v -5 0 5
+v 5 0 5
+v 5 0 -5
+v -5 0 -5
+usemtl floor
+f 1 2 3
+f 1 3 4
+o Cube
+v -0.5 0 0.5
+v 0.5 0 0.5
+v 0.5 0 -0.5
+v -0.5 0 -0.5
+v -0.5 1 0.5
+v 0.5 1 0.5
+v 0.5 1 -0.5
+v -0.5 1 -0.5
+usemtl red
+f 5 7 6
+f 5 8 7
+f 9 10 11
+f 9 11 12
+f 5 6 10
+f 5 10 9
+f 6 7 11
+f 6 11 10
+f 7 8 12
+f 7 12 11
+f 8 5 9
+f 8 9 12
+o Cube.001
+v 1.5 0 0.5
+v 2.5 0 0.5
+v 2.5 0 -0.5
+v 1.5 0 -0.5
+v 2 1 0
+usemtl red
+f 13 15 14
+f 13 16 15
+f 13 14 17
+f 14 15 17
+f 15 16 17
+f 16 13 17
+"""
+STANDIN_MTL = "newmtl floor\nKd 0.6 0.6 0.6\nnewmtl red\nKd 0.8 0.1 0.1\n"
+
+
+@dataclass
+class Outcome:
+    """What happened to one config."""
+
+    config: str
+    status: str  # valid | ran | unavailable | invalid | failed
+    detail: str = ""
+    notices: int = 0
+
+
+def example_configs(path: Path, tag: str | None, into: Path) -> list[Path]:
+    """The example configs of a checkout (working tree) or of ``tag`` in a bare mirror, copied under ``into``."""
+    if (path / "examples").is_dir() and tag is None:
+        return sorted((path / "examples").rglob("*.yaml"))
+    if tag is None:
+        raise SystemExit(f"{path} has no examples/ folder; for a bare git mirror give --tag (e.g. v1.12.0)")
+    names = subprocess.run(["git", "-C", str(path), "ls-tree", "-r", "--name-only", tag, "examples"],
+                           check=True, capture_output=True, text=True).stdout.split()
+    configs = []
+    for name in names:
+        if not name.endswith(".yaml"):
+            continue
+        text = subprocess.run(["git", "-C", str(path), "show", f"{tag}:{name}"], check=True, capture_output=True,
+                              text=True).stdout
+        target = into / name
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_text(text)
+        configs.append(target)
+    return configs
+
+
+def standin_args(config: Path, work: Path) -> list[str]:
+    """A value for every ``<args:N>`` of ``config``, made from the names on its ``# Args:`` line."""
+    text = config.read_text()
+    count = 1 + max((int(n) for n in re.findall(r"<args:(\d+)>", text)), default=-1)
+    header = re.search(r"#\s*Args:\s*(.*)", text)
+    names = re.findall(r"<([^<>]+)>", header.group(1)) if header else []
+    names += [f"arg{i}" for i in range(len(names), count)]
+    args = []
+    for i, name in enumerate(names[:count]):
+        lower = name.lower()
+        if "output" in lower:
+            value = work / "output"
+        elif "obj" in lower or "scene" in lower or "mesh" in lower or "model" in lower or "file" in lower and \
+                "cam" not in lower:
+            value = work / "scene.obj"
+        elif "cam" in lower or "pose" in lower or "position" in lower:
+            value = work / "camera_positions"
+        else:
+            value = work / f"folder_{i}"
+            value.mkdir(exist_ok=True)
+        args.append(str(value))
+    return args
+
+
+def make_standins(work: Path) -> None:
+    """The stand-in inputs every config may use."""
+    (work / "scene.obj").write_text(STANDIN_OBJ)
+    (work / "scene.mtl").write_text(STANDIN_MTL)
+    # location + Blender Euler rotation per line: two views of the origin from 6 m
+    (work / "camera_positions").write_text("0 -6 3 1.1 0 0\n4 -4 3 1.1 0 0.785\n")
+
+
+def check(config: Path, root: Path, run: bool, work: Path) -> Outcome:
+    """Validate (and run) one config on stand-ins."""
+    from hybridgen.config.config_file import load_config
+    from hybridgen.config.notices import set_sink
+    from hybridgen.errors import ConfigError, HybridgenError
+    from hybridgen.run.pipeline import build_modules, run_config
+
+    lines: list[str] = []
+    set_sink(lines.append)
+    name = str(config.relative_to(root))
+    args = standin_args(config, work)
+    try:
+        try:
+            loaded = load_config(config, args)
+            build_modules(loaded)
+        except ConfigError as exc:
+            status = "unavailable" if "not available in hybridgen" in exc.detail else "invalid"
+            return Outcome(name, status, str(exc).replace(str(root) + "/", ""), len(lines))
+        except HybridgenError as exc:
+            return Outcome(name, "invalid", str(exc), len(lines))
+        if not run:
+            return Outcome(name, "valid", "", len(lines))
+        start = time.perf_counter()
+        try:
+            summary = run_config(config, args)
+        except HybridgenError as exc:
+            return Outcome(name, "failed", str(exc).replace(str(root) + "/", ""), len(lines))
+        return Outcome(name, "ran", f"{summary.frames} frames in {time.perf_counter() - start:.1f} s", len(lines))
+    finally:
+        set_sink(None)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("path", type=Path, help="BlenderProc checkout, or bare git mirror with --tag")
+    parser.add_argument("--tag", help="git tag to read from a bare mirror (e.g. v1.12.0, v1.0.0)")
+    parser.add_argument("--run", action="store_true", help="also run the valid configs on stand-in inputs")
+    parser.add_argument("--only", default="", help="only configs whose path contains this")
+    ns = parser.parse_args()
+    with tempfile.TemporaryDirectory(prefix="bp-configs-") as tmp:
+        root = Path(tmp) / "checkout"
+        configs = example_configs(ns.path, ns.tag, root)
+        base = root if ns.tag else ns.path
+        outcomes = []
+        for config in configs:
+            if ns.only not in str(config):
+                continue
+            work = Path(tempfile.mkdtemp(prefix="standins-", dir=tmp))
+            make_standins(work)
+            outcome = check(config, base, ns.run, work)
+            outcomes.append(outcome)
+            print(f"{outcome.status:11s} {outcome.config}  [{outcome.notices} notices] {outcome.detail}", flush=True)
+    counts = {s: sum(o.status == s for o in outcomes) for s in ("valid", "ran", "unavailable", "invalid", "failed")}
+    validated = counts["valid"] + counts["ran"] + counts["failed"]
+    print(f"{len(outcomes)} configs: {validated} validate, {counts['ran']} ran end to end"
+          + (f", {counts['failed']} failed while running" if ns.run else "")
+          + f", {counts['unavailable']} need something hybridgen cannot have, {counts['invalid']} invalid")
+
+
+if __name__ == "__main__":
+    main()
