@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ConfigError, InputError
+from ..io.bounded_read import MAX_POSE_FILE_BYTES, read_bounded_text
 from ..scene.camera import Intrinsics
 from ..scene.frames import BLENDER_TO_OPENCV, euler_xyz_to_matrix, forward_to_rotation_blender, look_at_blender, \
     make_pose
@@ -152,10 +153,7 @@ def poses_from_file(path: str | Path, file_format: str, defaults: dict[str, Any]
     """One cam2world per non-empty, non-comment line of ``path``."""
     fields = parse_file_format(file_format)
     width = sum(n for _, n in fields)
-    try:
-        lines = Path(path).read_text(encoding="utf-8").splitlines()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read camera pose file '{path}': {exc}") from None
+    lines = read_bounded_text(path, MAX_POSE_FILE_BYTES, "camera pose file").splitlines()
     poses = []
     for number, line in enumerate(lines, start=1):
         text = line.split("#", 1)[0].strip()

@@ -16,6 +16,7 @@ written or overwritten if rendering fails. No timestamps are written, so a run i
 from __future__ import annotations
 
 import csv
+import io
 import json
 from pathlib import Path
 from typing import Any, Mapping
@@ -24,6 +25,7 @@ import numpy as np
 
 from ..errors import InputError
 from .atomic import prepare_output_dir
+from .bounded_read import MAX_TABLE_BYTES, read_bounded_text
 from .output_lock import hold_output_lock
 from .frame_sink import PassLayout
 from .image_files import StagedFiles, jpeg_bytes, png_bytes, write_file
@@ -58,11 +60,8 @@ def load_label_mapping(value: Mapping[Any, Any] | str | Path | None) -> dict[int
         where = "label_mapping"
     else:
         path = Path(value)
-        try:
-            with open(path, newline="", encoding="utf-8") as handle:
-                rows = list(csv.DictReader(handle))
-        except OSError as exc:
-            raise InputError(f"cannot read label mapping '{path}': {exc.strerror or exc}") from None
+        text = read_bounded_text(path, MAX_TABLE_BYTES, "label mapping", latin1_fallback=True)
+        rows = list(csv.DictReader(io.StringIO(text, newline="")))
         if not rows or "id" not in rows[0] or "name" not in rows[0]:
             raise InputError(f"label mapping '{path}' needs a CSV header with 'id' and 'name' columns")
         items = [(row["id"], row["name"]) for row in rows]

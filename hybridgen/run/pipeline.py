@@ -102,9 +102,11 @@ def writer_folders(modules: list[Module]) -> list[Path]:
 
 
 def single_file_output(modules: list[Module]) -> Path | None:
-    """The final path of a ``writer.Hdf5Writer`` with ``layout: single``, if the config has exactly one."""
-    writers = [m for m in modules if m.module_name == "writer.Hdf5Writer" and m.config["layout"] == "single"]
-    if len(writers) != 1:
+    """The final path of the config's ``writer.Hdf5Writer`` with ``layout: single`` when it is the only
+    writer (then an existing file is resumed or refused); None for other configs (appending writers such as
+    COCO or BOP make a rerun mean "more data", so their data.hdf5 is rewritten as before)."""
+    writers = [m for m in modules if m.module_name.startswith("writer.")]
+    if len(writers) != 1 or writers[0].module_name != "writer.Hdf5Writer" or writers[0].config["layout"] != "single":
         return None
     return Path(writers[0].config["output_dir"]) / writers[0].config["file_name"]
 
