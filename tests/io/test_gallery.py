@@ -76,6 +76,7 @@ def test_page_loads_every_image_with_legends(gallery, tmp_path, run_cli):
     assert {attrs["src"].split("_", 1)[1][:-4] for attrs in images} == passes
     assert len(images) == len(data) * len(passes)
     assert int(check["data-failed"]) == 0 and int(check["data-loaded"]) == int(check["data-total"]) > len(images)
+    assert check["data-lightbox"] == "none"  # the enlarged view stays closed until a click
     for attrs in images:  # the browser decoded each thumbnail at the width of the file on disk
         with Image.open(page.parent / attrs["src"]) as thumb:
             assert int(attrs["data-natural-width"]) == thumb.width == 40  # 40x30 images are not downscaled
