@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 from pathlib import Path
@@ -263,6 +264,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         if ns.json:
             _json_line(ns, "error", started, exit_code=EXIT_USER_ERROR, error=str(exc))
         return EXIT_USER_ERROR
+    except BrokenPipeError:  # the reader of stdout went away (`hybridgen modules | head`): stop quietly
+        sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - Python flushes stdout at exit
+        return 0
     except KeyboardInterrupt:
         LOGGER.error("interrupted; no output was committed for unfinished writers")
         if ns.json:

@@ -9,9 +9,9 @@ from .schema import Param
 
 
 def _summary(doc: str | None) -> str:
-    """The first paragraph of a docstring as one line (never cut mid-sentence)."""
+    """The first paragraph of a docstring as one line (never cut mid-sentence), without RST markup."""
     paragraph = inspect.cleandoc(doc or "").split("\n\n")[0]
-    return " ".join(paragraph.split())
+    return " ".join(paragraph.split()).replace("``", "`")  # reStructuredText literals as plain backticks
 
 
 def describe_param(param: Param) -> str:

@@ -8,8 +8,8 @@ variable ``HYBRIDGEN_STRICT=1`` that it sets for worker processes) every notice 
 """
 from __future__ import annotations
 
+import logging
 import os
-import sys
 from typing import Callable
 
 from ..errors import ConfigError
@@ -51,4 +51,4 @@ def notice(message: str, *, file: str | None = None, module: str | None = None, 
         return
     if line not in _seen:
         _seen.add(line)
-        print(line, file=sys.stderr)
+        logging.getLogger("hybridgen").warning("notice: %s", error)  # the CLI prints "hybridgen: notice: ..."

@@ -18,7 +18,8 @@ class ObjLoader(Module):
     """
 
     params = (
-        Param("path", "path", doc=f"mesh file ({', '.join(LOADERS)}); relative to the working directory"),
+        Param("path", "path", doc=f"mesh file ({', '.join(LOADERS)}); relative to the working directory, else to "
+              "the config's folder"),
         *PLACEMENT_PARAMS,
         Param("up_axis", "str", "auto", choices=("auto", "Y", "Z"),
               doc="the file's up axis; auto: as Blender's importers read the format - Y for OBJ "
