@@ -26,6 +26,9 @@ def _texture_image(obj: MeshObject) -> np.ndarray | None:
     if isinstance(texture, (str,)):
         from PIL import Image
 
+        from ..io.image_check import check_image_file
+
+        check_image_file(texture, f"object '{obj.name}': texture file")
         texture = np.asarray(Image.open(texture).convert("RGBA"))
     image = np.asarray(texture)
     if image.shape[-1] == 3:

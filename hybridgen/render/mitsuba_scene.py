@@ -24,6 +24,7 @@ import numpy as np
 
 from ..config.paths import not_found
 from ..errors import InputError
+from ..io.image_check import check_image_file
 from ..scene.light import Light
 from ..scene.material import Material
 from ..scene.mesh_object import MeshObject
@@ -45,6 +46,7 @@ def _texture(material: Material, owner: str) -> dict[str, Any]:
         path = Path(texture)
         if not path.is_file():
             raise InputError(f"object '{owner}': {not_found('texture file', path)}")
+        check_image_file(path, f"object '{owner}': texture file")  # header pixel budget, truncation
         return {"type": "bitmap", "filename": str(path)}
     array = np.ascontiguousarray(np.asarray(texture)[..., :3])
     if array.dtype != np.uint8 or array.ndim != 3:
@@ -181,6 +183,7 @@ def world_dict(world: World) -> dict[str, Any]:
         path = Path(world.hdri_path)
         if not path.is_file():
             raise InputError(not_found("HDRI file", path))
+        check_image_file(path, "HDRI file")  # header pixel budget before Mitsuba decodes it
         rotation = np.eye(4)
         c, s = math.cos(world.hdri_rotation), math.sin(world.hdri_rotation)
         rotation[:2, :2] = [[c, -s], [s, c]]
