@@ -3,7 +3,6 @@ materials and poses/attributes, with values from samplers (drawn per object)."""
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ..config.material_config import apply_material_config
 from ..config.registry import register_module
@@ -11,6 +10,7 @@ from ..config.schema import Param
 from ..errors import InputError
 from ..io.mesh_loader import object_pose
 from ..run.context import RunContext
+from ..scene.frames import matrix_to_euler_xyz
 from .selecting import SelectingModule
 
 
@@ -55,7 +55,7 @@ class EntityManipulator(SelectingModule):
                 current = obj.local2world
                 linear = current[:3, :3]
                 old_scale = np.linalg.norm(linear, axis=0)
-                old_rotation = Rotation.from_matrix(linear / old_scale).as_euler("xyz")
+                old_rotation = matrix_to_euler_xyz(linear / old_scale)
                 obj.local2world = object_pose(current[:3, 3] if location is None else location,
                                               old_rotation if rotation is None else rotation,
                                               old_scale if scale is None else scale)

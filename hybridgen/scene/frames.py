@@ -9,6 +9,7 @@ from __future__ import annotations
 from typing import Sequence
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 BLENDER_TO_OPENCV = np.diag([1.0, -1.0, -1.0, 1.0])
 """Right-multiplying a Blender-axes cam2world by this gives the OpenCV-axes cam2world (it is its own inverse)."""
@@ -27,11 +28,13 @@ def opencv_to_blender(cam2world: np.ndarray) -> np.ndarray:
 
 
 def source_frame_matrix(axes: Sequence[str]) -> np.ndarray:
-    """4x4 matrix mapping OpenCV camera coordinates into a camera frame named by its axes.
+    """4x4 signed axis-permutation matrix ``S`` with row i = the signed unit vector that ``axes[i]`` names.
 
-    ``axes`` names, for each of the source frame's x, y, z axes, which OpenCV-relative axis it is, the
-    BlenderProc way: ``["X", "-Y", "-Z"]`` is Blender's camera frame, ``["X", "Y", "Z"]`` is OpenCV.
-    ``cam2world_cv = cam2world_source @ source_frame_matrix(axes)``.
+    A frame whose axis i is ``axes[i]`` of a reference frame maps points as ``p_ref = S^T p`` (S is
+    orthonormal). For the two frames configs use the matrix is its own inverse:
+    ``source_frame_matrix(["X", "-Y", "-Z"]) == BLENDER_TO_OPENCV``, so
+    ``cam2world_opencv = cam2world_blender @ source_frame_matrix(["X", "-Y", "-Z"])``. What a config's
+    ``source_frame`` means (BlenderProc's meaning) is applied by :mod:`hybridgen.config.camera_poses`.
     """
     if len(axes) != 3:
         raise ValueError(f"source_frame needs 3 axes like [X, -Y, -Z], got {list(axes)}")
@@ -54,22 +57,26 @@ def source_frame_matrix(axes: Sequence[str]) -> np.ndarray:
 
 
 def euler_xyz_to_matrix(angles: Sequence[float]) -> np.ndarray:
-    """3x3 rotation from Blender ``XYZ`` Euler angles in radians: ``R = Rz(c) @ Ry(b) @ Rx(a)``."""
-    a, b, c = (float(v) for v in angles)
-    ca, sa, cb, sb, cc, sc = np.cos(a), np.sin(a), np.cos(b), np.sin(b), np.cos(c), np.sin(c)
-    rx = np.array([[1, 0, 0], [0, ca, -sa], [0, sa, ca]])
-    ry = np.array([[cb, 0, sb], [0, 1, 0], [-sb, 0, cb]])
-    rz = np.array([[cc, -sc, 0], [sc, cc, 0], [0, 0, 1]])
-    return rz @ ry @ rx
+    """3x3 rotation from Blender ``XYZ`` Euler angles in radians: ``R = Rz(c) @ Ry(b) @ Rx(a)``.
+
+    That is SciPy's extrinsic ``"xyz"`` (rotate about world X, then world Y, then world Z); every Euler
+    angle in hybridgen goes through this one convention (docs/conventions.md section 1).
+    """
+    values = np.asarray(angles, dtype=np.float64).ravel()
+    if values.size != 3:
+        raise ValueError(f"Euler XYZ rotation needs 3 angles, got {list(values)}")
+    return Rotation.from_euler("xyz", values).as_matrix()
+
+
+def matrix_to_euler_xyz(rotation: np.ndarray) -> np.ndarray:
+    """Blender ``XYZ`` Euler angles (radians) of a 3x3 rotation; the inverse of :func:`euler_xyz_to_matrix`."""
+    return Rotation.from_matrix(np.asarray(rotation, dtype=np.float64)).as_euler("xyz")
 
 
 def rotation_about_axis(axis: np.ndarray, angle: float) -> np.ndarray:
-    """3x3 rotation of ``angle`` radians about ``axis`` (right-hand rule)."""
+    """3x3 rotation of ``angle`` radians about ``axis`` (right-hand rule; any non-zero length)."""
     axis = np.asarray(axis, dtype=np.float64)
-    axis = axis / np.linalg.norm(axis)
-    x, y, z = axis
-    k = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
-    return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * (k @ k)
+    return Rotation.from_rotvec(axis / np.linalg.norm(axis) * float(angle)).as_matrix()
 
 
 def forward_to_rotation_blender(forward: Sequence[float], inplane_rot: float = 0.0) -> np.ndarray:

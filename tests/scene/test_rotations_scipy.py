@@ -1,0 +1,38 @@
+"""Euler XYZ and axis-angle rotations go through scipy's Rotation: checked against hand-built matrices."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hybridgen.scene.frames import euler_xyz_to_matrix, matrix_to_euler_xyz, rotation_about_axis
+
+
+def _rx(a):
+    return np.array([[1, 0, 0], [0, np.cos(a), -np.sin(a)], [0, np.sin(a), np.cos(a)]])
+
+
+def _ry(b):
+    return np.array([[np.cos(b), 0, np.sin(b)], [0, 1, 0], [-np.sin(b), 0, np.cos(b)]])
+
+
+def _rz(c):
+    return np.array([[np.cos(c), -np.sin(c), 0], [np.sin(c), np.cos(c), 0], [0, 0, 1]])
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_euler_xyz_is_blenders_order(seed):
+    a, b, c = np.random.default_rng(seed).uniform(-np.pi, np.pi, 3)
+    np.testing.assert_allclose(euler_xyz_to_matrix([a, b, c]), _rz(c) @ _ry(b) @ _rx(a), atol=1e-14)
+    angles = matrix_to_euler_xyz(euler_xyz_to_matrix([a, b / 2, c]))
+    np.testing.assert_allclose(euler_xyz_to_matrix(angles), euler_xyz_to_matrix([a, b / 2, c]), atol=1e-14)
+
+
+def test_axis_angle_right_hand_rule():
+    np.testing.assert_allclose(rotation_about_axis(np.array([0, 0, 2.0]), np.pi / 2) @ [1, 0, 0], [0, 1, 0],
+                               atol=1e-15)
+    axis = np.array([1.0, 2.0, -0.5])
+    r = rotation_about_axis(axis, 0.7)
+    np.testing.assert_allclose(r @ axis, axis, atol=1e-14)  # the axis is fixed
+    np.testing.assert_allclose(np.trace(r), 1 + 2 * np.cos(0.7), atol=1e-14)
+    with pytest.raises(ValueError):
+        euler_xyz_to_matrix([0.1, 0.2])
