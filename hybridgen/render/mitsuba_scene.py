@@ -30,8 +30,10 @@ from ..scene.material import Material
 from ..scene.mesh_object import MeshObject
 from ..scene.scene import Scene, World
 
-Y_UP_TO_Z_UP = np.array([[1.0, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1]])
-"""Mitsuba's environment maps are +Y up; this turns them to hybridgen's +Z up."""
+ENVMAP_TO_WORLD = np.array([[0.0, 0, 1, 0], [1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 0, 1]])
+"""Lays Mitsuba's lat-long map (local +Y up, u = atan2(x, -z) / 2 pi mod 1) out as Blender's equirectangular
+mapping (world +Z up, u = 1/2 - atan2(y, x) / 2 pi): image centre column = world +X, a quarter from the left
+= +Y, top row = +Z, so an HDRI lights a scene from the same side as in BlenderProc."""
 
 
 def _rgb(value: Any) -> dict[str, Any]:
@@ -188,7 +190,7 @@ def world_dict(world: World) -> dict[str, Any]:
         c, s = math.cos(world.hdri_rotation), math.sin(world.hdri_rotation)
         rotation[:2, :2] = [[c, -s], [s, c]]
         return {"type": "envmap", "filename": str(path), "scale": float(world.strength),
-                "to_world": mi.ScalarTransform4f((rotation @ Y_UP_TO_Z_UP).tolist())}
+                "to_world": mi.ScalarTransform4f((rotation @ ENVMAP_TO_WORLD).tolist())}
     return {"type": "constant", "radiance": _rgb(np.asarray(world.color, float) * world.strength)}
 
 
