@@ -1,9 +1,7 @@
 """Reading a config file in the paper's shape: ``setup`` / ``global`` / ``modules`` (docs/conventions.md section 5)."""
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, field
-from importlib import metadata
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
@@ -14,6 +12,7 @@ from .blenderproc import (BLENDER_PYTHON_PACKAGES, BLENDER_SETUP_KEYS, GLOBAL_IG
 from .blenderproc import finish as finish_translation
 from .notices import notice
 from .placeholders import resolve_placeholders
+from .requirements import NOT_A_REQUIREMENT, RequirementCheck, check_requirements
 from .schema import closest
 from .yaml_safety import MAX_CONFIG_BYTES, load_yaml, read_limited
 
@@ -200,26 +199,20 @@ def _check_pip(packages: Any, file: str) -> None:
     """
     if not isinstance(packages, list) or not all(isinstance(p, str) for p in packages):
         raise ConfigError("must be a list of package names", file=file, key="setup.pip")
-    missing, blender_only = [], []
-    for spec in packages:
-        text = spec.strip()
-        plain = re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*(\[[^\]]*\])?\s*([<>=!~].*)?", text)
-        name = re.split(r"[\[<>=!~\s]", text, maxsplit=1)[0] if plain else text
-        if plain:
-            try:
-                metadata.version(name)
-                continue
-            except metadata.PackageNotFoundError:
-                pass
-        key = re.sub(r"[-_.]+", "-", name).lower()
-        if not plain or key in BLENDER_PYTHON_PACKAGES or key.replace("-", "_") in BLENDER_PYTHON_PACKAGES:
-            blender_only.append(spec)
+    missing: list[RequirementCheck] = []
+    blender_only: list[str] = []
+    for check in check_requirements(packages):  # PEP 508 specifiers against what is installed (packaging)
+        if check.met:
+            continue
+        if check.status == NOT_A_REQUIREMENT or check.name in BLENDER_PYTHON_PACKAGES or \
+                check.name.replace("-", "_") in BLENDER_PYTHON_PACKAGES:
+            blender_only.append(check.describe())
         else:
-            missing.append(spec)
+            missing.append(check)
     if blender_only:
-        notice(f"not installed, and not needed by hybridgen's modules (BlenderProc installs them into "
+        notice(f"not installed as asked, and not needed by hybridgen's modules (BlenderProc installs them into "
                f"Blender's Python): {', '.join(blender_only)}", file=file, key="setup.pip")
     if missing:
-        raise ConfigError(f"package(s) not installed: {', '.join(missing)}; install them with "
-                          f"`.venv/bin/pip install {' '.join(missing)}` (hybridgen never installs packages)",
-                          file=file, key="setup.pip")
+        raise ConfigError(f"requirement(s) not met: {', '.join(m.describe() for m in missing)}; install them with "
+                          f"`.venv/bin/pip install {' '.join(repr(m.spec) for m in missing)}` "
+                          "(hybridgen never installs packages)", file=file, key="setup.pip")
