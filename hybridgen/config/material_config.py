@@ -22,7 +22,11 @@ def _number(value: Any, key: str) -> float:
 
 
 def apply_material_config(material: Material, config: dict[str, Any]) -> Material:
-    """A copy of ``material`` with the config's values; errors name ``material.<key>``."""
+    """A copy of ``material`` with the config's values; errors name ``material.<key>``.
+
+    Overrides replace what they name: a ``base_color`` without a ``base_color_texture`` also removes the
+    mesh's own base-color texture (as setting a value on a linked input in BlenderProc unlinks the texture).
+    """
     values: dict[str, Any] = {}
     for key, value in config.items():
         if key not in KNOWN_KEYS:
@@ -57,4 +61,6 @@ def apply_material_config(material: Material, config: dict[str, Any]) -> Materia
             if not isinstance(value, str) or not value:
                 raise ConfigError(f"must be a non-empty string, got {value!r}", key=f"material.{key}")
             values[key] = locate_input(value) if key == "base_color_texture" else value
+    if "base_color" in values and "base_color_texture" not in values:
+        values["base_color_texture"] = None
     return dataclasses.replace(material, **values)

@@ -17,23 +17,47 @@ def _non_negative(value: Any) -> str | None:
     return None if value >= 0 else f"must be >= 0, got {value}"
 
 
+def _optional_non_negative(value: Any) -> str | None:
+    return None if value is None else _non_negative(value)
+
+
+def _optional_positive(value: Any) -> str | None:
+    return None if value is None else positive(value)
+
+
 @register_module("renderer.RgbRenderer")
 class RgbRenderer(Module):
     """Renders color for every keypoint; render_depth / render_normals / map_by add labels in the same pass."""
 
     params = (
-        Param("samples", "int", 64, "spp", "samples per pixel", check=positive),
+        Param("samples", "int|null", None, "spp", "null: adaptive sampling up to 1024 spp (BlenderProc 2.8's "
+              "default); N: a plain N-spp estimate in every pixel, or at most N when noise_threshold is given "
+              "(Cycles' meaning)", check=_optional_positive),
+        Param("noise_threshold", "float|null", None, doc="adaptive sampling: a pixel gets no more samples once "
+              "its noise estimate (Cycles') is below this; null: 0.01 when samples is null, else off; 0: off",
+              check=_optional_non_negative),
+        Param("use_adaptive_sampling", "float|null", None, doc="BlenderProc 1.x's name of noise_threshold",
+              check=_optional_non_negative),
+        Param("min_samples", "int", 16, "spp", "samples every pixel gets before adaptive sampling judges it "
+              "(Cycles' Min Samples)", check=positive),
+        Param("clamp_indirect", "float", 10.0, doc="firefly control, Cycles' sample_clamp_indirect: indirect "
+              "light of one sample is scaled down to at most this linear radiance (direct light never); 0: off",
+              check=_non_negative),
         Param("min_bounces", "int", 1, doc="bounces before Russian roulette may end a path (Cycles' meaning)",
               check=_non_negative),
-        Param("max_bounces", "int", 8, doc="indirect bounces, 0 = direct light only (Mitsuba max_depth = "
-              "max_bounces + 2)", check=_non_negative),
+        Param("max_bounces", "int", 3, doc="indirect bounces, 0 = direct light only (Mitsuba max_depth = "
+              "max_bounces + 2); 3 is BlenderProc's default", check=_non_negative),
         Param("glossy_bounces", "int|null", None, doc="must be >= max_bounces if given: Mitsuba has one depth "
               "limit for all lobes", check=lambda v: None if v is None else _non_negative(v)),
         Param("resolution_x", "int|null", None, "px", "overrides the camera width (K scaled)"),
         Param("resolution_y", "int|null", None, "px", "overrides the camera height (K scaled)"),
         Param("output_hdr", "bool", False, doc="also write linear colors_hdr (float16)"),
-        Param("denoise", "bool", False, doc="Open Image Denoise (needs pyoidn) guided by the raster albedo and "
-              "normals; colors_hdr is the denoised image too"),
+        Param("denoise", "bool", True, doc="Open Image Denoise (pyoidn) guided by the raster albedo and normals; "
+              "colors_hdr is the denoised image too; false: the raw estimate"),
+        Param("output_raw", "bool", False, doc="with denoise: also write colors_raw, the image before denoising "
+              "(sRGB uint8 like colors)"),
+        Param("output_sample_counts", "bool", False, doc="also write sample_counts (uint32 H x W): the samples each "
+              "pixel received"),
         Param("stereo", "bool", False, doc="render left/right pairs (every key gains a leading axis of 2)"),
         Param("interocular_distance", "float", 0.065, "m", "stereo baseline", check=positive),
         Param("variant", "str", "auto", choices=("auto", "cuda_ad_rgb", "llvm_ad_rgb", "scalar_rgb"),
@@ -49,13 +73,21 @@ class RgbRenderer(Module):
         request = label_request(cfg)
         wants_labels = any((request.depth, request.distance, request.normals, request.map_by, request.albedo,
                             request.flow, request.nocs, request.object_records))
-        settings = PathTraceSettings(cfg["samples"], cfg["min_bounces"], cfg["max_bounces"], cfg["glossy_bounces"])
+        threshold = cfg["noise_threshold"] if cfg["noise_threshold"] is not None else cfg["use_adaptive_sampling"]
+        settings = PathTraceSettings(cfg["samples"], cfg["min_bounces"], cfg["max_bounces"], cfg["glossy_bounces"],
+                                     noise_threshold=threshold, min_samples=cfg["min_samples"],
+                                     clamp_indirect=cfg["clamp_indirect"])
+        plan = settings.plan()
         variant = choose_variant(cfg["variant"])
-        context.log(f"color: Mitsuba {variant}, {settings.samples} spp, max_bounces {settings.max_bounces}"
+        sampling = (f"adaptive {plan.min_samples}..{plan.max_samples} spp (noise threshold {plan.noise_threshold})"
+                    if plan.adaptive else f"{plan.max_samples} spp")
+        context.log(f"color: Mitsuba {variant}, {sampling}, max_bounces {settings.max_bounces}"
+                    + (f", indirect clamp {settings.clamp_indirect}" if settings.clamp_indirect else "")
                     + (", denoised" if cfg["denoise"] else ""))
         context.frames_rendered += render_color(
             scene, context.sinks, settings, labels=request if wants_labels else None, seed=context.scene_seed,
-            variant=variant, hdr=cfg["output_hdr"], denoise=cfg["denoise"],
+            variant=variant, hdr=cfg["output_hdr"], denoise=cfg["denoise"], keep_raw=cfg["output_raw"],
+            sample_counts=cfg["output_sample_counts"],
             stereo_baseline=cfg["interocular_distance"] if cfg["stereo"] else None,
             default_category_id=context.default_category_id, progress=context.progress,
             indices=context.keypoint_indices())

@@ -1,4 +1,4 @@
-"""Denoising with Intel Open Image Denoise (PyPI ``pyoidn``, an optional dependency), guided by the raster
+"""Denoising with Intel Open Image Denoise (PyPI ``pyoidn``, a core dependency), guided by the raster
 view's exact albedo and normals: the guides are noise-free (``clean_aux``), which Mitsuba's own AOVs are
 not, and they cost a raster draw instead of doubling the render time."""
 from __future__ import annotations
@@ -9,7 +9,8 @@ import numpy as np
 
 from ..errors import SystemSetupError
 
-INSTALL_HINT = "denoising needs pyoidn: `.venv/bin/pip install pyoidn` (or `pip install 'hybridgen[denoise]'`)"
+INSTALL_HINT = ("denoising needs pyoidn (a hybridgen dependency): `pip install pyoidn`, or set `denoise: false` "
+                "on renderer.RgbRenderer")
 
 
 def require_oidn() -> Any:

@@ -175,8 +175,9 @@ def light_dict(light: Light) -> dict[str, Any]:
             "emitter": {"type": "area", "radiance": _rgb(radiance)}}
 
 
-def world_dict(world: World) -> dict[str, Any]:
-    """The background emitter."""
+def world_dict(world: World) -> dict[str, Any] | None:
+    """The background emitter; None for a black world (an emitter of zero radiance would still take its
+    share of the light samples: Mitsuba picks the emitter to sample uniformly)."""
     import mitsuba as mi
 
     if world.strength < 0 or not math.isfinite(world.strength):
@@ -191,12 +192,18 @@ def world_dict(world: World) -> dict[str, Any]:
         rotation[:2, :2] = [[c, -s], [s, c]]
         return {"type": "envmap", "filename": str(path), "scale": float(world.strength),
                 "to_world": mi.ScalarTransform4f((rotation @ ENVMAP_TO_WORLD).tolist())}
-    return {"type": "constant", "radiance": _rgb(np.asarray(world.color, float) * world.strength)}
+    radiance = np.asarray(world.color, float)[:3] * world.strength
+    if not np.any(radiance > 0):
+        return None
+    return {"type": "constant", "radiance": _rgb(radiance)}
 
 
 def scene_dict(scene: Scene) -> dict[str, Any]:
     """Everything but the sensor and integrator, keyed by stable names."""
-    out: dict[str, Any] = {"type": "scene", "world": world_dict(scene.world)}
+    out: dict[str, Any] = {"type": "scene"}
+    world = world_dict(scene.world)
+    if world is not None:
+        out["world"] = world
     for obj in scene.objects:
         out[f"object_{obj.instance_id}"] = mesh_shape(obj)
         if np.any(emitted_radiance(obj) > 0):

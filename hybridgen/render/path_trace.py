@@ -16,43 +16,87 @@ import numpy as np
 from ..errors import InputError
 from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
+from . import clamped_path, pinhole_sensor
+from .adaptive_sampling import PixelTracer, SamplingPlan, render_adaptive
 from .mitsuba_scene import scene_dict
-from . import pinhole_sensor
 from .mitsuba_variant import activate, choose_variant, is_jit
 
 OPENCV_TO_MITSUBA = np.diag([-1.0, -1.0, 1.0, 1.0])
 """Mitsuba's camera looks along +z with +y up and +x to the image's left; OpenCV's x is right, y down."""
 
 
+DEFAULT_MAX_SAMPLES = 1024
+"""Samples per pixel at most when ``samples`` is not given (BlenderProc 2.8's default maximum)."""
+DEFAULT_NOISE_THRESHOLD = 0.01
+"""Adaptive sampling's threshold when ``samples`` is not given (BlenderProc 2.8's default)."""
+
+
 @dataclass(frozen=True)
 class PathTraceSettings:
-    """Integrator settings in BlenderProc's terms.
+    """Integrator and sampling settings in BlenderProc's (Cycles') terms.
 
-    Bounces count as in Cycles: ``max_bounces`` 0 is direct light only. Mitsuba's ``path`` integrator counts
-    path segments, so ``max_depth = max_bounces + 2`` and Russian roulette starts at
-    ``rr_depth = min(min_bounces, max_bounces) + 2``. Mitsuba has a single depth limit for all
-    lobes, so ``glossy_bounces`` can only be honoured when it is not smaller than ``max_bounces``; a
-    smaller value is rejected rather than silently ignored.
+    Bounces count as in Cycles: ``max_bounces`` 0 is direct light only (default 3, BlenderProc's). Mitsuba's
+    ``path`` integrator counts path segments, so ``max_depth = max_bounces + 2`` and Russian roulette starts
+    at ``rr_depth = min(min_bounces, max_bounces) + 2``. Mitsuba has a single depth limit for all lobes, so
+    ``glossy_bounces`` can only be honoured when it is not smaller than ``max_bounces``; a smaller value is
+    rejected rather than silently ignored.
+
+    Sampling (see :mod:`hybridgen.render.adaptive_sampling`): with ``samples`` not given, every pixel is
+    sampled adaptively from ``min_samples`` until its noise estimate is below ``noise_threshold`` (default
+    :data:`DEFAULT_NOISE_THRESHOLD`) or it has :data:`DEFAULT_MAX_SAMPLES`. An explicit ``samples: N`` is a
+    plain N-spp estimate in every pixel, unless ``noise_threshold`` is given too: then N is the maximum
+    (Cycles' meaning of samples with adaptive sampling on).
+
+    ``clamp_indirect`` (linear radiance; 0 = off) is the firefly control of
+    :mod:`hybridgen.render.clamped_path`, Cycles' ``sample_clamp_indirect`` (default 10, Cycles' default):
+    indirect contributions are clamped per sample, direct light never. It needs a JIT variant
+    (``llvm_ad_rgb``/``cuda_ad_rgb``); ``scalar_rgb`` renders unclamped.
     """
 
-    samples: int = 64
+    samples: int | None = None
     min_bounces: int = 1
-    max_bounces: int = 8
+    max_bounces: int = 3
     glossy_bounces: int | None = None
+    noise_threshold: float | None = None
+    min_samples: int = 16
+    clamp_indirect: float = 10.0
 
     def __post_init__(self) -> None:
-        if self.samples < 1:
+        if self.samples is not None and self.samples < 1:
             raise InputError(f"samples must be >= 1, got {self.samples}")
         if self.min_bounces < 0 or self.max_bounces < 0:
             raise InputError("min_bounces and max_bounces must be >= 0")
         if self.glossy_bounces is not None and self.glossy_bounces < self.max_bounces:
             raise InputError(f"glossy_bounces ({self.glossy_bounces}) < max_bounces ({self.max_bounces}) cannot "
                              "be honoured: Mitsuba's path tracer has one depth limit for every lobe")
+        if not (math.isfinite(self.clamp_indirect) and self.clamp_indirect >= 0):
+            raise InputError(f"clamp_indirect must be >= 0 (0 = off), got {self.clamp_indirect}")
+        self.plan()  # validates the sampling knobs
+
+    def plan(self) -> SamplingPlan:
+        """The per-pixel sample plan these settings stand for (rule in the class docstring)."""
+        if self.samples is None:
+            threshold = DEFAULT_NOISE_THRESHOLD if self.noise_threshold is None else self.noise_threshold
+            return SamplingPlan(DEFAULT_MAX_SAMPLES, min(self.min_samples, DEFAULT_MAX_SAMPLES), threshold)
+        threshold = self.noise_threshold or 0.0
+        return SamplingPlan(self.samples, min(self.min_samples, self.samples) if threshold else self.samples,
+                            threshold)
 
     def integrator(self) -> dict[str, Any]:
+        """Mitsuba's built-in ``path`` integrator with these bounces (no clamping)."""
         rr_depth = min(self.min_bounces, self.max_bounces) + 2  # no roulette needed past the last bounce
         return {"type": "path", "max_depth": self.max_bounces + 2, "rr_depth": rr_depth,
                 "hide_emitters": False}
+
+    def integrator_for(self, variant: str) -> dict[str, Any]:
+        """The integrator used in ``variant``: the clamped path tracer where it can run (JIT variants, clamp
+        on), else :meth:`integrator`."""
+        if self.clamp_indirect > 0 and is_jit(variant):
+            clamped_path.register(variant)
+            plain = self.integrator()
+            return {"type": clamped_path.PLUGIN_NAME, "max_depth": plain["max_depth"],
+                    "rr_depth": plain["rr_depth"], "clamp_indirect": float(self.clamp_indirect)}
+        return self.integrator()
 
 
 def sensor_dict(intr: Intrinsics, cam2world: np.ndarray, variant: str) -> dict[str, Any]:
@@ -98,7 +142,8 @@ class PathTraceView:
         activate(self.variant)
         self.intrinsics = scene.camera.intrinsics
         description = scene_dict(scene)
-        description["integrator"] = integrator or self.settings.integrator()
+        self._own_film = integrator is not None  # e.g. AOV integrators: rendered through Mitsuba's film
+        description["integrator"] = integrator or self.settings.integrator_for(self.variant)
         first = scene.camera.keypoints[0] if scene.camera.keypoints else np.eye(4)
         description["sensor"] = sensor_dict(self.intrinsics, first, self.variant)
         try:
@@ -107,6 +152,10 @@ class PathTraceView:
             raise InputError(f"Mitsuba could not build the scene: {str(exc).splitlines()[-1]}") from None
         self.sensor = self.mi_scene.sensors()[0]
         self._sensor_params = None if is_jit(self.variant) else mi.traverse(self.sensor)
+        self._tracer: PixelTracer | FullFrameTracer = (
+            PixelTracer(self.mi_scene, self.sensor, self.mi_scene.integrator()) if is_jit(self.variant)
+            else FullFrameTracer(self))
+        self.clamped = description["integrator"]["type"] == clamped_path.PLUGIN_NAME
 
     def set_pose(self, cam2world: np.ndarray) -> None:
         """Move the sensor to an OpenCV-axes ``cam2world`` (nothing else is rebuilt)."""
@@ -119,12 +168,44 @@ class PathTraceView:
         self._sensor_params.update()
 
     def render(self, cam2world: np.ndarray, seed: int, spp: int | None = None) -> np.ndarray:
-        """Linear RGB of one keypoint; ``seed`` fixes the sample pattern (same seed -> same bytes)."""
+        """Linear RGB of one keypoint; ``seed`` fixes the sample pattern (same seed -> same bytes). ``spp``
+        forces a plain fixed-count estimate."""
+        return self.render_with_counts(cam2world, seed, spp)[0]
+
+    def render_with_counts(self, cam2world: np.ndarray, seed: int,
+                           spp: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Linear RGB (float32 H x W x 3) and samples per pixel (uint32 H x W) of one keypoint, sampled by
+        the settings' plan (adaptive or fixed; ``spp`` forces a fixed count)."""
         import mitsuba as mi
 
         self.set_pose(cam2world)
-        image = mi.render(self.mi_scene, sensor=self.sensor, spp=spp or self.settings.samples, seed=int(seed))
-        return np.array(image, dtype=np.float32)[..., :3]
+        plan = SamplingPlan(spp, spp, 0.0) if spp else self.settings.plan()
+        if self._own_film:
+            image = mi.render(self.mi_scene, sensor=self.sensor, spp=plan.max_samples, seed=int(seed))
+            counts = np.full((self.intrinsics.height, self.intrinsics.width), plan.max_samples, np.uint32)
+            return np.array(image, dtype=np.float32)[..., :3], counts
+        return render_adaptive(self._tracer, plan, int(seed))
+
+
+class FullFrameTracer:
+    """The :class:`~hybridgen.render.adaptive_sampling.PixelTracer` interface for ``scalar_rgb``, where a
+    per-sample Python loop would be slow: each call renders the whole frame through Mitsuba's film (one
+    render per half of the samples) and returns the pixels asked for, so adaptive sampling there decides
+    counts but saves no time."""
+
+    def __init__(self, view: PathTraceView) -> None:
+        self.view = view
+        self.width, self.height = view.intrinsics.width, view.intrinsics.height
+
+    def trace(self, pixels: np.ndarray, spp: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+        import mitsuba as mi
+
+        sums = []
+        for half, count in enumerate((spp // 2, spp - spp // 2) if spp % 2 == 0 else (spp,)):
+            image = mi.render(self.view.mi_scene, sensor=self.view.sensor, spp=count,
+                              seed=(int(seed) + half * 0x9E3779B9) % 2**32)
+            sums.append(np.array(image, dtype=np.float64)[..., :3].reshape(-1, 3)[pixels] * count)
+        return sums[0], (sums[1] if len(sums) > 1 else np.zeros_like(sums[0]))
 
 
 def mitsuba_pixel_centre_depth(view: PathTraceView, cam2world: np.ndarray) -> np.ndarray:

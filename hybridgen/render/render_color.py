@@ -28,12 +28,16 @@ class ColorProducer:
     ``colors_hdr`` (float16) from one Mitsuba scene loaded at construction.
 
     With ``denoise`` the linear image goes through Open Image Denoise, guided by the raster view's albedo and
-    normals, before it is encoded.
+    normals, before it is encoded; ``keep_raw`` also stores the image before denoising as ``colors_raw``
+    (sRGB uint8, encoded like ``colors``). ``sample_counts`` stores the samples each pixel received
+    (uint32, ``sample_counts``; constant unless adaptive sampling is on).
     """
 
     def __init__(self, scene: Scene, settings: PathTraceSettings, *, seed: int = 0, variant: str | None = None,
-                 hdr: bool = False, denoise: bool = False, view: PathTraceView | None = None) -> None:
+                 hdr: bool = False, denoise: bool = False, view: PathTraceView | None = None,
+                 keep_raw: bool = False, sample_counts: bool = False) -> None:
         self.scene, self.settings, self.seed, self.hdr, self.denoise = scene, settings, int(seed), hdr, denoise
+        self.keep_raw, self.sample_counts = keep_raw and denoise, sample_counts
         self._guides: tuple[RasterView, AlbedoPass] | None = None
         if denoise:
             require_oidn()
@@ -44,24 +48,38 @@ class ColorProducer:
     def layouts(self) -> list[PassLayout]:
         intr = self.scene.camera.intrinsics
         shape = (intr.height, intr.width, 3)
-        return [PassLayout("colors", "uint8", shape)] + ([PassLayout("colors_hdr", "float16", shape)]
-                                                          if self.hdr else [])
+        layouts = [PassLayout("colors", "uint8", shape)]
+        if self.hdr:
+            layouts.append(PassLayout("colors_hdr", "float16", shape))
+        if self.keep_raw:
+            layouts.append(PassLayout("colors_raw", "uint8", shape))
+        if self.sample_counts:
+            layouts.append(PassLayout("sample_counts", "uint32", shape[:2]))
+        return layouts
 
     def attributes(self) -> dict[str, Any]:
-        s = self.settings
-        return {"mitsuba_variant": self.view.variant, "samples": s.samples, "min_bounces": s.min_bounces,
-                "max_bounces": s.max_bounces, "mitsuba_max_depth": s.max_bounces + 2,
+        s, plan = self.settings, self.settings.plan()
+        return {"mitsuba_variant": self.view.variant, "samples": plan.max_samples,
+                "min_samples": plan.min_samples if plan.adaptive else plan.max_samples,
+                "noise_threshold": plan.noise_threshold, "adaptive_sampling": plan.adaptive,
+                "clamp_indirect": s.clamp_indirect if self.view.clamped else 0.0,
+                "min_bounces": s.min_bounces, "max_bounces": s.max_bounces, "mitsuba_max_depth": s.max_bounces + 2,
                 "color_encoding": "sRGB transfer of linear radiance clipped to [0, 1]", "denoised": self.denoise}
 
     def records(self) -> dict[str, np.ndarray]:
         return {}
 
     def produce(self, index: int, cam2world: np.ndarray, eye: int = 0) -> dict[str, Any]:
-        linear = self.view.render(cam2world, keypoint_seed(self.seed, index, eye))
+        linear, counts = self.view.render_with_counts(cam2world, keypoint_seed(self.seed, index, eye))
+        values: dict[str, Any] = {}
+        if self.keep_raw:
+            values["colors_raw"] = to_srgb8(linear)
+        if self.sample_counts:
+            values["sample_counts"] = counts
         if self._guides is not None:
             raster, albedo = self._guides
             linear = oidn_denoise(linear, albedo.render(cam2world), raster.render(cam2world, ["normals"])["normals"])
-        values: dict[str, Any] = {"colors": to_srgb8(linear)}
+        values["colors"] = to_srgb8(linear)
         if self.hdr:
             values["colors_hdr"] = linear.astype(np.float16)
         return values
@@ -78,13 +96,14 @@ def render_color(scene: Scene, sinks: Iterable[FrameSink], settings: PathTraceSe
                  labels: LabelRequest | None = None, seed: int = 0, variant: str | None = None,
                  hdr: bool = False, denoise: bool = False, stereo_baseline: float | None = None,
                  default_category_id: int | None = None, progress: ProgressFactory | None = None,
-                 indices: Sequence[int] | None = None) -> int:
-    """Color (and ``labels`` if given) of every keypoint, as left/right pairs when ``stereo_baseline`` (m)."""
+                 indices: Sequence[int] | None = None, keep_raw: bool = False, sample_counts: bool = False) -> int:
+    """Color (and ``labels`` if given) of every keypoint, as left/right pairs when ``stereo_baseline`` (m).
+    ``keep_raw`` and ``sample_counts`` as in :class:`ColorProducer`."""
     producers: list[Producer] = []
     if labels is not None:
         producers.append(LabelProducer(scene, labels, default_category_id=default_category_id))
     producers.insert(0, ColorProducer(scene, settings or PathTraceSettings(), seed=seed, variant=variant, hdr=hdr,
-                                      denoise=denoise))
+                                      denoise=denoise, keep_raw=keep_raw, sample_counts=sample_counts))
     if stereo_baseline is not None:
         producers = [StereoProducer(producers, stereo_baseline, scene)]
     return run_keypoints(scene, sinks, producers, progress=progress, what="color", indices=indices)

@@ -11,7 +11,9 @@ import numpy as np
 class Material:
     """A principled material. Colors are linear RGB(A) in [0, 1]; textures are file paths or arrays.
 
-    ``base_color_texture`` (when set) replaces ``base_color``'s RGB and is sampled with the mesh UVs.
+    ``base_color_texture`` (when set) replaces ``base_color``'s RGB and is sampled with the mesh UVs. A
+    config override of ``base_color`` alone removes the texture (see
+    :func:`hybridgen.config.material_config.apply_material_config`).
     """
 
     name: str = "default"

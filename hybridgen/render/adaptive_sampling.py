@@ -1,0 +1,170 @@
+"""Adaptive sampling: more samples where the image is still noisy, up to a maximum (Cycles' scheme).
+
+Knobs (Cycles' and BlenderProc's names and meaning):
+
+- ``noise_threshold``: a pixel stops receiving samples once its error estimate is below it (Cycles'
+  "Noise Threshold", BlenderProc's ``set_noise_threshold`` / 1.x ``use_adaptive_sampling``; 0.01 is
+  BlenderProc's default, smaller is cleaner and slower). 0 disables adaptivity: every pixel gets
+  ``max_samples``.
+- ``max_samples``: samples per pixel a pixel never exceeds (Cycles' ``samples`` when adaptive).
+- ``min_samples``: samples every pixel gets before the first error estimate (Cycles' "Min Samples").
+
+The error estimate is Cycles' (after Dammertz et al. 2010, "A hierarchical automatic stopping condition
+for Monte Carlo global illumination"): every pixel's samples are split into two independent halves A and B
+of equal count; with ``I = (A + B) / 2`` the pixel mean and ``A`` the first half's mean (linear RGB),
+
+    error = (|I_r - A_r| + |I_g - A_g| + |I_b - A_b|) / (1e-4 + sqrt(I_r + I_g + I_b)),
+
+a relative error that tolerates more absolute noise in bright pixels, as the eye (and a tone curve) does.
+A pixel is still active when its error, or that of one of its 8 neighbours, is at least the threshold
+(the neighbourhood keeps isolated noisy pixels from stopping next to noisy regions). Rounds double the
+sample count of the active pixels (``min_samples``, then +``min_samples``, +2x, ... up to ``max_samples``),
+so a pixel's count is ``min_samples * 2^k`` or ``max_samples``; converged pixels stay converged.
+
+Only active pixels are traced: :class:`PixelTracer` launches one wavefront of ``len(pixels) x spp``
+samples through the loaded scene's integrator and sensor (pixel-major, so each pixel's samples are
+contiguous and summed in NumPy in a fixed order - the result does not depend on thread scheduling).
+Sample counts, pixel indices and seeds are opaque Dr.Jit variables, so later rounds and keypoints reuse
+the kernels compiled by the first (``tools/bench_color.py`` counts compilations per keypoint). Each round
+and chunk has its own seed derived from the keypoint's, so the result is a pure function of the seed.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+
+MAX_WAVEFRONT = 1 << 22
+"""Samples per kernel launch at most (bounds the per-sample output arrays to ~50 MB)."""
+
+
+@dataclass(frozen=True)
+class SamplingPlan:
+    """How many samples each pixel gets; ``noise_threshold`` 0 means exactly ``max_samples`` everywhere."""
+
+    max_samples: int = 1024
+    min_samples: int = 16
+    noise_threshold: float = 0.01
+
+    def __post_init__(self) -> None:
+        if self.max_samples < 1:
+            raise InputError(f"samples must be >= 1, got {self.max_samples}")
+        if self.noise_threshold < 0:
+            raise InputError(f"noise_threshold must be >= 0, got {self.noise_threshold}")
+        if self.adaptive and not 2 <= self.min_samples <= self.max_samples:
+            raise InputError(f"min_samples must be in 2..samples ({self.max_samples}), got {self.min_samples}")
+
+    @property
+    def adaptive(self) -> bool:
+        return self.noise_threshold > 0
+
+    def rounds(self) -> list[int]:
+        """Samples added to every still-active pixel in each round. Adaptive rounds add even counts (the two
+        halves stay equal), so an odd ``max_samples`` is rounded down by one there."""
+        if not self.adaptive:
+            return [self.max_samples]
+        first = self.min_samples - self.min_samples % 2
+        out, total = [first], first
+        while True:
+            step = min(total, self.max_samples - total)
+            step -= step % 2
+            if step == 0:
+                return out
+            out.append(step)
+            total += step
+
+
+def pixel_error(sum_a: np.ndarray, sum_b: np.ndarray, count: np.ndarray) -> np.ndarray:
+    """Cycles' per-pixel error estimate (see the module docstring) from the two halves' sample sums
+    (N x 3 each) and the samples per pixel ``count`` (N,), half of them in each sum."""
+    half = np.maximum(count, 2)[:, None] / 2.0
+    mean_a, mean = sum_a / half, (sum_a + sum_b) / (2.0 * half)
+    difference = np.abs(mean - mean_a).sum(axis=1)
+    return difference / (1e-4 + np.sqrt(np.maximum(mean.sum(axis=1), 0.0)))
+
+
+def dilate(mask: np.ndarray) -> np.ndarray:
+    """``mask`` (H x W bool) grown by one pixel in all 8 directions."""
+    padded = np.pad(mask, 1)
+    h, w = mask.shape
+    out = np.zeros_like(mask)
+    for dy in range(3):
+        for dx in range(3):
+            out |= padded[dy:dy + h, dx:dx + w]
+    return out
+
+
+def round_seed(seed: int, round_index: int, chunk: int) -> int:
+    """Sampler seed of one launch: a pure function of the keypoint seed, the round and the chunk."""
+    return int(np.random.SeedSequence([int(seed), round_index, chunk]).generate_state(1)[0])
+
+
+class PixelTracer:
+    """Traces chosen pixels of the loaded Mitsuba scene (JIT variants only)."""
+
+    def __init__(self, mi_scene: Any, sensor: Any, integrator: Any) -> None:
+        self.mi_scene, self.sensor, self.integrator = mi_scene, sensor, integrator
+        size = sensor.film().crop_size()
+        self.width, self.height = int(size[0]), int(size[1])
+
+    def trace(self, pixels: np.ndarray, spp: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+        """Sums of linear RGB over the first and the second half of ``spp`` samples of every pixel in
+        ``pixels`` (flat indices ``v * width + u``): two float64 arrays of shape (len(pixels), 3)."""
+        import drjit as dr
+        import mitsuba as mi
+
+        n = len(pixels)
+        sampler = self.sensor.sampler().fork()
+        sampler.set_sample_count(spp)
+        sampler.set_samples_per_wavefront(spp)
+        sampler.seed(dr.opaque(mi.UInt32, seed % 2**32), n * spp)
+        spp_o, width_o = dr.opaque(mi.UInt32, spp), dr.opaque(mi.UInt32, self.width)
+        index = dr.arange(mi.UInt32, n * spp)
+        local = index // spp_o
+        pixel = dr.gather(mi.UInt32, mi.UInt32(np.ascontiguousarray(pixels, np.uint32)), local)
+        v = pixel // width_o
+        u = pixel - v * width_o
+        offset = sampler.next_2d()
+        position = mi.Point2f((mi.Float(u) + offset.x) / self.width, (mi.Float(v) + offset.y) / self.height)
+        ray, weight = self.sensor.sample_ray(0.0, sampler.next_1d(), position, sampler.next_2d())
+        value, _, _ = self.integrator.sample(self.mi_scene, sampler, ray, None, True)
+        rgb = mi.Color3f(value) * weight
+        # Deterministic block sums (evaluated mode: no atomics) over each half of each pixel's samples;
+        # an odd spp (fixed-count rendering only) goes into the first sum whole.
+        block = spp // 2 if spp % 2 == 0 else spp
+        dr.eval(rgb)  # one kernel for all three channels
+        sums = dr.block_sum(rgb, block, mode="evaluated")
+        sums = np.stack([np.asarray(sums.x), np.asarray(sums.y), np.asarray(sums.z)], axis=-1).astype(np.float64)
+        if block == spp:
+            return sums, np.zeros_like(sums)
+        sums = sums.reshape(n, 2, 3)
+        return sums[:, 0], sums[:, 1]
+
+
+def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Linear RGB (float32 H x W x 3) and samples per pixel (uint32 H x W) of one keypoint."""
+    h, w = tracer.height, tracer.width
+    sum_a, sum_b = np.zeros((h * w, 3)), np.zeros((h * w, 3))
+    count = np.zeros(h * w, dtype=np.uint32)
+    active = np.arange(h * w)
+    for round_index, spp in enumerate(plan.rounds()):
+        if round_index > 0:
+            error = pixel_error(sum_a, sum_b, count)
+            unconverged = np.zeros(h * w, dtype=bool)
+            unconverged[active] = error[active] >= plan.noise_threshold
+            keep = dilate(unconverged.reshape(h, w)).ravel()
+            active = active[keep[active]]
+            if len(active) == 0:
+                break
+        per_chunk = max(1, MAX_WAVEFRONT // spp)
+        for chunk, start in enumerate(range(0, len(active), per_chunk)):
+            pixels = active[start:start + per_chunk]
+            a, b = tracer.trace(pixels, spp, round_seed(seed, round_index, chunk))
+            sum_a[pixels] += a
+            sum_b[pixels] += b
+        count[active] += spp
+    image = (sum_a + sum_b) / np.maximum(count, 1)[:, None]
+    return image.reshape(h, w, 3).astype(np.float32), count.reshape(h, w)
