@@ -369,12 +369,28 @@ def _segmap(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any
     if defaults:
         note("objects lacking a map_by attribute get 0 (background) in hybridgen unless main.Initializer's "
              "default_category_id is set", "default_values")
-    if "map_by" not in cfg:
-        cfg["map_by"] = "class"  # BlenderProc's default
+    cfg["map_by"] = _map_by(cfg.get("map_by", "class"), note)  # "class": BlenderProc's default
     # BlenderProc's SegMapRenderer writes only segmentation; hybridgen's would add depth and normals
     cfg.setdefault("render_depth", False)
     cfg.setdefault("render_normals", False)
     return [("renderer.SegMapRenderer", cfg)]
+
+
+def _map_by(value: Any, note: Note) -> Any:
+    """BlenderProc's map_by: ``name`` (text) lives in instance_attribute_maps, as BlenderProc's segcolormap
+    holds it; ``cp_<attr>`` is hybridgen's attribute ``<attr>``."""
+    items = [value] if isinstance(value, str) else list(value) if isinstance(value, list) else value
+    if not isinstance(items, list):
+        return value
+    out: list[str] = []
+    for item in items:
+        if item == "name":
+            item = "instance"  # instance_attribute_maps carry each instance's name
+        elif isinstance(item, str) and item.startswith("cp_"):
+            item = item[3:]
+        if item not in out:
+            out.append(item)
+    return out
 
 
 def _single_pass(flag: str | None) -> Callable[[dict[str, Any], Note], list[tuple[str, dict[str, Any]]]]:
@@ -618,6 +634,10 @@ def translate_module(name: str, config: dict[str, Any], note: Note,
     return [(ALIASES.get(name, name), config)]
 
 
+def _as_list(value: Any) -> list[Any]:
+    return [] if value is None else [value] if isinstance(value, str) else list(value)
+
+
 def finish(entries: list[Any], state: dict[str, Any], output_dir: Any) -> None:
     """Cross-module effects: Dist2Depth renders depth where distance was rendered; writers' BlenderProc folders."""
     if state.get("dist2depth"):
@@ -625,6 +645,19 @@ def finish(entries: list[Any], state: dict[str, Any], output_dir: Any) -> None:
             if entry.name.startswith("renderer.") and entry.config.get("render_distance"):
                 entry.config["render_distance"] = False
                 entry.config["render_depth"] = True
+    for position, entry in enumerate(entries):
+        if entry.name not in ("writer.BopWriter", "writer.CocoAnnotationsWriter"):
+            continue
+        # BlenderProc's BOP writer renders its own masks and depth; hybridgen's writers take them from the
+        # renderer before them, which is asked for them here
+        renderers = [e for e in entries[:position] if e.name.startswith("renderer.")]
+        if not renderers:
+            continue
+        last = renderers[-1].config
+        if not any("instance" in _as_list(e.config.get("map_by")) for e in renderers):
+            last["map_by"] = [*_as_list(last.get("map_by")), "instance"]
+        if entry.name == "writer.BopWriter" and not any(e.config.get("render_depth") for e in renderers):
+            last["render_depth"] = True
     subdirs = state.get("subdirs", {})
     if subdirs and isinstance(output_dir, str):
         for entry in entries:

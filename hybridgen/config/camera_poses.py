@@ -33,7 +33,7 @@ from .schema import closest
 
 ROTATION_FORMATS = ("euler", "look_at", "forward_vec")
 POSE_KEYS = ("location", "rotation", "cam2world_matrix", "source_frame")
-FILE_FIELDS = {"location": 3, "rotation/value": 3, "rotation/inplane_rot": 1, "cam2world_matrix": 16, "_": 1}
+FILE_FIELDS = {"location": 3, "rotation": 3, "rotation/value": 3, "rotation/inplane_rot": 1, "cam2world_matrix": 16, "_": 1}
 BLENDER_FRAME = ("X", "Y", "Z")
 """BlenderProc's default ``source_frame``: the numbers are Blender's own axes."""
 OPENCV_FRAME = ("X", "-Y", "-Z")

@@ -155,10 +155,25 @@ def load_config(path: str | Path, args: Sequence[str] = (), env: Mapping[str, st
         for target, target_config in translated:
             config.modules.append(ModuleEntry(target, target_config, index))
     finish_translation(config.modules, state, config.global_all.get("output_dir"))
+    if blenderproc_form and "output_dir" in config.global_all and not _declared(config.modules, "output_dir"):
+        del config.global_all["output_dir"]  # BlenderProc always sets it (also for its temporary files)
     for key in [k for k in config.global_all if k in GLOBAL_IGNORED]:
         notice(f"ignored: {GLOBAL_IGNORED[key]}", file=file, key=f"global.{key}")
         del config.global_all[key]
     return config
+
+
+def _declared(modules: list[ModuleEntry], key: str) -> bool:
+    """True if some module of the list declares the parameter ``key`` (unknown modules count as not)."""
+    from .registry import get_module
+
+    for entry in modules:
+        try:
+            if key in get_module(entry.name).param_table():
+                return True
+        except ConfigError:
+            continue
+    return False
 
 
 def _module_entry(entry: Any, index: int, file: str) -> tuple[str, dict[str, Any]]:

@@ -26,7 +26,9 @@ def light_from_entry(entry: Any, where: str, default_name: str = "light") -> Lig
         kind = LIGHT_KEYS[key]
         ok = isinstance(value, (int, float)) and not isinstance(value, bool) if kind is float else \
             isinstance(value, kind)
-        if not ok or (kind is list and (len(value) != 3 or not all(isinstance(v, (int, float)) for v in value))):
+        sizes = (3, 4) if key == "color" else (3,)  # a color may be RGBA (BlenderProc's); alpha is unused
+        if not ok or (kind is list and (len(value) not in sizes or not all(isinstance(v, (int, float))
+                                                                            for v in value))):
             raise ConfigError(f"expected {'3 numbers' if kind is list else kind.__name__}, got {value!r}",
                               key=f"{where}.{key}")
     kind = str(entry.get("type", "POINT")).upper()
@@ -39,7 +41,7 @@ def light_from_entry(entry: Any, where: str, default_name: str = "light") -> Lig
         raise ConfigError("channels must be >= 0", key=f"{where}.color")
     optional = {k: float(entry[k]) for k in ("radius", "spot_size", "spot_blend", "size") if k in entry}
     return Light(name=str(entry.get("name", default_name)), type=kind,
-                 color=tuple(float(c) for c in entry.get("color", [1.0, 1.0, 1.0])),  # type: ignore[arg-type]
+                 color=tuple(float(c) for c in entry.get("color", [1.0, 1.0, 1.0])[:3]),  # type: ignore[arg-type]
                  energy=energy, local2world=object_pose(entry.get("location", [0, 0, 0]),
                                                         entry.get("rotation", [0, 0, 0])), **optional)
 
