@@ -23,8 +23,8 @@ def test_modules_lists_every_module_with_parameters(run_cli):
         assert f"{name}:" in out
     assert "seed: int, default 0" in out
     assert "location: vec3 [m] (sampleable), default [0.0, 0.0, 0.0]" in out
-    code, out, _ = run_cli("modules", "writer.Hdf5Writr")
-    assert code == 0 or "did you mean 'writer.Hdf5Writer'" in _
+    code, out, err = run_cli("modules", "writer.Hdf5Writr")
+    assert code == 2 and "did you mean 'writer.Hdf5Writer'" in err and len(err.strip().splitlines()) == 1
 
 
 def test_paper_basic_config_runs(gl_context, tmp_path, run_cli, monkeypatch):

@@ -122,6 +122,21 @@ def test_camera_sampler_config_is_deterministic_and_checked(gl_context, write_co
     for pose in poses:
         out = view.render(pose, ["distance", "instance_segmaps"])
         assert (out["instance_segmaps"] == 2).any() and (out["instance_segmaps"] > 0).all()
+        assert out["distance"].min() >= 1.0
+
+
+def test_proximity_minimum_that_rejects_poses_holds_in_every_kept_pose(gl_context, write_config):
+    """min 2.2 m rejects many candidates of this shell (radius 1.5..4 around a 0.8 m ball on a floor); every
+    kept pose, rendered independently at full resolution (the check image has the same 64 px width, so the
+    same pixel centres), has nothing closer than 2.2 m."""
+    scene, messages = _sampled_poses(write_config, seed=5, minimum=2.2)
+    rejected = dict(part.rsplit(" ", 1) for part in messages[-1].split("rejections: ")[1].split(", "))
+    assert int(rejected["min"]) > 0, messages[-1]
+    view = hg.RasterView(scene)
+    assert len(scene.camera.keypoints) == 4
+    for pose in scene.camera.keypoints:
+        out = view.render(pose, ["distance", "instance_segmaps"])
+        assert out["distance"].min() >= 2.2 and (out["instance_segmaps"] > 0).all()
 
 
 def test_impossible_constraint_is_a_clear_error(gl_context, write_config, run_cli):
