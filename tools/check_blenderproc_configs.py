@@ -5,7 +5,8 @@
 PATH is a BlenderProc working tree (its ``examples/`` is read) or a bare git mirror, read at ``--tag``
 (``git ls-tree`` + ``git show``; nothing of BlenderProc is stored in this repository). For each
 ``examples/**/*.yaml`` the tool makes stand-in inputs for its ``<args:N>`` from the config's ``# Args:``
-line (a Y-up OBJ with several ``o`` objects, a camera pose file, an output folder ...), then
+line (a Y-up OBJ with several ``o`` objects, a camera pose file, a small BOP dataset, a texture, an output
+folder ...), then
 
 - validates: hybridgen reads the config and every module's keys (``load_config`` + ``build_modules``);
 - with ``--run``, runs the valid ones end to end on the stand-ins.
@@ -118,7 +119,14 @@ def standin_args(config: Path, work: Path) -> list[str]:
     args = []
     for i, name in enumerate(names[:count]):
         lower = name.lower()
-        if "output" in lower:
+        if "bop_data" in lower:
+            value = work / "bop"
+        elif "bop_datset_name" in lower or "bop_dataset_name" in lower:
+            args.append(BOP_NAME)
+            continue
+        elif "texture_file" in lower:
+            value = work / "texture.png"
+        elif "output" in lower:
             value = work / "output"
         elif "obj" in lower or "scene" in lower or "mesh" in lower or "model" in lower or "file" in lower and \
                 "cam" not in lower:
@@ -132,10 +140,55 @@ def standin_args(config: Path, work: Path) -> list[str]:
     return args
 
 
+BOP_NAME = "lm"
+
+
+def make_bop_standin(root: Path, name: str = BOP_NAME) -> Path:
+    """A small BOP dataset: three box models (mm, vertex colors), camera.json, models_info.json and scene
+    000001 (two images of the three objects) in the train, val and test splits; returns its folder."""
+    import json
+
+    import numpy as np
+    import trimesh
+
+    dataset = root / name
+    (dataset / "models").mkdir(parents=True, exist_ok=True)
+    info = {}
+    for obj_id, extents in ((1, [60, 40, 30]), (2, [30, 30, 80]), (3, [50, 50, 50])):
+        box = trimesh.creation.box(extents=extents)
+        box.visual.vertex_colors = np.tile([40 * obj_id, 200 - 40 * obj_id, 120, 255], (len(box.vertices), 1))
+        box.export(dataset / "models" / f"obj_{obj_id:06d}.ply")
+        info[str(obj_id)] = {"diameter": float(np.linalg.norm(extents)), "min_x": -extents[0] / 2,
+                             "min_y": -extents[1] / 2, "min_z": -extents[2] / 2, "size_x": extents[0],
+                             "size_y": extents[1], "size_z": extents[2]}
+    (dataset / "models" / "models_info.json").write_text(json.dumps(info))
+    camera = {"cx": 325.26, "cy": 242.05, "fx": 572.41, "fy": 573.57, "width": 640, "height": 480,
+              "depth_scale": 1.0}
+    (dataset / "camera.json").write_text(json.dumps(camera))
+    k = [camera["fx"], 0, camera["cx"], 0, camera["fy"], camera["cy"], 0, 0, 1]
+    gt, cams = {}, {}
+    for image, turn in ((0, 0.0), (1, 0.35)):
+        rotation = trimesh.transformations.rotation_matrix(turn, [0, 1, 0])[:3, :3]
+        gt[str(image)] = [{"obj_id": obj_id, "cam_R_m2c": rotation.ravel().tolist(),
+                           "cam_t_m2c": (rotation @ np.array([x, 20.0, 0]) + [0, 0, 600.0]).tolist()}
+                          for obj_id, x in ((1, -90.0), (2, 0.0), (3, 90.0))]
+        cams[str(image)] = {"cam_K": k, "depth_scale": 1.0}
+    for split in ("train", "val", "test"):
+        scene = dataset / split / "000001"
+        scene.mkdir(parents=True, exist_ok=True)
+        (scene / "scene_gt.json").write_text(json.dumps(gt))
+        (scene / "scene_camera.json").write_text(json.dumps(cams))
+    return dataset
+
+
 def make_standins(work: Path) -> None:
     """The stand-in inputs every config may use."""
+    from PIL import Image
+
     (work / "scene.obj").write_text(STANDIN_OBJ)
     (work / "scene.mtl").write_text(STANDIN_MTL)
+    make_bop_standin(work / "bop")
+    Image.new("RGB", (16, 16), (180, 120, 60)).save(work / "texture.png")
     # location + Blender Euler rotation per line: two views of the origin from 6 m
     (work / "camera_positions").write_text("0 -6 3 1.1 0 0\n4 -4 3 1.1 0 0.785\n")
 

@@ -102,8 +102,6 @@ UNAVAILABLE = {
     "composite.CameraObjectSampler": "not implemented yet: it re-samples objects and cameras together per "
                                      "scene; use main.Initializer number_of_scenes with object.ObjectPoseSampler "
                                      "and camera.CameraSampler (each scene draws both anew)",
-    "loader.BopLoader": "not implemented yet: BOP datasets load per model with loader.ObjLoader (path: "
-                        "<dataset>/models/obj_000001.ply, scale: 0.001 for mm); writer.BopWriter writes BOP",
     "object.Hide": "not implemented yet: remove objects with manipulators.EntityManipulator by moving them "
                    "out of view",
     "writer.MyWriter": "an example of a user plugin; write it as a hybridgen plugin (entry point "
@@ -270,6 +268,12 @@ def _mesh_initializer(config: dict[str, Any], note: Note) -> list[tuple[str, dic
                               "mat_name", key=f"{where}.{unknown[0]}")
         out.append(("loader.PrimitiveLoader", cfg))
     return out
+
+
+def _bop_loader(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]]]:
+    cfg = dict(config)
+    _shading(cfg, note)
+    return [("loader.BopLoader", cfg)]
 
 
 def _replacer(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]]]:
@@ -606,6 +610,7 @@ TRANSLATORS: dict[str, Callable[..., list[tuple[str, dict[str, Any]]]]] = {
     "object.OnSurfaceSampler": _passthrough("object.OnSurfaceSampler", "objects_to_sample", "surface"),
     "lighting.SurfaceLighting": _passthrough("lighting.SurfaceLighting", "selector"),
     "constructor.BasicMeshInitializer": _mesh_initializer,
+    "loader.BopLoader": _bop_loader,
     "object.ObjectReplacer": _replacer,
     "object.FloorExtractor": _passthrough("object.FloorExtractor", "selector"),
     "manipulators.FloorExtractor": _passthrough("object.FloorExtractor", "selector"),

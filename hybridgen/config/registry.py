@@ -37,6 +37,7 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.floor_extractor",
     "hybridgen.modules.world_manipulator",
     "hybridgen.modules.state_writers",
+    "hybridgen.modules.bop_loader",
 )
 
 MODULES: dict[str, type["Module"]] = {}

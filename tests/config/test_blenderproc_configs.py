@@ -5,6 +5,7 @@ coco_annotations / semantic_segmentation examples on stand-in inputs made here."
 from __future__ import annotations
 
 import json
+import sys
 import textwrap
 from pathlib import Path
 
@@ -427,3 +428,65 @@ def test_coco_annotations_at_blenderprocs_place(tmp_path, notices):
         assert mask.sum() == pytest.approx(ann["area"], abs=1)
     image = coco.dataset["images"][0]
     assert (out / "coco_data" / image["file_name"]).is_file()
+
+
+BOP_REPLICATION_V3 = """\
+    # Args: <path_to_bop_data> <bop_datset_name> <bop_toolkit_path> <output_dir>
+    {
+      "version": 3,
+      "setup": {"blender_install_path": "/home_local/<env:HYBRIDGEN_TEST_SURELY_UNSET>/blender/",
+                "pip": ["h5py", "scikit-image", "pypng==0.0.20"]},
+      "modules": [
+        {"module": "main.Initializer", "config": {"global": {"output_dir": "<args:3>", "sys_paths": ["<args:2>"]}}},
+        {"module": "loader.BopLoader", "config": {"source_frame": ["X", "-Y", "-Z"], "bop_dataset_path":
+            "<args:0>/<args:1>", "mm2m": True, "split": "test", "scene_id": 1, "model_type": ""}},
+        {"module": "lighting.LightLoader", "config": {"lights": [{"type": "POINT", "location": [0, -1, -1],
+                                                                  "energy": 100}]}},
+        {"module": "renderer.RgbRenderer", "config": {"samples": 1, "render_distance": True,
+                                                      "resolution_x": 80, "resolution_y": 60}},
+        {"module": "renderer.SegMapRenderer", "config": {"map_by": "instance"}},
+        {"module": "writer.BopWriter", "config": {"dataset": "<args:1>", "save_world2cam": False,
+            "postprocessing_modules": {"distance": [{"module": "postprocessing.Dist2Depth"}]}}}
+      ]
+    }
+"""
+
+
+def _bop_standin(tmp_path: Path) -> Path:
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "check_bp", Path(__file__).resolve().parents[2] / "tools" / "check_blenderproc_configs.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up
+    spec.loader.exec_module(module)  # type: ignore[union-attr]
+    return module.make_bop_standin(tmp_path / "bop")
+
+
+def test_bop_scene_replication_round_trips_through_the_bop_writer(tmp_path, notices, monkeypatch):
+    monkeypatch.delenv("HYBRIDGEN_TEST_SURELY_UNSET", raising=False)
+    dataset = _bop_standin(tmp_path)
+    gt_in = json.loads((dataset / "test" / "000001" / "scene_gt.json").read_text())
+    config = write(tmp_path, "bop.yaml", BOP_REPLICATION_V3)
+    out = tmp_path / "out"
+    args = [str(tmp_path / "bop"), "lm", str(tmp_path / "toolkit"), str(out)]
+    loaded = load_config(config, args)
+    scene = execute(loaded, build_modules(loaded)[:2]).scene
+    assert [o.name for o in scene.objects] == ["obj_000001", "obj_000002", "obj_000003"]
+    assert [o.category_id for o in scene.objects] == [1, 2, 3]
+    assert all(o.attributes["bop_dataset_name"] == "lm" for o in scene.objects)
+    for image, instances in gt_in.items():  # every camera sees every object where BOP says it is
+        world2cam = np.linalg.inv(scene.camera.keypoints[int(image)])
+        for obj, inst in zip(scene.objects, instances):
+            m2c = world2cam @ obj.local2world @ np.diag([1000.0, 1000.0, 1000.0, 1.0])  # model in mm
+            np.testing.assert_allclose(m2c[:3, :3].ravel(), inst["cam_R_m2c"], atol=1e-9)
+            np.testing.assert_allclose(m2c[:3, 3] * 1000, inst["cam_t_m2c"], atol=1e-6)
+    run_config(config, args)
+    written = out / "bop_data" / "lm" / "train_pbr" / "000000"
+    gt_out = json.loads((written / "scene_gt.json").read_text())
+    for image, instances in gt_in.items():
+        for inst_in, inst_out in zip(instances, gt_out[image]):
+            assert inst_out["obj_id"] == inst_in["obj_id"]
+            np.testing.assert_allclose(inst_out["cam_R_m2c"], inst_in["cam_R_m2c"], atol=1e-6)
+            np.testing.assert_allclose(inst_out["cam_t_m2c"], inst_in["cam_t_m2c"], atol=1e-3)
+    assert (written / "rgb" / "000000.png").is_file() and (written / "depth" / "000001.png").is_file()

@@ -1,0 +1,168 @@
+"""``loader.BopLoader``: objects (and optionally a whole scene) of a BOP dataset, as BlenderProc loads them.
+
+A BOP dataset folder (``bop_dataset_path``, e.g. ``.../bop/lm``) holds ``models[_<model_type>]/obj_<id:06d>.ply``
+(millimetres), ``models*/models_info.json``, ``camera[_<cam_type>].json`` (fx, fy, cx, cy, width, height) and
+split folders ``<split>/<scene_id:06d>/scene_gt.json`` + ``scene_camera.json``.
+
+- Without ``scene_id``: loads ``obj_ids`` (default: every model) - or, with ``sample_objects``,
+  ``num_of_objs_to_sample`` random draws among them (at most ``obj_instances_limit`` copies each) - at the
+  origin, and sets the camera intrinsics from the dataset's camera file.
+- With ``scene_id``: replicates the scene as BlenderProc does. The world is the first image's camera frame
+  (OpenCV axes); every object gets its ``cam_R_m2c``/``cam_t_m2c`` of that image; every image of the scene
+  becomes a keypoint whose cam2world is ``m2w_ref @ inv(m2c_ref)`` (ref: the image's first object), read in
+  the ``source_frame`` (default ``[X, -Y, -Z]``: an OpenCV camera, see docs/conventions.md section 1).
+
+Objects are named as Blender's PLY importer names them (``obj_000001``, clashes ``.001``), get
+``category_id`` = their BOP obj_id and the attribute ``bop_dataset_name`` (the folder's name), which
+writer.BopWriter uses. ``mm2m`` scales models and poses from millimetres to metres.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..config.blenderproc import custom_properties
+from ..config.camera_poses import source_frame_axes
+from ..config.notices import notice
+from ..config.registry import register_module
+from ..config.schema import Param
+from ..errors import InputError
+from ..io.mesh_loader import load_objects
+from ..run.context import RunContext
+from ..scene.camera import Intrinsics
+from ..scene.frames import BLENDER_TO_OPENCV
+from .base import Module
+from .obj_loader import add_with_blender_names
+
+
+def _read_json(path: Path) -> Any:
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError(f"BOP file not found: '{path}'") from None
+    except (OSError, json.JSONDecodeError) as exc:
+        raise InputError(f"cannot read BOP file '{path}': {exc}") from None
+
+
+def _pose(rotation: Any, translation: Any, scale: float) -> np.ndarray:
+    pose = np.eye(4)
+    pose[:3, :3] = np.asarray(rotation, dtype=np.float64).reshape(3, 3)
+    pose[:3, 3] = np.asarray(translation, dtype=np.float64).reshape(3) * scale
+    return pose
+
+
+@register_module("loader.BopLoader")
+class BopLoader(Module):
+    """Loads BOP models (sampled, listed or all) or replicates a BOP scene with its cameras."""
+
+    params = (
+        Param("bop_dataset_path", "path", doc="the dataset's folder, e.g. <bop>/lm"),
+        Param("model_type", "str", "", doc="models folder suffix: '' (models), cad, eval, reconst ..."),
+        Param("cam_type", "str", "", doc="camera file suffix: '' (camera.json) or e.g. primesense"),
+        Param("split", "str", "test", doc="split folder for scene replication (test, val, train ...)"),
+        Param("scene_id", "int", -1, doc="scene to replicate (-1: load objects only)"),
+        Param("obj_ids", "list", [], doc="BOP object ids to load (default: every model)"),
+        Param("sample_objects", "bool", False, doc="draw num_of_objs_to_sample objects among obj_ids"),
+        Param("num_of_objs_to_sample", "int|null", None, doc="how many objects to draw"),
+        Param("obj_instances_limit", "int", -1, doc="at most this many copies of one model (-1: no limit)"),
+        Param("move_origin_to_x_y_plane", "bool", False, doc="put each model's origin at the centre of its "
+              "bottom (for filler objects; not for pose annotations)"),
+        Param("source_frame", "list", ["X", "-Y", "-Z"], doc="axes of the scene's camera poses in Blender's "
+              "camera axes; the default is OpenCV's"),
+        Param("mm2m", "bool", False, doc="models and poses from millimetres to metres"),
+        Param("add_properties", "dict", {}, doc="cp_* custom properties of every loaded object"),
+    )
+
+    def run(self, context: RunContext) -> None:
+        cfg = self.config
+        root = Path(cfg["bop_dataset_path"])
+        if not root.is_dir():
+            raise InputError(f"BOP dataset folder not found: '{root}'")
+        scale = 0.001 if cfg["mm2m"] else 1.0
+        models = root / ("models" + (f"_{cfg['model_type']}" if cfg["model_type"] else ""))
+        camera = _read_json(root / ("camera" + (f"_{cfg['cam_type']}" if cfg["cam_type"] else "") + ".json"))
+        labels: dict[str, Any] = {}
+        custom_properties(cfg["add_properties"], labels)
+        if cfg["scene_id"] < 0:
+            ids = self._object_ids(context, models)
+            poses = [np.eye(4)] * len(ids)
+            context.scene.camera.intrinsics = Intrinsics(
+                [[camera["fx"], 0, camera["cx"]], [0, camera["fy"], camera["cy"]], [0, 0, 1]],
+                int(camera["width"]), int(camera["height"]))
+        else:
+            ids, poses = self._replicate(context, root, camera, scale)
+        for obj_id, pose in zip(ids, poses):
+            path = models / f"obj_{int(obj_id):06d}.ply"
+            objects = load_objects(path, category_id=int(obj_id), up_axis="auto",
+                                   attributes={"bop_dataset_name": root.name, **labels.get("attributes", {})},
+                                   local2world=pose @ np.diag([scale, scale, scale, 1.0]))
+            for obj in objects:
+                if "category_id" in labels:
+                    obj.category_id = labels["category_id"]
+                if cfg["move_origin_to_x_y_plane"]:
+                    self._origin_to_bottom(obj)
+            add_with_blender_names(context, objects, renamed=True)
+
+    def _object_ids(self, context: RunContext, models: Path) -> list[int]:
+        cfg = self.config
+        ids = [int(i) for i in cfg["obj_ids"]]
+        if not ids:
+            info = _read_json(models / "models_info.json")
+            ids = sorted(int(k) for k in info)
+        if not cfg["sample_objects"]:
+            return ids
+        count = cfg["num_of_objs_to_sample"]
+        if count is None or count < 1:
+            raise InputError("sample_objects needs num_of_objs_to_sample >= 1")
+        limit = cfg["obj_instances_limit"]
+        if limit != -1 and len(set(ids)) * limit < count:
+            raise InputError(f"{len(set(ids))} models with at most {limit} copies each cannot give {count} objects")
+        drawn: list[int] = []
+        copies: dict[int, int] = {}
+        while len(drawn) < count:
+            pick = ids[int(context.rng.integers(len(ids)))]
+            if limit == -1 or copies.get(pick, 0) < limit:
+                copies[pick] = copies.get(pick, 0) + 1
+                drawn.append(pick)
+        return drawn
+
+    def _replicate(self, context: RunContext, root: Path, camera: dict[str, Any],
+                   scale: float) -> tuple[list[int], list[np.ndarray]]:
+        cfg = self.config
+        scene_dir = root / cfg["split"] / f"{cfg['scene_id']:06d}"
+        gt = _read_json(scene_dir / "scene_gt.json")
+        cams = _read_json(scene_dir / "scene_camera.json")
+        if not gt:
+            raise InputError(f"'{scene_dir / 'scene_gt.json'}' lists no image")
+        axes = np.eye(4)
+        axes[:3, :3] = source_frame_axes(cfg["source_frame"]).T
+        first = None
+        ids: list[int] = []
+        poses: list[np.ndarray] = []
+        ks = []
+        for image_id in sorted(gt, key=int):
+            instances = gt[image_id]
+            ref = _pose(instances[0]["cam_R_m2c"], instances[0]["cam_t_m2c"], scale)
+            if first is None:  # world = this first camera's frame
+                first = ref
+                ids = [int(inst["obj_id"]) for inst in instances]
+                poses = [_pose(inst["cam_R_m2c"], inst["cam_t_m2c"], scale) for inst in instances]
+            cam2world = first @ np.linalg.inv(ref)  # the given (source-frame) camera
+            context.scene.camera.add_keypoint(cam2world @ axes @ BLENDER_TO_OPENCV)
+            ks.append(np.asarray(cams[str(image_id)]["cam_K"], dtype=np.float64).reshape(3, 3))
+        if any(not np.allclose(k, ks[0]) for k in ks):
+            notice("the scene's images have different cam_K; hybridgen cameras have one K, the first image's",
+                   module=self.module_name, index=self.index, key="scene_id")
+        context.scene.camera.intrinsics = Intrinsics(ks[0], int(camera["width"]), int(camera["height"]))
+        return ids, poses
+
+    @staticmethod
+    def _origin_to_bottom(obj: Any) -> None:
+        """Move the mesh so its origin is the centre of its bottom (local frame), keeping its world place."""
+        low, high = obj.bounds_local
+        shift = np.array([(low[0] + high[0]) / 2, (low[1] + high[1]) / 2, low[2]])
+        obj.vertices = obj.vertices - shift
+        obj.local2world = obj.local2world @ np.block([[np.eye(3), shift[:, None]], [np.zeros((1, 3)), 1.0]])
