@@ -36,8 +36,12 @@ def _update_dataset(digest: "hashlib._Hash", name: str, dset: h5py.Dataset) -> N
         _update_value(digest, dset[()])
         return
     dsid = dset.id
-    for i in range(dsid.get_num_chunks()):
-        info = dsid.get_chunk_info(i)
+    infos: list[Any] = []
+    if hasattr(dsid, "chunk_iter"):  # HDF5 >= 1.12.3: one pass over the chunk index (20x faster)
+        dsid.chunk_iter(infos.append)
+    else:
+        infos = [dsid.get_chunk_info(i) for i in range(dsid.get_num_chunks())]
+    for info in sorted(infos, key=lambda item: item.chunk_offset):
         mask, data = dsid.read_direct_chunk(info.chunk_offset)
         digest.update(f"{info.chunk_offset}:{mask}:{len(data)}".encode())
         digest.update(data)

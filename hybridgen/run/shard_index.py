@@ -11,6 +11,7 @@ so the same shards give the same bytes.
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -62,52 +63,78 @@ def _virtual(h5: h5py.File, key: str, pieces: list[tuple[str, int, int, tuple[in
                     dcpl=dcpl)
 
 
+@dataclass
+class _Shard:
+    """What the index needs of one shard, read with only that shard open (an index over 100k shards must
+    not hold 100k open files and their caches)."""
+
+    name: str  # relative to the index's folder
+    count: int
+    scene: int
+    digest: str
+    layouts: dict[str, tuple[Any, tuple[int, ...]]]  # per-keypoint key -> (dtype, shape)
+    strings: dict[str, np.ndarray]  # per-keypoint JSON keys (copied, cannot be virtual)
+    records: dict[str, Any]  # SCENE_RECORDS, for a scene's first chunk
+
+
+def _read_shard(shard: Path, folder: Path, first_of_scene: set[int]) -> _Shard:
+    with h5py.File(shard, "r") as f:
+        count = len(f["keypoint_index"])
+        scene = int(f.attrs["scene_index"])
+        layouts, strings = {}, {}
+        for key in f:
+            dset = f[key]
+            if not isinstance(dset, h5py.Dataset) or dset.shape[:1] != (count,) or key in SCENE_RECORDS:
+                continue
+            if h5py.check_string_dtype(dset.dtype) is not None:
+                strings[key] = dset[()]
+            layouts[key] = (dset.dtype, dset.shape)
+        records = {}
+        if scene not in first_of_scene:
+            first_of_scene.add(scene)
+            records = {key: f[key][()] for key in SCENE_RECORDS if key in f}
+        return _Shard(str(Path(shard).relative_to(folder)), count, scene, _text(f.attrs.get(DIGEST_ATTR, "")),
+                      layouts, strings, records)
+
+
 def build_index(path: Path, shards: list[Path], fingerprint: str | None = None) -> Path:
     """Write ``path`` over ``shards`` (already in scene, chunk order); returns ``path``. The index records
     each shard's ``content_sha256`` (attribute ``shard_digests``, JSON: relative path -> digest) and the
-    run's ``fingerprint``; it is sealed itself (:func:`hybridgen.io.integrity.seal`)."""
-    opened = [h5py.File(shard, "r") for shard in shards]
-    try:
-        counts = [len(f["keypoint_index"]) for f in opened]
-        per_keypoint = [k for k in opened[0] if isinstance(opened[0][k], h5py.Dataset)
-                        and opened[0][k].shape[:1] == (counts[0],) and k not in SCENE_RECORDS]
-        temp = temporary_path(path)
-        with h5py.File(temp, "w", libver="v110") as index:
-            offsets = np.concatenate([[0], np.cumsum(counts)])
-            for key in per_keypoint:
-                first = opened[0][key]
-                if h5py.check_string_dtype(first.dtype) is not None:
-                    values = np.concatenate([f[key][()] for f in opened])
-                    index.create_dataset(key, data=values, dtype=first.dtype, track_times=False)
-                    continue
-                pieces = [(str(Path(shard).relative_to(path.parent)), int(offsets[i]), counts[i], f[key].shape)
-                          for i, (shard, f) in enumerate(zip(shards, opened))]
-                _virtual(index, key, pieces, first.dtype, first.shape[1:])
-                for name, value in first.attrs.items():  # how the pass is stored (encoding), read by decoders
-                    index[key].attrs[name] = value
-            scenes = np.concatenate([[f.attrs["scene_index"]] * c for f, c in zip(opened, counts)]).astype(np.int64)
-            index.create_dataset("scene_index", data=scenes, track_times=False)
-            first_chunks = {}
-            for f in opened:
-                first_chunks.setdefault(int(f.attrs["scene_index"]), f)
-            for key in SCENE_RECORDS:
-                if key in opened[0]:
-                    values = [first_chunks[s][key][()] for s in sorted(first_chunks)]
-                    index.create_dataset(key, data=values, dtype=h5py.string_dtype(), track_times=False)
-            for key, value in opened[0].attrs.items():
-                if key not in UNIT_ATTRIBUTES:
-                    index.attrs[key] = value
-            index.attrs["number_of_scenes"] = len(first_chunks)
-            index.attrs["layout"] = "sharded: virtual datasets over shards/*.hdf5"
-            digests = {str(Path(shard).relative_to(path.parent)): _text(f.attrs.get(DIGEST_ATTR, ""))
-                       for shard, f in zip(shards, opened)}
-            index.attrs[SHARD_DIGESTS_ATTR] = json.dumps(digests, sort_keys=True)
-            if fingerprint is not None:
-                index.attrs[FINGERPRINT_ATTR] = fingerprint
-            seal(index)
-    finally:
-        for f in opened:
-            f.close()
+    run's ``fingerprint``; it is sealed itself (:func:`hybridgen.io.integrity.seal`). Shards are read one
+    at a time."""
+    first_of_scene: set[int] = set()
+    infos = [_read_shard(shard, path.parent, first_of_scene) for shard in shards]
+    with h5py.File(shards[0], "r") as first:
+        run_attributes = {k: v for k, v in first.attrs.items() if k not in UNIT_ATTRIBUTES}
+        key_attributes = {key: dict(first[key].attrs) for key in infos[0].layouts}
+    offsets = np.concatenate([[0], np.cumsum([info.count for info in infos])])
+    temp = temporary_path(path)
+    with h5py.File(temp, "w", libver="v110") as index:
+        for key, (dtype, shape) in infos[0].layouts.items():
+            if key in infos[0].strings:
+                values = np.concatenate([info.strings[key] for info in infos])
+                index.create_dataset(key, data=values, dtype=dtype, track_times=False)
+                continue
+            pieces = [(info.name, int(offsets[i]), info.count, info.layouts[key][1]) for i, info in enumerate(infos)]
+            # shards of different scenes may store ids in different narrow types: the widest holds all
+            _virtual(index, key, pieces, np.result_type(*(info.layouts[key][0] for info in infos)), shape[1:])
+            for name, value in key_attributes[key].items():  # how the pass is stored (encoding), read by decoders
+                index[key].attrs[name] = value
+        scenes = np.concatenate([[info.scene] * info.count for info in infos]).astype(np.int64)
+        index.create_dataset("scene_index", data=scenes, track_times=False)
+        firsts = sorted((info for info in infos if info.records), key=lambda info: info.scene)
+        for key in SCENE_RECORDS:
+            if key in infos[0].records:
+                index.create_dataset(key, data=[info.records[key] for info in firsts], dtype=h5py.string_dtype(),
+                                     track_times=False)
+        for key, value in run_attributes.items():
+            index.attrs[key] = value
+        index.attrs["number_of_scenes"] = len(firsts)
+        index.attrs["layout"] = "sharded: virtual datasets over shards/*.hdf5"
+        index.attrs[SHARD_DIGESTS_ATTR] = json.dumps({info.name: info.digest for info in infos}, sort_keys=True)
+        if fingerprint is not None:
+            index.attrs[FINGERPRINT_ATTR] = fingerprint
+        seal(index)
     commit(temp, path)
     return path
 
