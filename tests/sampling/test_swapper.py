@@ -63,12 +63,15 @@ def test_swapper_keeps_categories_ids_and_avoids_collisions(write_config):
     scene = context.scene
     assert [o.name for o in scene.objects if o.attributes.get("pool")] == []  # templates removed
     originals = {o.instance_id: o for o in before.scene.objects if o.attributes.get("swap")}
+    assert len(originals) == 4
     ids = [o.instance_id for o in scene.objects]
-    assert len(set(ids)) == len(ids)
-    for obj in scene.objects:
-        if obj.instance_id not in originals:
-            continue
-        original = originals[obj.instance_id]
+    assert len(set(ids)) == len(ids) and ids == sorted(ids)  # unique, each replacement in its original's slot
+    pool_ids = {o.instance_id for o in before.scene.objects if o.attributes.get("pool")}
+    # every original id survives; the removed templates' ids are gone and not reassigned
+    assert set(ids) == {o.instance_id for o in before.scene.objects} - pool_ids
+    by_id = {o.instance_id: o for o in scene.objects}
+    for instance_id, original in originals.items():
+        obj = by_id[instance_id]  # each of the 4 swapped objects is checked; none may be skipped
         assert obj.attributes["swapped_from"] == original.name
         assert obj.category_id == original.category_id
         assert obj.name in {"cone_template", "knot_template", "crate"} if obj.category_id == 2 else \
