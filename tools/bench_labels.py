@@ -18,7 +18,9 @@ import argparse
 import importlib.util
 import multiprocessing as mp
 import os
+import shutil
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -88,7 +90,8 @@ def _ours_worker(conn: Any) -> None:
                 with tempfile.TemporaryDirectory() as tmp:
                     path = Path(tmp) / "data.hdf5"
                     start = time.perf_counter()
-                    writer = hg.Hdf5SingleFileWriter(path, compression=compression.split("-")[0])
+                    writer = (hg.Hdf5SingleFileWriter(path) if compression == "default" else
+                              hg.Hdf5SingleFileWriter(path, compression=compression.split("-")[0]))
                     label_pass(scene, view, keypoints, [writer])
                     writer.finalize({"object_states": [o.state() for o in scene.objects]})
                     elapsed = time.perf_counter() - start
@@ -205,6 +208,173 @@ def _compare(depth: Any, ids: Any, ref_depth: Any, ref_ids: Any) -> str:
             f"  |dz| median {np.median(dz) * 1000:8.4f} mm  p99 {np.percentile(dz, 99) * 1000:8.2f} mm"
             f"  >1 cm {100 * np.mean(dz > 0.01):5.2f} %")
 
+# ---------------------------------------------------------------- whole processes
+
+PYRENDER_SCRIPT = "pyrender-script"
+"""argv[1] of this file that makes it the pyrender reference: a script a user would write."""
+
+
+def pyrender_script(spec_path: str) -> None:
+    """The reference a user compares with: load the same mesh files with trimesh, render depth + segmentation
+    (colour-coded ids, decoded) of the same poses with pyrender, write nothing. Runs as its own process."""
+    os.environ["PYOPENGL_PLATFORM"] = "egl"
+    import json
+
+    import numpy as np
+
+    if not hasattr(np, "infty"):
+        np.infty = np.inf  # pyrender 0.1.45 still uses the alias removed in NumPy 2
+    import pyrender
+    import trimesh
+
+    spec = json.loads(Path(spec_path).read_text())
+    scene = pyrender.Scene()
+    seg = {}
+    instance = 0
+    for entry in spec["meshes"]:
+        kwargs = {"file_type": "obj", "force": "scene"} if entry["path"].endswith(".obj") else {}
+        loaded = trimesh.load(entry["path"], process=False, **kwargs)
+        geometries = list(loaded.geometry.values()) if isinstance(loaded, trimesh.Scene) else [loaded]
+        for geometry in geometries:
+            instance += 1
+            node = scene.add(pyrender.Mesh.from_trimesh(geometry), pose=np.asarray(entry["pose"]))
+            seg[node] = [instance % 256, instance // 256, 0]
+    K, (width, height) = np.asarray(spec["K"]), spec["resolution"]
+    camera = scene.add(pyrender.IntrinsicsCamera(K[0, 0], K[1, 1], K[0, 2] + 0.5, K[1, 2] + 0.5,
+                                                 znear=spec["clip"][0], zfar=spec["clip"][1]))
+    renderer = pyrender.OffscreenRenderer(width, height)
+    flip = np.diag([1.0, -1.0, -1.0, 1.0])  # OpenCV camera axes -> OpenGL camera axes
+    for pose in spec["poses"]:
+        scene.set_pose(camera, np.asarray(pose) @ flip)
+        color, depth = renderer.render(scene, flags=pyrender.RenderFlags.SEG, seg_node_map=seg)
+        ids = color[..., 0].astype(np.int32) + 256 * color[..., 1].astype(np.int32)
+        assert depth.shape == ids.shape == (height, width)
+    renderer.delete()
+
+
+def export_assets(name: str, folder: Path) -> list[dict[str, Any]]:
+    """The scene's mesh files: the monastery as pybullet_data's OBJ itself; the other scenes written once as
+    binary PLY in world coordinates (vertex normals kept where the object has them). Each entry: path,
+    category_id, 4x4 pose (identity unless the file is +Y up)."""
+    import bench_scenes as bs
+    import numpy as np
+    import trimesh
+
+    if name.startswith("monastery"):
+        y_up = np.array([[1.0, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1]])
+        return [{"path": str(bs.pybullet_data_dir() / "samurai_monastry.obj"), "category_id": 1,
+                 "up_axis": "Y", "pose": y_up.tolist()}]
+    scene = bs.ALL_SCENES[name]()
+    folder.mkdir(parents=True, exist_ok=True)
+    entries = []
+    for i, obj in enumerate(scene.objects):
+        path = folder / f"{i:03d}.ply"
+        if not path.exists():
+            normals = None
+            if obj.vertex_normals is not None:
+                normals = obj.vertex_normals @ np.linalg.inv(obj.local2world[:3, :3])  # inverse transpose
+                normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+            mesh = trimesh.Trimesh(obj.world_vertices(), obj.faces, vertex_normals=normals, process=False)
+            temp = path.with_suffix(".tmp")
+            temp.write_bytes(mesh.export(file_type="ply"))
+            temp.rename(path)
+        entries.append({"path": str(path), "category_id": int(obj.category_id or 1), "up_axis": "Z",
+                        "pose": np.eye(4).tolist()})
+    return entries
+
+
+def write_configs(name: str, resolution: str, count: int, folder: Path) -> tuple[Path, Path]:
+    """A labels-only hybridgen config (depth + normals + class + instance, default HDF5 writer) and the
+    pyrender script's spec: the same meshes, intrinsics and ``count`` poses."""
+    import json
+
+    import bench_scenes as bs
+    import numpy as np
+
+    meshes = export_assets(name, Path(tempfile.gettempdir()) / "hybridgen_bench_assets" / name.split()[0])
+    scene = bs.ALL_SCENES[name]()
+    width, height = bs.RESOLUTIONS[resolution]
+    intr = bs.intrinsics(width, height)
+    poses = bs.orbit_poses(scene, count)
+    lines = ["global: {all: {output_dir: \"<args:0>\"}}", "modules:",
+             "  - {name: main.Initializer, config: {seed: 1}}"]
+    for i, entry in enumerate(meshes):
+        lines.append(f"  - {{name: loader.ObjLoader, config: {{path: '{entry['path']}', name: m{i}, "
+                     f"category_id: {entry['category_id']}, up_axis: {entry['up_axis']}}}}}")
+    K = [float(v) for v in intr.K.ravel()]
+    lines.append(f"  - name: camera.CameraLoader\n    config:\n      intrinsics: {{resolution_x: {width}, "
+                 f"resolution_y: {height}, cam_K: {K}, clip_start: {intr.clip_start}, clip_end: {intr.clip_end}}}\n"
+                 "      cam_poses:")
+    for pose in poses:
+        lines.append(f"        - {{cam2world_matrix: {[float(v) for v in pose.ravel()]}, source_frame: [X, Y, Z]}}")
+    lines.append("  - {name: renderer.SegMapRenderer, config: {render_depth: true, render_normals: true, "
+                 "map_by: [class, instance]}}")
+    lines.append("  - {name: writer.Hdf5Writer}")
+    folder.mkdir(parents=True, exist_ok=True)
+    stem = f"{name.split()[0]}_{resolution}_{count}"
+    config = folder / f"{stem}.yaml"
+    config.write_text("\n".join(lines) + "\n")
+    spec = folder / f"{stem}.json"
+    spec.write_text(json.dumps({"meshes": meshes, "K": intr.K.tolist(), "resolution": [width, height],
+                                "clip": [intr.clip_start, intr.clip_end], "poses": [p.tolist() for p in poses]}))
+    return config, spec
+
+
+def run_timed(command: list[str], env: dict[str, str]) -> float:
+    """Wall seconds of one whole process (fails loudly)."""
+    start = time.perf_counter()
+    done = subprocess.run(command, env=env, capture_output=True, text=True)
+    elapsed = time.perf_counter() - start
+    if done.returncode != 0:
+        raise SystemExit(f"{' '.join(command)} failed ({done.returncode}):\n{done.stdout[-2000:]}{done.stderr[-4000:]}")
+    return elapsed
+
+
+def whole_process_table(names: list[str], resolutions: list[str], count: int, rounds: int,
+                        ask: Any, cache_dir: Path) -> None:
+    """The issue's table: whole ``hybridgen run`` vs the pyrender script, alternating, plus raw / in-process
+    end-to-end label fps, bytes per keypoint and time to first keypoint (1-keypoint runs)."""
+    hybridgen = [sys.executable, "-m", "hybridgen"]  # the package on sys.path (PYTHONPATH: another checkout)
+    env = dict(os.environ, HYBRIDGEN_CACHE_DIR=str(cache_dir))
+    print(f"\nwhole processes, {count} keypoints, {rounds} alternating rounds, medians; hybridgen run = labels-only "
+          "config (depth + normals + class + instance, default writer); pyrender = script loading the same files, "
+          "rendering depth + seg of the same poses, writing nothing; mesh cache in "
+          f"{cache_dir} (warmed by an untimed run)")
+    print(f"{'scene':<20} {'resolution':<10} {'raw fps':>8} {'e2e fps':>8} {'run fps':>8} {'pyrender':>9} "
+          f"{'ratio':>6} {'MB/kp':>6} {'1st kp run':>11} {'1st kp pyr':>11}")
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        for name in names:
+            for resolution in resolutions:
+                config, spec = write_configs(name, resolution, count, work / "configs")
+                config1, spec1 = write_configs(name, resolution, 1, work / "configs")
+                out = work / "out"
+                ours_cmd = [*hybridgen, "run", "--quiet", str(config), str(out)]
+                theirs_cmd = [sys.executable, __file__, PYRENDER_SCRIPT, str(spec)]
+                run_timed([*hybridgen, "run", "--quiet", str(config1), str(work / "warm")], env)  # warms caches
+                times: dict[str, list[float]] = {"ours": [], "theirs": [], "ours1": [], "theirs1": []}
+                size = 0
+                for r in range(rounds):
+                    order = ("ours", "theirs") if r % 2 == 0 else ("theirs", "ours")
+                    for engine in order:
+                        if engine == "ours":
+                            shutil.rmtree(out, ignore_errors=True)
+                            times["ours"].append(run_timed(ours_cmd, env))
+                            size = sum(f.stat().st_size for f in out.rglob("*.hdf5"))
+                            shutil.rmtree(work / "one", ignore_errors=True)
+                            times["ours1"].append(run_timed([*hybridgen, "run", "--quiet", str(config1),
+                                                             str(work / "one")], env))
+                        else:
+                            times["theirs"].append(run_timed(theirs_cmd, env))
+                            times["theirs1"].append(run_timed([sys.executable, __file__, PYRENDER_SCRIPT,
+                                                               str(spec1)], env))
+                med = {k: statistics.median(v) for k, v in times.items()}
+                raw = ask("ours", "raw", name, resolution, 8)
+                e2e, _ = ask("ours", "hdf5", name, resolution, 8, "default")
+                print(f"{name:<20} {resolution:<10} {raw:>8.1f} {e2e:>8.1f} {count / med['ours']:>8.1f} "
+                      f"{count / med['theirs']:>9.1f} {med['theirs'] / med['ours']:>6.2f} {size / count / 1e6:>6.2f} "
+                      f"{med['ours1']:>10.2f}s {med['theirs1']:>10.2f}s", flush=True)
+
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -221,6 +391,12 @@ def main() -> None:
                         help="depth/id agreement of both engines with a ray cast (default: on unless --quick)")
     parser.add_argument("--breakdown", action="store_true", help="also time our stages serially per keypoint")
     parser.add_argument("--skip-pyrender", action="store_true", help="only the HDF5 end-to-end part")
+    parser.add_argument("--keypoints", type=int, default=120, help="keypoints of the whole-process runs")
+    parser.add_argument("--whole-rounds", type=int, default=3, help="alternating rounds of the whole-process runs")
+    parser.add_argument("--inner", action="store_true", help="also the in-process sections: raster pass vs "
+                        "pyrender, --breakdown, --check, end to end per compression")
+    parser.add_argument("--cache-dir", type=Path, help="HYBRIDGEN_CACHE_DIR of the whole-process runs "
+                        "(default: a fresh temporary folder, warmed by an untimed run)")
     args = parser.parse_args()
 
     import bench_scenes as bs
@@ -255,6 +431,14 @@ def main() -> None:
     triangles = {name: bs.ALL_SCENES[name]().triangle_count for name in names}
     print(f"{frames} keypoints per round, {rounds} rounds, median frames/s; ours = depth + normals + instance + class; "
           f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f} (other processes skew absolute numbers)")
+    with tempfile.TemporaryDirectory() as cache:
+        whole_process_table(names, resolutions, 20 if args.quick else args.keypoints,
+                            2 if args.quick else args.whole_rounds, ask, args.cache_dir or Path(cache))
+    if not args.inner:
+        for conn, process in workers.values():
+            conn.send(None)
+            process.join(timeout=10)
+        return
     if not args.skip_pyrender:
         print(f"\n{'scene':<20} {'resolution':<10} {'triangles':>10} {'ours fps':>9} {'pyrender fps':>13} "
               f"{'ours/pyrender':>14}")
@@ -313,4 +497,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    if len(sys.argv) == 3 and sys.argv[1] == PYRENDER_SCRIPT:
+        pyrender_script(sys.argv[2])
+    else:
+        main()

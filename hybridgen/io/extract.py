@@ -35,6 +35,7 @@ from ..render.tonemap import to_srgb8
 from ..run.shard_index import check_index_sources
 from .atomic import prepare_output_dir
 from .integrity import DIGEST_ATTR, verify
+from .label_encoding import decode_dataset
 from .image_files import json_bytes, npy_bytes, png_bytes, write_exr_file, write_file
 
 FORMATS = ("png", "npy", "exr")
@@ -244,7 +245,7 @@ def _exr_writer(samples: np.ndarray, names: Sequence[str] | None) -> Callable[[P
 def _write_key(h5: h5py.File, source: Source, index: int, key: str, out: Path, fmt: str,
                depth_scale: float) -> tuple[int, list[Path]]:
     dset = h5[key]
-    value = dset[()] if source.per_keypoint else dset[index]
+    value = decode_dataset(dset, () if source.per_keypoint else index)  # compact encodings: documented dtypes
     base = f"{_stem(source, index)}_{key}"
     if key in source.texts:
         text = _decode_text(value)

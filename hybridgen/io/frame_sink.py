@@ -14,6 +14,7 @@ class PassLayout:
     key: str
     dtype: str
     shape: tuple[int, ...]
+    value_range: tuple[int, int] | None = None  # integer passes: the lowest and highest value they can hold
 
 
 class FrameSink(Protocol):

@@ -1,16 +1,25 @@
-"""The default HDF5 output (docs/conventions.md section 4): one file, every pass a dataset with a leading keypoint axis.
+"""The default HDF5 output (docs/conventions.md section 4): one file, every pass a dataset with a leading
+keypoint axis.
 
-Chunks hold one keypoint each. Writing happens on a background thread, so keypoint i+1 renders while
-keypoint i is compressed (zlib releases the GIL) and written: gzip chunks are deflated here and stored
-with ``write_direct_chunk``, bit-identical to what HDF5's own gzip filter makes. The file is written under
-a temporary name and renamed only when complete.
+Chunks hold one keypoint each. Passes are stored compactly by default (``encoding="compact"``: ids in the
+smallest integer type, octahedral uint16 normals, distance derived from depth - see
+:mod:`hybridgen.io.label_encoding`, whose :func:`~hybridgen.io.label_encoding.decode_dataset` reads them
+back); ``encoding="plain"`` stores the documented dtypes as they are.
+
+Writing never blocks the render thread: each pass of a keypoint is encoded, byte-shuffled (float passes)
+and deflated on a thread pool (numpy and zlib release the GIL), while one writer thread stores the finished
+chunks in keypoint order with ``write_direct_chunk`` - bit-identical to what HDF5's shuffle + gzip filters
+make, so any HDF5 reader opens the file, and the file's bytes do not depend on thread timing. The file is
+written under a temporary name and renamed only when complete.
 """
 from __future__ import annotations
 
 import json
+import os
 import queue
 import threading
 import zlib
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -21,9 +30,23 @@ from ..errors import InputError
 from .atomic import commit, prepare_output_dir, temporary_path
 from .frame_sink import PassLayout
 from .integrity import seal
+from .label_encoding import StoredPass, plan_storage
 
 COMPRESSIONS = ("gzip", "lzf", "none")
+ENCODINGS = ("compact", "plain")
 _STOP = object()
+
+
+def default_threads() -> int:
+    """Compressor threads: the cores left over by the render thread (at least one)."""
+    return max(1, (os.cpu_count() or 2) - 1)
+
+
+def shuffled(array: np.ndarray) -> np.ndarray:
+    """The bytes HDF5's shuffle filter makes of a contiguous ``array``: byte k of every element together."""
+    if array.itemsize == 1:
+        return array
+    return np.ascontiguousarray(array.reshape(-1).view(np.uint8).reshape(-1, array.itemsize).T)
 
 
 class Hdf5SingleFileWriter:
@@ -33,16 +56,22 @@ class Hdf5SingleFileWriter:
     """
 
     def __init__(self, path: str | Path, *, compression: str = "gzip", compression_level: int = 1,
-                 queue_size: int = 3) -> None:
+                 encoding: str = "compact", threads: int | None = None, queue_size: int = 3) -> None:
         if compression not in COMPRESSIONS:
             raise InputError(f"compression must be one of {COMPRESSIONS}, got {compression!r}")
+        if encoding not in ENCODINGS:
+            raise InputError(f"encoding must be one of {ENCODINGS}, got {encoding!r}")
         self.path = Path(path)
         prepare_output_dir(self.path.parent)
         self.compression = compression
         self.level = int(compression_level)
+        self.encoding = encoding
+        self.threads = default_threads() if threads is None else max(1, int(threads))
         self._temp = temporary_path(self.path)
         self._file: h5py.File | None = None
         self._layouts: dict[str, PassLayout] = {}
+        self._stored: dict[str, StoredPass] = {}
+        self._pool: ThreadPoolExecutor | None = None
         self._queue: queue.Queue[Any] = queue.Queue(maxsize=queue_size)
         self._thread: threading.Thread | None = None
         self._error: BaseException | None = None
@@ -54,10 +83,12 @@ class Hdf5SingleFileWriter:
         """Create the datasets of one renderer's passes and store the camera records (checked if present)."""
         self._drain()
         h5 = self._open()
+        keys = {layout.key for layout in layouts} | set(self._layouts)
+        background = float(attributes.get("depth_background", h5.attrs.get("depth_background", np.inf)))
         for layout in layouts:
             if layout.key in h5:
                 raise InputError(f"output key '{layout.key}' is produced twice (two renderers write it)")
-            self._create(h5, layout, n_keypoints)
+            self._create(h5, layout, n_keypoints, keys, background)
             self._layouts[layout.key] = layout
         for key, value in camera_records.items():
             if key in h5:
@@ -67,13 +98,23 @@ class Hdf5SingleFileWriter:
                 h5.create_dataset(key, data=value, track_times=False)
         for key, value in attributes.items():
             h5.attrs[key] = value
+        if self._pool is None:
+            self._pool = ThreadPoolExecutor(self.threads, thread_name_prefix="hdf5-compress")
         self._thread = threading.Thread(target=self._work, name="hdf5-writer", daemon=True)
         self._thread.start()
 
     def write(self, index: int, values: dict[str, Any]) -> None:
-        """Queue keypoint ``index``'s values (arrays or JSON-ready objects) for writing."""
+        """Queue keypoint ``index``'s values (arrays or JSON-ready objects): their chunks are made on the
+        thread pool now and stored in keypoint order by the writer thread."""
         self._raise_worker_error()
-        self._queue.put((index, values))
+        assert self._pool is not None, "write() before begin()"
+        jobs: dict[str, Any] = {}
+        for key, value in values.items():
+            if self._layouts[key].dtype == "json":
+                jobs[key] = value
+            else:
+                jobs[key] = self._pool.submit(self._chunk, key, index, value)
+        self._queue.put((index, jobs))
 
     def end(self) -> None:
         """Wait until every queued keypoint is written."""
@@ -91,6 +132,7 @@ class Hdf5SingleFileWriter:
         seal(h5)  # content_sha256: resume and readers verify the file with it
         h5.close()
         self._file = None
+        self._shutdown_pool()
         commit(self._temp, self.path)
         return self.path
 
@@ -106,6 +148,7 @@ class Hdf5SingleFileWriter:
             except Exception:
                 pass
             self._file = None
+        self._shutdown_pool()
         self._temp.unlink(missing_ok=True)
 
     # ------------------------------------------------------------------ internals
@@ -117,17 +160,43 @@ class Hdf5SingleFileWriter:
                 raise InputError(f"cannot write '{self._temp.parent}': {exc}") from None
         return self._file
 
-    def _create(self, h5: h5py.File, layout: PassLayout, n: int) -> None:
+    def _shutdown_pool(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(wait=True)
+            self._pool = None
+
+    def _create(self, h5: h5py.File, layout: PassLayout, n: int, keys: set[str], depth_background: float) -> None:
         if layout.dtype == "json":
             h5.create_dataset(layout.key, shape=(n,), dtype=h5py.string_dtype(), track_times=False)
             return
+        stored = plan_storage(layout, compact=self.encoding == "compact", keys=keys,
+                              depth_background=depth_background)
+        self._stored[layout.key] = stored
         options: dict[str, Any] = {}
-        if self.compression == "gzip":
-            options = {"compression": "gzip", "compression_opts": self.level}
+        if stored.encode is None:  # derived on read: no chunk is ever written; a plain read gives NaN
+            options = {"fillvalue": np.nan}
+        elif self.compression == "gzip":
+            options = {"compression": "gzip", "compression_opts": self.level, "shuffle": stored.shuffle}
         elif self.compression == "lzf":
-            options = {"compression": "lzf"}
-        h5.create_dataset(layout.key, shape=(n, *layout.shape), dtype=layout.dtype,
-                          chunks=(1, *layout.shape), track_times=False, **options)
+            options = {"compression": "lzf", "shuffle": stored.shuffle}
+        dset = h5.create_dataset(layout.key, shape=(n, *stored.shape), dtype=stored.dtype,
+                                 chunks=(1, *stored.shape), track_times=False, **options)
+        for name, value in stored.attrs.items():
+            dset.attrs[name] = value
+
+    def _chunk(self, key: str, index: int, value: Any) -> np.ndarray | bytes | None:
+        """Keypoint ``index``'s stored chunk of ``key`` (runs on the pool): the encoded array, or for gzip
+        the shuffled and deflated bytes; None when the pass is derived on read."""
+        layout, stored = self._layouts[key], self._stored[key]
+        array = np.asarray(value)
+        if array.shape != layout.shape:
+            raise InputError(f"'{key}' keypoint {index} has shape {array.shape}, expected {layout.shape}")
+        if stored.encode is None:
+            return None
+        encoded = stored.encode(array)
+        if self.compression == "gzip":
+            return zlib.compress(shuffled(encoded) if stored.shuffle else encoded, self.level)
+        return encoded
 
     def _work(self) -> None:
         h5 = self._file
@@ -138,25 +207,24 @@ class Hdf5SingleFileWriter:
                 return
             if self._error is not None:
                 continue  # keep draining so producers never block
-            index, values = item
+            index, jobs = item
             try:
-                for key, value in values.items():
-                    self._store(h5[key], self._layouts[key], index, value)
+                for key, job in jobs.items():
+                    dset = h5[key]
+                    if not isinstance(job, Future):
+                        dset[index] = json.dumps(job)
+                        continue
+                    chunk = job.result()
+                    if chunk is None:
+                        continue
+                    if isinstance(chunk, bytes) or self.compression == "none":
+                        # gzip: deflated bytes; none: the array's bytes are the chunk as HDF5 stores it
+                        dset.id.write_direct_chunk((index,) + (0,) * (dset.ndim - 1), chunk)
+                    else:
+                        dset[index] = chunk
                 self.frames_written += 1
             except BaseException as exc:  # surfaced to the producer thread
                 self._error = exc
-
-    def _store(self, dset: h5py.Dataset, layout: PassLayout, index: int, value: Any) -> None:
-        if layout.dtype == "json":
-            dset[index] = json.dumps(value)
-            return
-        array = np.ascontiguousarray(value, dtype=layout.dtype)
-        if array.shape != layout.shape:
-            raise InputError(f"'{layout.key}' keypoint {index} has shape {array.shape}, expected {layout.shape}")
-        if self.compression == "gzip":
-            dset.id.write_direct_chunk((index,) + (0,) * len(layout.shape), zlib.compress(array, self.level))
-        else:
-            dset[index] = array
 
     def _drain(self) -> None:
         if self._thread is not None:

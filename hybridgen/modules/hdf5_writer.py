@@ -6,7 +6,7 @@ from pathlib import Path
 from ..config.registry import register_module
 from ..config.schema import Param
 from ..io.hdf5_blenderproc import BlenderProcHdf5Writer
-from ..io.hdf5_single import COMPRESSIONS, Hdf5SingleFileWriter
+from ..io.hdf5_single import COMPRESSIONS, ENCODINGS, Hdf5SingleFileWriter
 from ..run.context import RunContext
 from .base import Module
 
@@ -29,6 +29,11 @@ class Hdf5Writer(Module):
         Param("append_to_existing_output", "bool", False,
               doc="blenderproc layout: number the files after the highest <i>.hdf5 already in output_dir"),
         Param("compression", "str", "gzip", choices=COMPRESSIONS, doc="dataset compression"),
+        Param("encoding", "str", "compact", choices=ENCODINGS,
+              doc="single layout: compact (ids in the smallest integer type, normals octahedral uint16 within "
+              "1e-4 rad, distance derived from depth; read them with hybridgen.data or "
+              "hybridgen.io.label_encoding.decode_dataset, docs/reading_outputs.md) or plain (the documented "
+              "dtypes as they are); the blenderproc layout always stores BlenderProc's encodings"),
         Param("compression_level", "int", 1, doc="gzip level 0..9 (1: twice as fast as 4, files ~10 % larger)",
               check=lambda v: None if 0 <= v <= 9 else f"must be in 0..9, got {v}"),
     )
@@ -43,11 +48,13 @@ class Hdf5Writer(Module):
         elif context.unit is not None:  # one work unit of a sharded run: its own complete file
             self.writer = Hdf5SingleFileWriter(context.unit.shard_path(cfg["output_dir"]),
                                                compression=cfg["compression"],
-                                               compression_level=cfg["compression_level"])
+                                               compression_level=cfg["compression_level"],
+                                               encoding=cfg["encoding"])
         else:
             self.writer = Hdf5SingleFileWriter(Path(cfg["output_dir"]) / cfg["file_name"],
                                                compression=cfg["compression"],
-                                               compression_level=cfg["compression_level"])
+                                               compression_level=cfg["compression_level"],
+                                               encoding=cfg["encoding"])
         context.sinks.append(self.writer)
         context.cleanups.append(self.writer.abort)
 

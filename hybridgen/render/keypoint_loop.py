@@ -6,6 +6,7 @@ together. :class:`StereoProducer` turns any producers into left/right pairs.
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any, Callable, Iterable, Protocol, Sequence
 
 import numpy as np
@@ -121,7 +122,7 @@ class StereoProducer:
         self.producers, self.baseline, self.scene = producers, float(baseline), scene
 
     def layouts(self) -> list[PassLayout]:
-        return [PassLayout(layout.key, layout.dtype, layout.shape if layout.dtype == "json" else (2, *layout.shape))
+        return [layout if layout.dtype == "json" else replace(layout, shape=(2, *layout.shape))
                 for p in self.producers for layout in p.layouts()]
 
     def attributes(self) -> dict[str, Any]:

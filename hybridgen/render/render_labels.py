@@ -1,6 +1,7 @@
 """Python API: the label passes of every keypoint, from the raster view, into frame sinks."""
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any, Iterable, Sequence
 
 import numpy as np
@@ -36,8 +37,14 @@ class LabelProducer:
         self._pending: dict[int, tuple[int, int, bytes]] = {}
 
     def layouts(self) -> list[PassLayout]:
+        """The request's layouts; id passes carry the range of ids this scene can produce (writers store
+        them in the smallest integer type that holds it)."""
         intr = self.scene.camera.intrinsics
-        return self.request.layouts(intr.width, intr.height)
+        ranges = {f"{attribute}_segmaps": lut for attribute, lut in self._tables.luts.items()}
+        ranges["instance_segmaps"] = np.array([0, *(o.instance_id for o in self.scene.objects)])
+        return [replace(layout, value_range=(min(0, int(ranges[layout.key].min())), int(ranges[layout.key].max())))
+                if layout.key in ranges and layout.dtype != "json" else layout
+                for layout in self.request.layouts(intr.width, intr.height)]
 
     def attributes(self) -> dict[str, Any]:
         return {"depth_background": self.request.depth_background, "normals_space": self.request.normals_space}

@@ -12,6 +12,7 @@ import pytest
 from PIL import Image
 
 import hybridgen as hg
+from hybridgen.io.label_encoding import decode_dataset
 
 CONFIG = """
 global: {all: {output_dir: "<args:0>"}}
@@ -116,15 +117,15 @@ def test_png_extraction_values_and_sizes(rendered, tmp_path, run_cli):
             np.testing.assert_array_equal(read("colors"), f["colors"][i])
             assert Image.open(tmp_path / f"png/data_{i:04d}_depth.png").mode == "I;16"
             for key in ("depth", "distance"):  # 16-bit millimetres, 0 where nothing was hit
-                metres = f[key][i]
+                metres = decode_dataset(f[key], i)
                 expected = np.where(np.isfinite(metres), np.rint(metres * 1000), 0)
                 np.testing.assert_array_equal(read(key), expected)
                 assert 0 < read(key).max() < 65535
-            np.testing.assert_array_equal(read("instance_segmaps"), f["instance_segmaps"][i])
+            np.testing.assert_array_equal(read("instance_segmaps"), decode_dataset(f["instance_segmaps"], i))
             assert set(np.unique(read("category_id_segmaps"))) == {0, 1, 2}
             normals = read("normals").astype(np.float64)
-            np.testing.assert_array_equal(normals, np.rint((f["normals"][i] + 1) / 2 * 255))
-            hit = f["instance_segmaps"][i] > 0
+            np.testing.assert_array_equal(normals, np.rint((decode_dataset(f["normals"], i) + 1) / 2 * 255))
+            hit = decode_dataset(f["instance_segmaps"], i) > 0
             assert np.allclose(np.linalg.norm(normals[hit] / 127.5 - 1, axis=1), 1, atol=0.02)
             flow = read("forward_flow").astype(np.float64)  # KITTI: u * 64 + 2^15, v * 64 + 2^15, valid
             np.testing.assert_allclose((flow[..., :2] - 2 ** 15) / 64, f["forward_flow"][i], atol=0.5 / 64 + 1e-4)
@@ -146,8 +147,9 @@ def test_npy_and_exr_keep_the_stored_values(rendered, tmp_path, run_cli):
         for i in range(2):
             for key in ("depth", "normals", "instance_segmaps", "colors", "forward_flow"):
                 stored = np.load(tmp_path / f"npy/data_{i:04d}_{key}.npy")
-                assert stored.dtype == f[key].dtype
-                np.testing.assert_array_equal(stored, f[key][i])
+                decoded = decode_dataset(f[key], i)  # the documented dtype, whatever the storage
+                assert stored.dtype == decoded.dtype
+                np.testing.assert_array_equal(stored, decoded)
             np.testing.assert_array_equal(np.load(tmp_path / f"npy/data_{i:04d}_cam_K.npy"), f["cam_K"][i])
             np.testing.assert_array_equal(json.loads((tmp_path / f"exr/data_{i:04d}_cam_K.json").read_text()),
                                           f["cam_K"][i])
@@ -156,12 +158,13 @@ def test_npy_and_exr_keep_the_stored_values(rendered, tmp_path, run_cli):
             depth = read_exr(tmp_path / f"exr/data_{i:04d}_depth.exr")
             assert depth.dtype == np.float32 and np.isinf(depth).any()
             np.testing.assert_array_equal(depth, f["depth"][i])
-            np.testing.assert_array_equal(read_exr(tmp_path / f"exr/data_{i:04d}_normals.exr"), f["normals"][i])
+            np.testing.assert_array_equal(read_exr(tmp_path / f"exr/data_{i:04d}_normals.exr"),
+                                          decode_dataset(f["normals"], i))
             np.testing.assert_array_equal(read_exr(tmp_path / f"exr/data_{i:04d}_forward_flow.exr"),
                                           f["forward_flow"][i])
             ids = read_exr(tmp_path / f"exr/data_{i:04d}_instance_segmaps.exr")
             assert ids.dtype == np.uint32
-            np.testing.assert_array_equal(ids, f["instance_segmaps"][i])
+            np.testing.assert_array_equal(ids, decode_dataset(f["instance_segmaps"], i))
             linear = read_exr(tmp_path / f"exr/data_{i:04d}_colors.exr")  # sRGB decoded to linear
             back = np.rint(hg_srgb(linear) * 255)
             np.testing.assert_array_equal(back, f["colors"][i])
@@ -182,9 +185,12 @@ def test_blenderproc_layout_files_extract_with_their_encodings(rendered, tmp_pat
         for i in range(2):
             np.testing.assert_array_equal(decode_png(tmp_path / f"bp/{i}_colors.png"), f["colors"][i])
             # stored normals are 0.5 n + 0.5 in Blender camera axes; the PNG is that times 255
-            blender = f["normals"][i] * np.array([1, -1, -1])
-            np.testing.assert_array_equal(decode_png(tmp_path / f"bp/{i}_normals.png"),
-                                          np.rint(np.float32(0.5) * blender.astype(np.float32) * 255 + 127.5))
+            with h5py.File(rendered / f"bp/{i}.hdf5") as bp:
+                stored = bp["normals"][()]
+            np.testing.assert_array_equal(decode_png(tmp_path / f"bp/{i}_normals.png"), np.rint(stored * 255))
+            # ... and those are the single file's normals (octahedral there: within its stated bound)
+            blender = decode_dataset(f["normals"], i) * np.array([1, -1, -1])
+            np.testing.assert_allclose(stored, 0.5 * blender + 0.5, atol=1e-4)
             depth = f["depth"][i]
             np.testing.assert_array_equal(decode_png(tmp_path / f"bp/{i}_depth.png"),
                                           np.where(np.isfinite(depth), np.rint(depth * 1000), 0))

@@ -10,7 +10,16 @@ import pytest
 import yaml
 
 import hybridgen as hg
+from hybridgen.io.label_encoding import OCTAHEDRAL_MAX_ERROR_RAD, decode_dataset
 from tests.conftest import REPO
+
+
+def _angles(a, b):
+    """Angle (rad) between unit normals; 0 where both are the (0, 0, 0) background, pi where one is."""
+    a, b = np.asarray(a, np.float64), np.asarray(b, np.float64)  # atan2: well conditioned near 0
+    angle = np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, axis=-1))
+    one_zero = np.any(a, axis=-1) != np.any(b, axis=-1)  # background in one only: as wrong as can be
+    return np.where(one_zero, np.pi, angle)
 
 
 def _run(tmp_path, run_cli, name="out", *extra):
@@ -30,8 +39,9 @@ def test_quickstart_file_layout(gl_context, tmp_path, run_cli, monkeypatch):
                     "normals": ("float32", (n, h, w, 3)), "instance_segmaps": ("int32", (n, h, w)),
                     "category_id_segmaps": ("int32", (n, h, w)), "cam_K": ("float64", (n, 3, 3)),
                     "cam2world": ("float64", (n, 4, 4))}
-        for key, (dtype, shape) in expected.items():
-            assert f[key].dtype == np.dtype(dtype) and f[key].shape == shape, key
+        for key, (dtype, shape) in expected.items():  # what a reader gets, whatever the storage
+            decoded = decode_dataset(f[key])
+            assert decoded.dtype == np.dtype(dtype) and decoded.shape == shape, key
         for key in ("depth", "normals", "instance_segmaps"):
             assert f[key].chunks == (1, *f[key].shape[1:]) and f[key].compression == "gzip"
         assert f["instance_attribute_maps"].shape == (n,)
@@ -46,13 +56,13 @@ def test_quickstart_file_layout(gl_context, tmp_path, run_cli, monkeypatch):
         assert states[1]["name"] == "box" and np.array(states[1]["local2world"]).shape == (4, 4)
         np.testing.assert_allclose(np.array(states[1]["local2world"])[:3, 3], [-0.9, 0.4, 0.4])
         visible = json.loads(f["instance_attribute_maps"][0])
-        ids = f["instance_segmaps"][0]
+        ids = decode_dataset(f["instance_segmaps"], 0)
         assert sorted(r["idx"] for r in visible) == sorted(set(np.unique(ids)) - {0})
         # class map is the instance map through object_states
         lut = np.zeros(6, np.int32)
         for s in states:
             lut[s["idx"]] = s["category_id"]
-        np.testing.assert_array_equal(f["category_id_segmaps"][()], lut[f["instance_segmaps"][()]])
+        np.testing.assert_array_equal(decode_dataset(f["category_id_segmaps"]), lut[decode_dataset(f["instance_segmaps"])])
         # what was written is what the renderer renders for that keypoint
         scene = hg.Scene()
         for s, shape, size in zip(states[:4], ["plane", "cube", "sphere", "torus"], [6.0, 0.8, 0.9, 1.0]):
@@ -64,13 +74,15 @@ def test_quickstart_file_layout(gl_context, tmp_path, run_cli, monkeypatch):
         intr = hg.Intrinsics(f["cam_K"][2], w, h)
         fresh = hg.RasterView(scene).render(f["cam2world"][2], ["depth", "normals", "instance_segmaps"],
                                             intrinsics=intr)
-        for key in fresh:
-            np.testing.assert_array_equal(f[key][2], fresh[key])
+        for key in ("depth", "instance_segmaps"):  # exact
+            np.testing.assert_array_equal(decode_dataset(f[key], 2), fresh[key])
+        assert _angles(decode_dataset(f["normals"], 2), fresh["normals"]).max() < OCTAHEDRAL_MAX_ERROR_RAD
         # distance is depth scaled by the pixel ray length
         rays = np.linalg.norm(intr.pixel_rays(), axis=-1)
-        hit = np.isfinite(f["depth"][2])
-        np.testing.assert_allclose(f["distance"][2][hit], (f["depth"][2] * rays)[hit], rtol=1e-6)
-        assert np.isinf(f["distance"][2][~hit]).all() and (f["normals"][2][~hit] == 0).all()
+        depth, distance = decode_dataset(f["depth"], 2), decode_dataset(f["distance"], 2)
+        hit = np.isfinite(depth)
+        np.testing.assert_allclose(distance[hit], (depth * rays)[hit], rtol=1e-6)
+        assert np.isinf(distance[~hit]).all() and (decode_dataset(f["normals"], 2)[~hit] == 0).all()
 
 
 def test_same_config_and_seed_give_identical_bytes(gl_context, tmp_path, run_cli, monkeypatch):
@@ -82,15 +94,16 @@ def test_same_config_and_seed_give_identical_bytes(gl_context, tmp_path, run_cli
     assert hashlib.sha256(again.read_bytes()).hexdigest() == first
 
 
+@pytest.mark.parametrize("encoding", ["compact", "plain"])
 @pytest.mark.parametrize("compression", ["gzip", "lzf", "none"])
-def test_compressions_read_back_identically(gl_context, tmp_path, compression):
+def test_compressions_read_back_identically(gl_context, tmp_path, compression, encoding):
     scene = hg.Scene()
     scene.add(hg.make_primitive("sphere", 1.0, name="s", category_id=4))
     scene.camera.intrinsics = hg.Intrinsics.from_fov(0.9, 48, 32)
     for loc in ([2, 0, 1], [0, 2, 1], [-2, -1, 0.5]):
         scene.camera.add_keypoint(hg.look_at(loc, [0, 0, 0]))
     request = hg.LabelRequest(distance=True, map_by=["class", "instance"], depth_background=-1.0)
-    writer = hg.Hdf5SingleFileWriter(tmp_path / "x.hdf5", compression=compression)
+    writer = hg.Hdf5SingleFileWriter(tmp_path / "x.hdf5", compression=compression, encoding=encoding)
     hg.render_labels(scene, [writer], request)
     writer.finalize({"object_states": [o.state() for o in scene.objects]})
     view = hg.RasterView(scene, depth_background=-1.0)
@@ -98,10 +111,14 @@ def test_compressions_read_back_identically(gl_context, tmp_path, compression):
         assert f["depth"].compression == (None if compression == "none" else compression)
         for i, pose in enumerate(scene.camera.keypoints):
             expected = request.compute(view.render_raw(pose), request.tables(view))
-            for key in ("depth", "distance", "normals", "instance_segmaps", "category_id_segmaps"):
-                np.testing.assert_array_equal(f[key][i], expected[key])
+            for key in ("depth", "distance", "instance_segmaps", "category_id_segmaps"):
+                np.testing.assert_array_equal(decode_dataset(f[key], i), expected[key])
+            if encoding == "plain":
+                np.testing.assert_array_equal(f["normals"][i], expected["normals"])
+            else:
+                assert _angles(decode_dataset(f["normals"], i), expected["normals"]).max() < OCTAHEDRAL_MAX_ERROR_RAD
             assert json.loads(f["instance_attribute_maps"][i]) == expected["instance_attribute_maps"]
-        assert (f["depth"][()] == -1.0).any() and (f["category_id_segmaps"][()] == 4).any()
+        assert (f["depth"][()] == -1.0).any() and (decode_dataset(f["category_id_segmaps"]) == 4).any()
         np.testing.assert_array_equal(f["cam2world"][()], np.stack(scene.camera.keypoints))
 
 
