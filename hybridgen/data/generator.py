@@ -40,12 +40,28 @@ from typing import Any, Iterator, Mapping, Sequence
 import numpy as np
 
 from ..config.config_file import ConfigFile, load_config
-from ..errors import ConfigError, InputError
+from ..errors import ConfigError, InputError, SystemSetupError
 from ..io.memory_sink import MemorySink
 from ..modules.base import Module
 from ..run.units import WorkUnit
 
 _COLOR_RENDERER = "renderer.RgbRenderer"
+_FORK_HINT = ("this process was forked from one that had already rendered (its OpenGL/EGL and Dr.Jit threads do "
+              "not survive a fork, rendering would hang): create the DataLoader with "
+              "multiprocessing_context='spawn' (or render nothing in the parent before the workers start)")
+_inherited_renderer = False
+
+
+def _after_fork_in_child() -> None:
+    """Remember whether the parent had a GL context or a Mitsuba variant when this process was forked."""
+    global _inherited_renderer
+    gl = sys.modules.get("hybridgen.render.gl_context")
+    mitsuba = sys.modules.get("mitsuba")
+    _inherited_renderer = _inherited_renderer or bool(gl is not None and gl._shared) or \
+        bool(mitsuba is not None and getattr(mitsuba, "variant", lambda: None)())
+
+
+os.register_at_fork(after_in_child=_after_fork_in_child)
 
 
 def current_worker() -> tuple[int, int]:
@@ -196,6 +212,8 @@ class GeneratorDataset:
         """The samples of worker ``worker`` of ``workers`` (scenes round-robin, see the module docs)."""
         if not 0 <= worker < workers:
             raise InputError(f"worker must be in 0..{workers - 1}, got {worker}")
+        if _inherited_renderer:
+            raise SystemSetupError(f"GeneratorDataset: {_FORK_HINT}")
         if workers > 1:
             from ..run.runner import limit_threads
 

@@ -112,3 +112,16 @@ def test_dataloader_workers_give_the_same_samples(gl_context, tmp_path):
     for a, b in zip(sorted(got, key=_key), expected):
         _assert_equal(a, b, keys)
     assert not (tmp_path / "never").exists()
+
+
+def test_forked_workers_of_a_rendering_parent_get_a_clear_error(gl_context, tmp_path):
+    """This test process holds a GL context (the gl_context fixture): a forked worker could not render (it
+    would hang in Mesa), so it stops with the fix instead."""
+    torch = pytest.importorskip("torch")
+    from hybridgen.data import TorchGeneratorDataset
+    from hybridgen.errors import SystemSetupError
+
+    data = TorchGeneratorDataset(_config(tmp_path), [str(tmp_path / "never")], scenes=2, color=False)
+    loader = torch.utils.data.DataLoader(data, batch_size=None, num_workers=1, multiprocessing_context="fork")
+    with pytest.raises(SystemSetupError, match="multiprocessing_context='spawn'"):
+        next(iter(loader))
