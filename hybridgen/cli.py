@@ -86,7 +86,9 @@ def _cmd_run(ns: argparse.Namespace) -> dict[str, Any]:
                          workers=ns.workers, shard=_parse_shard(ns.shard), executor=ns.executor,
                          address=ns.address, restart=ns.restart, force_resume=ns.force_resume,
                          max_tasks_per_child=ns.max_tasks_per_child)
-    outputs = ", ".join(str(p) for p in summary.outputs) or "(no output file)"
+    from .run.context import printable_text
+
+    outputs = ", ".join(printable_text(str(p)) for p in summary.outputs) or "(no output file)"
     rate = summary.frames / summary.seconds if summary.seconds > 0 else 0.0
     _say(ns, f"{summary.frames} keypoint(s) in {summary.seconds:.2f} s ({rate:.1f}/s) -> {outputs}")
     return {"config": str(ns.config), "args": list(ns.args), "keypoints": summary.frames,

@@ -28,6 +28,8 @@ MAX_EXPANDED_NODES = 1_000_000
 def read_limited(path: str | Path, limit: int, what: str) -> bytes:
     """At most ``limit`` bytes of ``path`` (a regular file, pipe or device); ConfigError when it has more.
     ``/dev/zero`` and multi-gigabyte files cost ``limit`` bytes, not all of memory."""
+    if "\0" in str(path):
+        raise ConfigError(f"{what} path contains a NUL character", file=repr(str(path)))
     with open(path, "rb") as handle:
         data = handle.read(limit + 1)
     if len(data) > limit:

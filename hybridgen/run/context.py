@@ -59,4 +59,10 @@ class RunContext:
             attrs["config"] = self.config.resolved_yaml()
             attrs["config_path"] = self.config.path
         attrs.update(self.attributes)
-        return attrs
+        return {key: printable_text(value) if isinstance(value, str) else value for key, value in attrs.items()}
+
+
+def printable_text(text: str) -> str:
+    """``text`` as valid UTF-8 for an HDF5 string attribute: bytes of a non-UTF-8 file name (Python's
+    surrogate escapes) become ``\\xNN``."""
+    return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")

@@ -268,6 +268,8 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
     if not 0 <= index < count:
         raise InputError(f"--shard i/N needs 0 <= i < N, got {index}/{count}")
     prepare_output_dir(plan.output_dir / SHARD_FOLDER)
+    if (plan.output_dir / plan.file_name).is_dir():
+        raise InputError(f"'{plan.output_dir / plan.file_name}' is a directory; the index cannot be written there")
     if policy.restart:
         removed = discard_outputs(plan)
         if removed:
