@@ -29,9 +29,16 @@ def _edges_cross(a: trimesh.Trimesh, b: trimesh.Trimesh) -> bool:
     return bool((travelled <= length[keep][rays]).any())
 
 
+def _inside(a: trimesh.Trimesh, b: trimesh.Trimesh) -> bool:
+    """Does a vertex of ``a`` lie inside ``b``, when ``b`` is closed? (trimesh's ray-parity test)"""
+    solid = trimesh.Trimesh(b.vertices, b.faces)  # duplicate corners merged
+    return bool(solid.is_watertight and solid.contains(a.vertices[:1]).any())
+
+
 def surfaces_intersect(a: hg.MeshObject, b: hg.MeshObject) -> bool:
+    """The surfaces cross, or one object lies entirely inside the other, closed, one."""
     ma, mb = _world(a), _world(b)
-    return _edges_cross(ma, mb) or _edges_cross(mb, ma)
+    return _edges_cross(ma, mb) or _edges_cross(mb, ma) or _inside(ma, mb) or _inside(mb, ma)
 
 
 def _context(text: str, write_config):
@@ -112,6 +119,54 @@ def test_independent_check_detects_a_real_intersection():
 
     world = CollisionWorld([a])
     assert world.collides(b) and not world.collides(c)
+
+
+def test_an_object_inside_another_is_a_collision_both_ways():
+    """Containment without touching surfaces: the independent check and the FCL world both see it."""
+    from hybridgen.scene.collision import CollisionWorld
+
+    big = hg.make_primitive("cube", 2.0, name="big", category_id=1, local2world=hg.object_pose([0, 0, 1], [0, 0, 0.3]))
+    small = hg.make_primitive("sphere", 0.5, name="small", category_id=2, local2world=hg.object_pose([0.2, 0.1, 1]))
+    outside = hg.make_primitive("sphere", 0.5, name="outside", category_id=2, local2world=hg.object_pose([3, 0, 1]))
+    sheet = hg.make_primitive("plane", 4.0, name="sheet", category_id=3, local2world=hg.object_pose([0, 0, 0.5]))
+    assert surfaces_intersect(small, big) and surfaces_intersect(big, small)
+    assert not surfaces_intersect(outside, big)
+    assert CollisionWorld([big]).collides(small) and CollisionWorld([small]).collides(big)
+    assert not CollisionWorld([big]).collides(outside)
+    # an open surface encloses nothing: a ball above (not touching) the sheet is free, one crossing it is not
+    assert not CollisionWorld([sheet]).collides(small) and not surfaces_intersect(small, sheet)
+    assert CollisionWorld([sheet]).collides(small, hg.object_pose([0, 0, 0.6]))
+
+
+def test_collision_world_agrees_with_the_independent_check_under_scale_and_rotation():
+    """Random poses of a torus near a non-uniformly scaled, rotated box and a scaled knot: the FCL world
+    (scale baked into a BVH built once, rigid transforms after) gives the independent check's answer."""
+    from hybridgen.scene import collision
+    from hybridgen.scene.collision import CollisionWorld
+
+    box = hg.make_primitive("cube", 1.0, name="box", category_id=1,
+                            local2world=hg.object_pose([0, 0, 0], [0.3, -0.5, 0.8], [1.5, 0.4, 0.7]))
+    knot = hg.load_objects(REPO / "configs/assets/knot.obj", name="knot", category_id=2,
+                           local2world=hg.object_pose([1.6, 0.2, 0.1], [0.2, 0.4, 0], 0.45))[0]
+    ring = hg.make_primitive("torus", 0.8, name="ring", category_id=3)
+    builds = []
+    original_build = collision._Shape.build
+    collision._Shape.build = classmethod(lambda cls, v, f: (builds.append(len(f)), original_build.__func__(cls, v, f))[1])
+    try:
+        world = CollisionWorld([box, knot])
+        rng = np.random.default_rng(4)
+        answers = []
+        for _ in range(40):
+            pose = hg.object_pose(rng.uniform([-1.2, -1.0, -0.8], [2.6, 1.0, 0.8]), rng.uniform(0, 6.3, 3),
+                                  [1.3, 1.0, 0.6])
+            ring.local2world = pose
+            expected = surfaces_intersect(ring, box) or surfaces_intersect(ring, knot)
+            answers.append(expected)
+            assert world.collides(ring, pose) == expected, pose
+    finally:
+        collision._Shape.build = original_build
+    assert 8 <= sum(answers) <= 32  # both outcomes are exercised
+    assert len(builds) == 3  # one BVH per object (box, knot, ring), not one per test
 
 
 def test_impossible_placement_is_a_clear_error(write_config, run_cli):
