@@ -56,6 +56,8 @@ class SingleFileLayout:
 
     def __init__(self, path: Path) -> None:
         self.path = path
+        self._cache: dict[str, h5py.Dataset] = {}
+        self._cache_for: h5py.File | None = None
         with self.open() as h5:
             if not _is_single_file(h5):
                 raise InputError(f"'{path}' is not a hybridgen data file: it has no 'cam_K' (N, 3, 3) dataset")
@@ -82,28 +84,40 @@ class SingleFileLayout:
                              "recreate them")
         return h5
 
+    def _datasets(self, h5: h5py.File) -> dict[str, h5py.Dataset]:
+        """The datasets of the open file ``h5`` by name (looked up once per handle: h5py lookups are slow)."""
+        if self._cache_for is not h5:
+            self._cache = {k: v for k, v in h5.items() if isinstance(v, h5py.Dataset)}
+            self._cache_for = h5
+        return self._cache
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {**self.__dict__, "_cache": {}, "_cache_for": None}
+
     def position(self, h5: h5py.File, index: int) -> tuple[int, int]:
         """(scene_index, keypoint_index) of keypoint ``index``."""
-        scene = int(h5["scene_index"][index]) if "scene_index" in h5 else 0
-        keypoint = int(h5["keypoint_index"][index]) if "keypoint_index" in h5 else index
+        datasets = self._datasets(h5)
+        scene = int(datasets["scene_index"][index]) if "scene_index" in datasets else 0
+        keypoint = int(datasets["keypoint_index"][index]) if "keypoint_index" in datasets else index
         return scene, keypoint
 
     def read(self, h5: h5py.File, index: int, keys: Sequence[str]) -> dict[str, Any]:
         """Keypoint ``index``'s ``keys`` (per-keypoint keys and scene records)."""
         scene, keypoint = self.position(h5, index)
+        datasets = self._datasets(h5)
         item: dict[str, Any] = {}
         for key in keys:
+            dset = datasets[key]
             if key in SCENE_RECORDS:
-                dset = h5[key]
                 item[key] = decode_text(dset[self.scene_slot[scene]] if dset.ndim else dset[()])
             elif key in self.text_keys:
-                item[key] = decode_text(h5[key][index])
+                item[key] = decode_text(dset[index])
             elif key in self.encoded:
                 from ..io.label_encoding import decode_dataset
 
-                item[key] = decode_dataset(h5[key], index)
+                item[key] = decode_dataset(dset, index)
             else:
-                item[key] = h5[key][index]
+                item[key] = dset[index]
         item["scene_index"], item["keypoint_index"] = scene, keypoint
         return item
 
