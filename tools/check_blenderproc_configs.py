@@ -124,6 +124,8 @@ def standin_args(config: Path, work: Path) -> list[str]:
         elif "bop_datset_name" in lower or "bop_dataset_name" in lower:
             args.append(BOP_NAME)
             continue
+        elif "cc_textures" in lower or "cctexture" in lower or "path_to_textures" in lower:
+            value = work / "cc_textures"
         elif "texture_file" in lower:
             value = work / "texture.png"
         elif "output" in lower:
@@ -187,8 +189,12 @@ def make_standins(work: Path) -> None:
 
     (work / "scene.obj").write_text(STANDIN_OBJ)
     (work / "scene.mtl").write_text(STANDIN_MTL)
-    make_bop_standin(work / "bop")
+    for name in ("lm", "tless", "ycbv", "hb", "icbin", "itodd", "tudl"):
+        make_bop_standin(work / "bop", name)
     Image.new("RGB", (16, 16), (180, 120, 60)).save(work / "texture.png")
+    for asset, color in (("Bricks001", (150, 60, 40)), ("Wood002", (120, 90, 50)), ("Marble003", (220, 220, 215))):
+        (work / "cc_textures" / asset).mkdir(parents=True, exist_ok=True)
+        Image.new("RGB", (16, 16), color).save(work / "cc_textures" / asset / f"{asset}_2K_Color.jpg")
     # location + Blender Euler rotation per line: two views of the origin from 6 m
     (work / "camera_positions").write_text("0 -6 3 1.1 0 0\n4 -4 3 1.1 0 0.785\n")
 

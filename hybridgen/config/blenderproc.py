@@ -85,8 +85,6 @@ UNAVAILABLE = {
     "loader.AMASSLoader": "posing SMPL bodies needs the AMASS data and the SMPL body model (licensed, not "
                           "distributable); export posed bodies to OBJ and load them with loader.ObjLoader",
     "loader.HavenEnvironmentLoader": "use main.Initializer's hdri_path with the .hdr/.exr file instead",
-    "loader.CCMaterialLoader": "builds Blender node materials from cc0textures folders; set textures with "
-                               "manipulators.MaterialManipulator material.base_color_texture (sampler.Path)",
     "loader.RockEssentialsRockLoader": "reads Blender .blend rock packs; " + _EXPORT,
     "constructor.RockEssentialsGroundConstructor": "builds Blender node-displaced ground; use "
                                                    "loader.PrimitiveLoader (plane) with a texture",
@@ -146,6 +144,9 @@ def selector(value: Any, note: Note, key: str = "selector") -> Any:
     """A BlenderProc ``getter.Entity`` selector in hybridgen's terms: ``type: MESH`` always holds."""
     if isinstance(value, dict):
         out = dict(value)
+        if not any(k in out for k in ("provider", "conditions", "random_samples", "index", "check_empty")):
+            out = {"conditions": out}
+        out.setdefault("check_empty", False)  # BlenderProc: an empty selection does nothing
         if "conditions" in out:
             out["conditions"] = _conditions(out["conditions"], note, f"{key}.conditions")
         provider = out.get("provider")
@@ -195,6 +196,11 @@ def samplers_as_blenderproc(value: Any, note: Note, key: str) -> Any:
                 [max(a, b) for a, b in zip(low, high)]
         elif isinstance(low, (int, float)) and isinstance(high, (int, float)) and low > high:
             params["min"], params["max"] = high, low
+    if provider in ("sampler.UpperRegionSampler", "UpperRegionSampler") and isinstance(params, dict) and \
+            "use_ray_trace_check" in params:
+        if params.pop("use_ray_trace_check"):
+            note("the ray check that nothing blocks the sampled point from the surface is not done; the "
+                 "placing module's collision check still applies", f"{key}.use_ray_trace_check")
     if provider in ("sampler.PartSphere", "PartSphereSampler") and isinstance(params, dict) and \
             "part_sphere_vector" in params:
         params["part_sphere_dir_vector"] = params.pop("part_sphere_vector")
@@ -469,14 +475,33 @@ def _entity(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any
     if "rotation_euler" in cfg:
         cfg["rotation"] = cfg.pop("rotation_euler")
     _matrix_world(cfg)
+    mode = cfg.get("mode")
+    if "cf_randomize_materials" in cfg:
+        cfg.pop("mode", None)  # the randomizer draws once for all or for each, as BlenderProc
     _mode(cfg, note)
     _shading(cfg, note)
     for key in ("cf_add_modifier", "cf_add_displace_modifier_with_texture", "cf_add_uv_mapping"):
         _pop(cfg, key, note, "Blender modifiers (displacement, subdivision, UV projection) are not applied")
-    if "cf_randomize_materials" in cfg:
-        _pop(cfg, "cf_randomize_materials", note, "material randomization from Blender's material list; use "
-             "manipulators.MaterialManipulator with randomize_color or a texture sampler")
-    return [("manipulators.EntityManipulator", cfg)]
+    out = []
+    randomize = cfg.pop("cf_randomize_materials", None)
+    if randomize is not None:
+        if not isinstance(randomize, dict):
+            raise ConfigError("must be a mapping {randomization_level, materials_to_replace_with}",
+                              key="cf_randomize_materials")
+        extra = [k for k in randomize if k not in ("randomization_level", "materials_to_replace_with")]
+        if extra:
+            raise ConfigError(f"unknown key {extra[0]!r}; hybridgen takes randomization_level and "
+                              "materials_to_replace_with", key="cf_randomize_materials")
+        source = randomize.get("materials_to_replace_with")
+        if isinstance(source, dict):
+            source = {k: v for k, v in source.items() if k != "check_empty"}
+        out.append(("manipulators.MaterialRandomizer", {
+            "selector": cfg.get("selector", {"conditions": {}}),
+            "randomization_level": randomize.get("randomization_level", 0.2),
+            "materials_to_replace_with": source, "mode": mode or "once_for_each"}))
+    if set(cfg) - {"selector"} or not out:
+        out.insert(0, ("manipulators.EntityManipulator", cfg))
+    return out
 
 
 def _mode(cfg: dict[str, Any], note: Note) -> None:
@@ -498,6 +523,7 @@ def _material(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, A
         conditions = sel.get("conditions", {})
         cfg["selector"] = {k: v for k, v in sel.items() if k not in ("provider", "conditions")}
         cfg["selector"]["conditions"] = _material_conditions(conditions)
+        cfg["selector"].setdefault("check_empty", False)
     elif "selector" in cfg:
         cfg["selector"] = selector(cfg["selector"], note)
     _mode(cfg, note)
@@ -645,6 +671,8 @@ def _as_list(value: Any) -> list[Any]:
 
 def finish(entries: list[Any], state: dict[str, Any], output_dir: Any) -> None:
     """Cross-module effects: Dist2Depth renders depth where distance was rendered; writers' BlenderProc folders."""
+    if not state.get("blenderproc"):
+        return
     if state.get("dist2depth"):
         for entry in entries:
             if entry.name.startswith("renderer.") and entry.config.get("render_distance"):

@@ -38,6 +38,8 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.world_manipulator",
     "hybridgen.modules.state_writers",
     "hybridgen.modules.bop_loader",
+    "hybridgen.modules.material_library",
+    "hybridgen.modules.material_randomizer",
 )
 
 MODULES: dict[str, type["Module"]] = {}

@@ -19,8 +19,12 @@ class SelectingModule(Module):
         self.selector = parse_selector(self.config[self.selector_key], self.selector_key)
 
     def selected(self, context: RunContext) -> list[MeshObject]:
-        """The objects the selector picks now (random subsets drawn from the run's generator); at least one."""
+        """The objects the selector picks now (random subsets drawn from the run's generator); at least one,
+        unless the selector says ``check_empty: false`` (BlenderProc's default: nothing selected, nothing done)."""
         chosen = self.selector.select(context.scene.objects, context.rng)
+        if not chosen and not self.selector.check_empty:
+            context.log(f"{self.module_name}: {self.selector_key} matches no object; nothing to do")
+            return []
         if not chosen:
             raise InputError(f"{self.selector_key} matches no object ({self.selector.conditions!r})")
         return chosen

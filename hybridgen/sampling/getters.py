@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import ConfigError, InputError
 from .registry import DrawContext, register_sampler
 
-SELECTOR_KEYS = ("provider", "conditions", "random_samples", "index")
+SELECTOR_KEYS = ("provider", "conditions", "random_samples", "index", "check_empty")
 
 
 @dataclass(frozen=True)
@@ -28,6 +28,7 @@ class Selector:
     conditions: Any = None  # dict (AND), list of dicts (OR) or None (every object)
     random_samples: int | None = None
     index: int | None = None
+    check_empty: bool = True  # BlenderProc's key (its default is false): an empty selection is an error
 
     def select(self, objects: Sequence[Any], rng: np.random.Generator | None = None) -> list[Any]:
         """The matching objects in scene order; ``random_samples`` of them drawn without replacement."""
@@ -77,6 +78,7 @@ def parse_selector(value: Any, key: str = "selector") -> Selector:
     """A :class:`Selector` from its config form; ConfigError names ``key`` when malformed."""
     if value is None:
         return Selector()
+    check_empty = True
     if isinstance(value, list):
         conditions: Any = value
         random_samples = index = None
@@ -89,6 +91,9 @@ def parse_selector(value: Any, key: str = "selector") -> Selector:
         if value.get("provider", "getter.Entity") != "getter.Entity":
             raise ConfigError(f"a selector's provider is getter.Entity, got {value['provider']!r}", key=key)
         conditions, random_samples, index = value.get("conditions"), value.get("random_samples"), value.get("index")
+        check_empty = value.get("check_empty", True)
+        if not isinstance(check_empty, bool):
+            raise ConfigError(f"check_empty must be true or false, got {check_empty!r}", key=key)
     else:
         raise ConfigError(f"a selector is a mapping of conditions or {{conditions, random_samples}}, got {value!r}",
                           key=key)
@@ -104,7 +109,7 @@ def parse_selector(value: Any, key: str = "selector") -> Selector:
                     raise ConfigError(f"condition {name}: bad regular expression {wanted!r}: {exc}", key=key) from None
     if random_samples is not None and (not isinstance(random_samples, int) or random_samples < 1):
         raise ConfigError(f"random_samples must be an integer >= 1, got {random_samples!r}", key=key)
-    return Selector(conditions, random_samples, index)
+    return Selector(conditions, random_samples, index, check_empty)
 
 
 def selected_or_fail(selector: Selector, ctx: DrawContext, what: str) -> list[Any]:
