@@ -24,7 +24,7 @@ from PIL import Image
 from ..errors import InputError
 from .colormaps import flow_to_color, viridis
 from .image_files import png_bytes, write_file
-from .preview import Legend, eyes, is_image, preview
+from .preview import Legend, eye_visible, eyes, is_image, preview
 
 THUMB_WIDTH = 192
 _PAGE = Path(__file__).with_name("gallery_page.html")
@@ -67,9 +67,7 @@ def _keypoint_html(sample: dict[str, Any], index: int, keys: Sequence[str], ster
         for eye, (title, value) in enumerate(eyes(key, sample[key], stereo)):
             if not is_image(key, value):
                 continue
-            eye_visible = visible[eye] if stereo and isinstance(visible, list) and len(visible) == 2 \
-                and isinstance(visible[0], list) else visible
-            shown = preview(key, value, eye_visible)
+            shown = preview(key, value, eye_visible(visible, eye, stereo))
             name = f"{index:06d}_{title.replace(' (', '_').rstrip(')')}.png"
             full = _write_png(folder / "images" / name, shown.image)
             smooth = value.dtype == np.uint8 and value.ndim == 3 or key in ("albedo", "normals", "nocs")

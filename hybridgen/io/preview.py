@@ -55,6 +55,13 @@ def eyes(key: str, value: Any, stereo: bool) -> list[tuple[str, Any]]:
     return [(key, value)]
 
 
+def eye_visible(visible: Any, eye: int, stereo: bool) -> list[dict[str, Any]] | None:
+    """The ``instance_attribute_maps`` of eye ``eye``: stereo runs store a [left, right] pair per keypoint."""
+    if stereo and isinstance(visible, list) and len(visible) == 2 and isinstance(visible[0], list):
+        return visible[eye]
+    return visible
+
+
 def _names(visible: list[dict[str, Any]], attribute: str) -> dict[int, list[dict[str, Any]]]:
     """Visible objects grouped by their value of ``attribute`` (``idx`` for instance ids)."""
     groups: dict[int, list[dict[str, Any]]] = {}

@@ -14,7 +14,7 @@ from PIL import Image, ImageDraw
 
 from ..errors import InputError
 from .colormaps import flow_to_color, viridis
-from .preview import Legend, eyes, is_image, preview
+from .preview import Legend, eye_visible, eyes, is_image, preview
 
 _LABEL_HEIGHT = 14
 _ROW = 12
@@ -101,9 +101,7 @@ def keypoint_tiles(sample: dict[str, Any], keys: Sequence[str], stereo: bool) ->
     tiles = []
     for key in keys:
         for index, (title, value) in enumerate(eyes(key, sample[key], stereo)):
-            eye_visible = visible[index] if stereo and isinstance(visible, list) and len(visible) == 2 \
-                and isinstance(visible[0], list) else visible
-            tile = render_tile(key, value, eye_visible)
+            tile = render_tile(key, value, eye_visible(visible, index, stereo))
             if tile is not None:
                 tiles.append((title, tile))
     return tiles
