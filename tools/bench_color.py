@@ -1,6 +1,7 @@
 """Color rendering: hybridgen vs a bare Mitsuba script on the same scene, and vs Blender Cycles (one run).
 
 Run: .venv/bin/python tools/bench_color.py [--res 640x480] [--spp 64] [--bounces 6] [--no-cycles] [--quick]
+     .venv/bin/python tools/bench_color.py --quality [--res 320x240] [--reference-spp 4096] (see color_quality.py)
 
 Scene: a closed 6 x 6 x 3 m room (floor, four walls, emissive ceiling), 20 primitives and a 100,000-triangle
 torus knot; 8 camera poses inside the room (everything seeded).
@@ -256,8 +257,9 @@ def ensure_bpy_venv(venv: Path) -> Path | None:
 
 
 def export_for_cycles(scene: Any, path: Path, spp: int, bounces: int, min_bounces: int) -> None:
-    """Meshes in world coordinates (with the world-space vertex normals hybridgen gives Mitsuba), materials,
-    camera and poses, for tools/cycles_render.py."""
+    """Meshes in world coordinates (with the world-space vertex normals hybridgen gives Mitsuba), materials
+    (base-color textures and UVs included), lights, world (color or HDRI), camera and poses, for
+    tools/cycles_render.py."""
     from hybridgen.render.mitsuba_scene import emitted_radiance
 
     arrays: dict[str, np.ndarray] = {}
@@ -269,13 +271,28 @@ def export_for_cycles(scene: Any, path: Path, spp: int, bounces: int, min_bounce
             normals = obj.vertex_normals @ np.linalg.inv(obj.local2world[:3, :3])
             arrays[f"n{i}"] = (normals / np.linalg.norm(normals, axis=1, keepdims=True)).astype(np.float32)
         m = obj.material
+        if m.base_color_texture is not None and obj.uvs is not None:
+            texture = m.base_color_texture
+            if isinstance(texture, (str, Path)):
+                from PIL import Image
+
+                texture = np.asarray(Image.open(texture).convert("RGB"))
+            arrays[f"tex{i}"] = np.ascontiguousarray(np.asarray(texture)[..., :3], dtype=np.uint8)
+            arrays[f"uv{i}"] = np.asarray(obj.uvs, dtype=np.float32)
         diffuse = m.specular == 0 and m.metallic == 0 and m.transmission == 0  # as mitsuba_scene.bsdf_dict
         objects.append({"name": obj.name, "kind": "diffuse" if diffuse else "principled",
                         "color": [float(c) for c in m.base_color[:3]], "roughness": float(m.roughness),
                         "metallic": float(m.metallic), "specular": float(m.specular),
+                        "transmission": float(m.transmission), "ior": float(m.ior),
                         "emission": emitted_radiance(obj).tolist()})
+    lights = [{"type": light.type, "energy": float(light.energy), "color": [float(c) for c in light.color],
+               "radius": float(light.radius), "local2world": np.asarray(light.local2world).tolist()}
+              for light in scene.lights if light.type in ("POINT", "SUN")]
+    world = scene.world
     intr = scene.camera.intrinsics
-    meta = {"objects": objects, "world": (np.asarray(scene.world.color) * scene.world.strength).tolist(),
+    meta = {"objects": objects, "world": (np.asarray(world.color)[:3] * world.strength).tolist(), "lights": lights,
+            "hdri": {"path": str(world.hdri_path), "strength": float(world.strength),
+                     "rotation": float(world.hdri_rotation)} if world.hdri_path else None,
             "resolution": [intr.width, intr.height], "K": intr.K.tolist(), "clip": [intr.clip_start, intr.clip_end],
             "spp": spp, "max_bounces": bounces, "min_bounces": min_bounces, "threads": os.cpu_count() or 2}
     np.savez(path, meta=np.array(json.dumps(meta)), poses=np.stack(scene.camera.keypoints), **arrays)
@@ -301,9 +318,12 @@ class CyclesWorker:
             raise RuntimeError(f"the Cycles worker stopped (exit code {self.process.wait()}):\n  " + "\n  ".join(tail))
         return json.loads(line)
 
-    def render(self, index: int, light_tree: bool, seed: int, save: Path | None = None) -> dict[str, Any]:
+    def render(self, index: int, light_tree: bool, seed: int, save: Path | None = None,
+               **extra: Any) -> dict[str, Any]:
+        """``extra``: ``mode`` ("blenderproc" / "reference") and ``spp``, see tools/cycles_render.py."""
         assert self.process.stdin is not None
-        request = {"index": index, "light_tree": light_tree, "seed": seed, "save": str(save) if save else None}
+        request = {"index": index, "light_tree": light_tree, "seed": seed, "save": str(save) if save else None,
+                   **extra}
         self.process.stdin.write(json.dumps(request) + "\n")
         self.process.stdin.flush()
         return self._answer()
@@ -418,7 +438,25 @@ def main() -> None:
     parser.add_argument("--warm-cache", action="store_true",
                         help="use ~/.drjit's kernel cache (default: a fresh one, so keypoint 1 shows compilation)")
     parser.add_argument("--no-profile", action="store_true", help="skip the 1-spp fixed-cost run and profile")
+    parser.add_argument("--quality", action="store_true", help="quality mode (tools/color_quality.py): defaults "
+                        "vs Cycles at BlenderProc's defaults, PSNR against each engine's own reference")
+    parser.add_argument("--reference-spp", type=int, default=4096, help="quality mode: reference spp")
+    parser.add_argument("--hg-threshold", type=float, default=None, help="quality mode: hybridgen's noise "
+                        "threshold (default: its default)")
+    parser.add_argument("--try-thresholds", type=lambda v: [float(x) for x in v.split(",")], default=[],
+                        help="quality mode: also time hybridgen at these noise thresholds (tuning)")
+    parser.add_argument("--scenes", default="", help="quality mode: comma-separated scene names (default all)")
+    parser.add_argument("--out", default=str(REPO / "output" / "bench_color_quality"),
+                        help="quality mode: folder for side-by-side PNGs")
     args = parser.parse_args()
+    if args.quality:
+        import color_quality
+
+        python = None if args.no_cycles else ensure_bpy_venv(args.bpy_venv)
+        res = args.res if args.res != "640x480" else "320x240"
+        args.res = res
+        color_quality.print_table(color_quality.run_quality(args, python), args.reference_spp)
+        return
     if args.quick:
         args.res, args.spp, args.no_cycles = "160x120", 8, True
     width, height = (int(v) for v in args.res.lower().split("x"))

@@ -7,7 +7,9 @@ bench_color.py, which creates ``.venv-bpy`` on demand::
 
 Protocol (one JSON object per line): after building the scene the worker answers
 ``{"ready": true, "blender": ..., "setup_s": ...}``; then each request line on stdin,
-``{"index": i, "light_tree": bool, "seed": int, "save": path-or-null}``, is answered with
+``{"index": i, "light_tree": bool, "seed": int, "save": path-or-null}`` (optionally ``"mode"``:
+``"blenderproc"`` - BlenderProc 2.8's render defaults, or ``"reference"`` - the same estimator at a fixed
+``"spp"`` without adaptive sampling or denoising), is answered with
 ``{"seconds": wall, "cpu_s": cpu}`` (the time of ``bpy.ops.render.render`` alone); ``{"quit": true}`` ends
 it with its peak RSS. Requests one at a time let the benchmark interleave Cycles with Mitsuba keypoint by
 keypoint, so both see the same machine noise; while waiting the worker is idle.
@@ -28,7 +30,7 @@ import mathutils
 import numpy as np
 
 
-def _material(name: str, spec: dict) -> bpy.types.Material:
+def _material(name: str, spec: dict, texture: np.ndarray | None = None) -> bpy.types.Material:
     """Diffuse BSDF for hybridgen's diffuse materials (specular = metallic = 0, as its Mitsuba translation),
     Principled BSDF otherwise; emissive ones add an Emission shader (Cycles emits from both sides, like
     hybridgen's two-sided Mitsuba emitters)."""
@@ -49,6 +51,15 @@ def _material(name: str, spec: dict) -> bpy.types.Material:
         surface.inputs["Roughness"].default_value = spec["roughness"]
         surface.inputs["Metallic"].default_value = spec["metallic"]
         surface.inputs["Specular IOR Level"].default_value = spec["specular"]
+        surface.inputs["Transmission Weight"].default_value = spec.get("transmission", 0.0)
+        surface.inputs["IOR"].default_value = spec.get("ior", 1.45)
+    if texture is not None:  # sRGB uint8 H x W x 3, sampled with the mesh's UV map
+        image = bpy.data.images.new(name + "_texture", texture.shape[1], texture.shape[0], alpha=True)
+        rgba = np.concatenate([texture[::-1] / 255.0, np.ones(texture.shape[:2] + (1,))], axis=-1)
+        image.pixels.foreach_set(rgba.astype(np.float32).ravel())
+        node = nodes.new("ShaderNodeTexImage")
+        node.image = image
+        links.new(node.outputs["Color"], surface.inputs["Color" if spec["kind"] == "diffuse" else "Base Color"])
     shader = surface.outputs["BSDF"]
     emission = spec["emission"]
     if max(emission) > 0:
@@ -76,15 +87,43 @@ def build(path: str) -> tuple[bpy.types.Scene, bpy.types.Object, np.ndarray]:
         if f"n{index}" in data:  # smooth shading with the same per-vertex normals Mitsuba gets
             mesh.shade_smooth()
             mesh.normals_split_custom_set_from_vertices(data[f"n{index}"].tolist())
+        if f"uv{index}" in data:
+            uvs = data[f"uv{index}"]
+            layer = mesh.uv_layers.new(name="uv")
+            corners = np.zeros(len(mesh.loops), dtype=np.int64)
+            mesh.loops.foreach_get("vertex_index", corners)
+            layer.data.foreach_set("uv", uvs[corners].astype(np.float32).ravel())
         mesh.update()
-        mesh.materials.append(_material(obj["name"], obj))
+        mesh.materials.append(_material(obj["name"], obj, data[f"tex{index}"] if f"tex{index}" in data else None))
         scene.collection.objects.link(bpy.data.objects.new(obj["name"], mesh))
     world = bpy.data.worlds.new("world")
     if bpy.app.version < (5, 0, 0):
         world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Color"].default_value = (*meta["world"], 1.0)
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 1.0
+    background = world.node_tree.nodes["Background"]
+    background.inputs["Color"].default_value = (*meta["world"], 1.0)
+    background.inputs["Strength"].default_value = 1.0
+    if meta.get("hdri"):
+        environment = world.node_tree.nodes.new("ShaderNodeTexEnvironment")
+        environment.image = bpy.data.images.load(meta["hdri"]["path"])
+        mapping = world.node_tree.nodes.new("ShaderNodeMapping")
+        coords = world.node_tree.nodes.new("ShaderNodeTexCoord")
+        mapping.inputs["Rotation"].default_value = (0.0, 0.0, meta["hdri"]["rotation"])
+        world.node_tree.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+        world.node_tree.links.new(mapping.outputs["Vector"], environment.inputs["Vector"])
+        world.node_tree.links.new(environment.outputs["Color"], background.inputs["Color"])
+        background.inputs["Strength"].default_value = meta["hdri"]["strength"]
     scene.world = world
+    for index, spec in enumerate(meta.get("lights", [])):  # Blender's units, as hybridgen's lights
+        light = bpy.data.lights.new(f"light{index}", spec["type"])
+        light.energy = spec["energy"]
+        light.color = spec["color"]
+        if spec["type"] in ("POINT", "SPOT"):
+            light.shadow_soft_size = spec.get("radius", 0.0)
+        if spec["type"] == "SUN":
+            light.angle = 0.0
+        light_object = bpy.data.objects.new(f"light{index}", light)
+        light_object.matrix_world = mathutils.Matrix(spec["local2world"])
+        scene.collection.objects.link(light_object)
 
     width, height = meta["resolution"]
     K = np.array(meta["K"])
@@ -122,6 +161,29 @@ def build(path: str) -> tuple[bpy.types.Scene, bpy.types.Object, np.ndarray]:
     return scene, camera, data["poses"]
 
 
+def blenderproc_defaults(scene: bpy.types.Scene, reference: bool, spp: int) -> None:
+    """BlenderProc 2.8's render defaults (its Initializer and DefaultConfig): adaptive sampling to noise
+    threshold 0.01 with at most 1024 spp, Open Image Denoise with albedo and normals, light tree off, bounces
+    max 3 / diffuse 3 / glossy 0 / transmission 0 / transparent 8 / volume 0; Cycles' own defaults elsewhere
+    (indirect clamp 10, filter glossy 1, Blackman-Harris 1.5 px pixel filter, Russian roulette after 0
+    minimum bounces). ``reference``: the same estimator at a fixed ``spp``, no adaptivity, no denoising."""
+    cycles = scene.cycles
+    cycles.use_adaptive_sampling = not reference
+    cycles.adaptive_threshold = 0.01
+    cycles.adaptive_min_samples = 0
+    cycles.samples = spp if reference else 1024
+    cycles.use_denoising = not reference
+    cycles.denoiser = "OPENIMAGEDENOISE"
+    cycles.denoising_input_passes = "RGB_ALBEDO_NORMAL"
+    cycles.use_light_tree = False
+    cycles.max_bounces, cycles.diffuse_bounces, cycles.glossy_bounces = 3, 3, 0
+    cycles.transmission_bounces, cycles.transparent_max_bounces, cycles.volume_bounces = 0, 8, 0
+    cycles.min_light_bounces = 0
+    cycles.sample_clamp_direct, cycles.sample_clamp_indirect, cycles.blur_glossy = 0.0, 10.0, 1.0
+    cycles.pixel_filter_type = "BLACKMAN_HARRIS"
+    cycles.filter_width = 1.5
+
+
 def main(path: str) -> None:
     protocol = os.fdopen(os.dup(1), "w", buffering=1)
     os.dup2(2, 1)  # Blender's progress lines go to stderr
@@ -136,6 +198,8 @@ def main(path: str) -> None:
         pose = np.asarray(poses[request["index"]]) @ np.diag([1.0, -1.0, -1.0, 1.0])  # OpenCV -> Blender axes
         camera.matrix_world = mathutils.Matrix(pose.tolist())  # (a plain nested list would be read transposed)
         scene.cycles.use_light_tree = bool(request["light_tree"])
+        if request.get("mode") in ("blenderproc", "reference"):
+            blenderproc_defaults(scene, request.get("mode") == "reference", int(request.get("spp", 1024)))
         scene.cycles.seed = int(request.get("seed", 0)) % 2**31  # Cycles' seed is an int32
         cpu, wall = time.process_time(), time.perf_counter()
         bpy.ops.render.render(write_still=False)
