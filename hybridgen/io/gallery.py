@@ -102,8 +102,10 @@ def build_gallery(source: str | Path, out_dir: str | Path | None = None, *, keys
         raise InputError(f"'{source}' has no image key(s) {missing}; available: {available}")
     base = Path(source) if Path(source).is_dir() else Path(source).parent
     folder = Path(out_dir) if out_dir is not None else base / "gallery"
-    (folder / "images").mkdir(parents=True, exist_ok=True)
-    (folder / "thumbs").mkdir(parents=True, exist_ok=True)
+    for sub in ("images", "thumbs"):  # the gallery's own folders: previews of an earlier gallery go
+        (folder / sub).mkdir(parents=True, exist_ok=True)
+        for stale in (folder / sub).glob("*.png"):
+            stale.unlink()
     ramp = np.linspace(0, 1, 256)
     _write_png(folder / "images/scale_viridis.png", viridis(ramp)[None].repeat(12, axis=0))
     flow = flow_to_color(np.stack([ramp, np.zeros_like(ramp)], -1), max_radius=1.0)

@@ -94,7 +94,10 @@ def test_page_loads_every_image_with_legends(gallery, tmp_path, run_cli):
 def test_scene_filter_and_screenshot(gallery, tmp_path):
     from hybridgen.io.gallery import build_gallery
 
+    build_gallery(gallery, tmp_path / "g")
     page = build_gallery(gallery, tmp_path / "g", keys=["colors", "depth", "instance_segmaps"])
+    kept = sorted(p.name for p in (tmp_path / "g/thumbs").iterdir())  # the first gallery's other passes are gone
+    assert kept == sorted(f"{i:06d}_{k}.png" for i in range(6) for k in ("colors", "depth", "instance_segmaps"))
     done = chromium(tmp_path, "--virtual-time-budget=10000", "--dump-dom", page.as_uri() + "#scene=1")
     assert done.returncode == 0, done.stderr[-2000:]
     dom = _Elements()
