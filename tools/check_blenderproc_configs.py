@@ -139,6 +139,15 @@ def standin_args(config: Path, work: Path) -> list[str]:
             value = work / f"folder_{i}"
             value.mkdir(exist_ok=True)
         args.append(str(value))
+    # the # Args: line is sometimes out of date: what a placeholder is used for decides where it is clear
+    usage = {"output_dir": work / "output", "folder_path": work / "cc_textures"}
+    for key, value in usage.items():
+        for index in re.findall(rf'"{key}"\s*:\s*"<args:(\d+)>"', text):
+            args[int(index)] = str(value)
+    for root, name in re.findall(r'"bop_dataset_path"\s*:\s*"<args:(\d+)>/<args:(\d+)>"', text):
+        args[int(root)], args[int(name)] = str(work / "bop"), BOP_NAME
+    for root in re.findall(r'"bop_dataset_path"\s*:\s*"<args:(\d+)>/\w+"', text):
+        args[int(root)] = str(work / "bop")
     return args
 
 
@@ -154,16 +163,19 @@ def make_bop_standin(root: Path, name: str = BOP_NAME) -> Path:
     import trimesh
 
     dataset = root / name
-    (dataset / "models").mkdir(parents=True, exist_ok=True)
+    for folder in ("models", "models_cad", "models_eval", "models_reconst"):
+        (dataset / folder).mkdir(parents=True, exist_ok=True)
     info = {}
     for obj_id, extents in ((1, [60, 40, 30]), (2, [30, 30, 80]), (3, [50, 50, 50])):
         box = trimesh.creation.box(extents=extents)
         box.visual.vertex_colors = np.tile([40 * obj_id, 200 - 40 * obj_id, 120, 255], (len(box.vertices), 1))
-        box.export(dataset / "models" / f"obj_{obj_id:06d}.ply")
+        for folder in ("models", "models_cad", "models_eval", "models_reconst"):
+            box.export(dataset / folder / f"obj_{obj_id:06d}.ply")
         info[str(obj_id)] = {"diameter": float(np.linalg.norm(extents)), "min_x": -extents[0] / 2,
                              "min_y": -extents[1] / 2, "min_z": -extents[2] / 2, "size_x": extents[0],
                              "size_y": extents[1], "size_z": extents[2]}
-    (dataset / "models" / "models_info.json").write_text(json.dumps(info))
+    for folder in ("models", "models_cad", "models_eval", "models_reconst"):
+        (dataset / folder / "models_info.json").write_text(json.dumps(info))
     camera = {"cx": 325.26, "cy": 242.05, "fx": 572.41, "fy": 573.57, "width": 640, "height": 480,
               "depth_scale": 1.0}
     (dataset / "camera.json").write_text(json.dumps(camera))
@@ -189,7 +201,7 @@ def make_standins(work: Path) -> None:
 
     (work / "scene.obj").write_text(STANDIN_OBJ)
     (work / "scene.mtl").write_text(STANDIN_MTL)
-    for name in ("lm", "tless", "ycbv", "hb", "icbin", "itodd", "tudl"):
+    for name in ("lm", "tless", "ycbv", "hb", "icbin", "itodd", "tudl", "tyol"):
         make_bop_standin(work / "bop", name)
     Image.new("RGB", (16, 16), (180, 120, 60)).save(work / "texture.png")
     for asset, color in (("Bricks001", (150, 60, 40)), ("Wood002", (120, 90, 50)), ("Marble003", (220, 220, 215))):

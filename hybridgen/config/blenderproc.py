@@ -60,6 +60,7 @@ ALIASES = {
     "manipulators.LightManipulator": "manipulators.EntityManipulator",
     "manipulators.FloorExtractor": "object.FloorExtractor",
     "object.ObjectReplacer": "object.ObjectSwapper",
+    "constructor.BasicMeshInitializer": "loader.PrimitiveLoader",
 }
 """BlenderProc module name -> the hybridgen module that does its work (keys translated below)."""
 
@@ -641,6 +642,10 @@ TRANSLATORS: dict[str, Callable[..., list[tuple[str, dict[str, Any]]]]] = {
     "object.FloorExtractor": _passthrough("object.FloorExtractor", "selector"),
     "manipulators.FloorExtractor": _passthrough("object.FloorExtractor", "selector"),
 }
+KEYS_ONLY_BLENDERPROC = ("constructor.BasicMeshInitializer", "object.ObjectReplacer", "renderer.NormalRenderer",
+                         "renderer.DepthRenderer", "renderer.DistanceRenderer", "renderer.FlowRenderer",
+                         "loader.ObjectLoader", "loader.PlyLoader")
+"""BlenderProc names whose keys are BlenderProc's in any config (hybridgen has no module of that name)."""
 WRITERS = {name: _writer(name) for name in ("writer.Hdf5Writer", "writer.BopWriter", "writer.CocoAnnotationsWriter")}
 
 
@@ -655,8 +660,8 @@ def translate_module(name: str, config: dict[str, Any], note: Note,
     """
     if name in UNAVAILABLE:
         raise ConfigError(f"not available in hybridgen: {UNAVAILABLE[name]}", key="module")
-    if not state.get("blenderproc"):  # hybridgen's own form: names only, keys and defaults are hybridgen's
-        return [(ALIASES.get(name, name), config)]
+    if not state.get("blenderproc") and name not in KEYS_ONLY_BLENDERPROC:
+        return [(ALIASES.get(name, name), config)]  # hybridgen's own form: names only, hybridgen's keys
     config = samplers_as_blenderproc(copy.deepcopy(config), note, "config")
     if name in WRITERS:
         return WRITERS[name](config, note, state)

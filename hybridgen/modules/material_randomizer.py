@@ -11,6 +11,9 @@ from __future__ import annotations
 import copy
 from typing import Any
 
+import numpy as np
+
+from ..config.notices import notice
 from ..config.registry import register_module
 from ..config.schema import Param
 from ..errors import InputError
@@ -27,6 +30,13 @@ def _check_source(value: Any) -> str | None:
         return "must be a getter.Material selector {provider: getter.Material, conditions, random_samples}"
     unknown = [k for k in value if k not in ("provider", "conditions", "random_samples", "check_empty")]
     return f"unknown key(s) {unknown}" if unknown else None
+
+
+def planar_uvs(vertices: np.ndarray) -> np.ndarray:
+    """UVs of a projection along local Z over the XY bounding box: a Blender plane's own UVs ([0, 1]^2)."""
+    xy = np.asarray(vertices, dtype=np.float64)[:, :2]
+    low, span = xy.min(axis=0), np.ptp(xy, axis=0)
+    return (xy - low) / np.where(span > 0, span, 1.0)
 
 
 @register_module("manipulators.MaterialRandomizer")
@@ -72,5 +82,7 @@ class MaterialRandomizer(SelectingModule):
             pick = shared if self.config["mode"] == "once_for_all" else \
                 candidates[int(context.rng.integers(len(candidates)))]
             if pick.base_color_texture is not None and obj.uvs is None:
-                raise InputError(f"object '{obj.name}' has no UVs for the textured material '{pick.name}'")
+                obj.uvs = planar_uvs(obj.vertices)
+                notice(f"object '{obj.name}' has no UVs: the texture is projected along its local Z axis",
+                       module=self.module_name, index=self.index, key="selector")
             obj.material = copy.copy(pick)
