@@ -79,9 +79,12 @@ def _parse_shard(text: str | None) -> tuple[int, int] | None:
 
 def _cmd_run(ns: argparse.Namespace) -> dict[str, Any]:
     from .config.notices import set_strict
+    from .io.mesh_references import LENIENT_ENV
     from .run.pipeline import run_config
 
     set_strict(ns.strict)
+    if ns.lenient:  # inherited by worker processes, read by the mesh loader
+        os.environ[LENIENT_ENV] = "1"
     summary = run_config(ns.config, ns.args, progress=_progress_factory(not ns.quiet), log=log_line,
                          workers=ns.workers, shard=_parse_shard(ns.shard), executor=ns.executor,
                          address=ns.address, restart=ns.restart, force_resume=ns.force_resume,
@@ -190,6 +193,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "Rerunning the same command resumes: complete work units are verified and kept.")
     run.add_argument("config", help="YAML config file")
     run.add_argument("args", nargs="*", help="values for <args:0>, <args:1>, ... (e.g. the output folder)")
+    run.add_argument("--lenient", action="store_true", help="render meshes whose MTL or texture files are "
+                     "missing (a notice) instead of stopping with an error")
     run.add_argument("--strict", action="store_true", help="every notice (a BlenderProc key or setting hybridgen "
                      "accepts but handles differently) is an error")
     run.add_argument("--workers", type=int, default=1, help="processes running work units in parallel (default 1)")

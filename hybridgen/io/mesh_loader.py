@@ -25,11 +25,13 @@ from typing import Any, Callable, Iterable, Sequence
 
 import numpy as np
 
+from ..config.notices import notice
 from ..config.paths import not_found
 from ..errors import InputError
 from ..scene.frames import euler_xyz_to_matrix, make_pose
 from ..scene.material import Material
 from ..scene.mesh_object import MeshObject
+from .mesh_references import check_references, is_lenient
 
 LOADERS: dict[str, tuple[str, str]] = {
     ".obj": ("obj", "Y"),
@@ -160,6 +162,11 @@ def load_objects(path: str | Path, *, name: str | None = None, category_id: int 
     up = native_up if up_axis == "auto" else str(up_axis).upper()
     if up not in ("Y", "Z"):
         raise InputError(f"up_axis must be 'auto', 'Y' or 'Z', got {up_axis!r}")
+    problem = check_references(file) if file_type == "obj" else None
+    if problem is not None:
+        if not is_lenient():
+            raise InputError(f"{problem} (hybridgen run --lenient renders it anyway)")
+        (notify or notice)(problem)
     try:
         loaded, obj_names = _read_scene(file, file_type)
     except Exception as exc:

@@ -20,20 +20,17 @@ from __future__ import annotations
 import glob
 import hashlib
 import json
-import re
 from pathlib import Path
 from typing import Any, Iterator
 
 from .._version import __version__
 from ..config.config_file import ConfigFile
+from ..io.mesh_references import referenced_files
 
 FINGERPRINT_ATTR = "fingerprint"
 IGNORED_KEYS = ("output_dir",)
 MAX_FOLDER_FILES = 10_000  # files hashed per named folder
 _LONG_VALUE = 200  # leaf values longer than this (in JSON) are stored as their SHA-256
-_MTLLIB = re.compile(rb"^\s*mtllib\s+(.+?)\s*$", re.MULTILINE)
-_MTL_MAPS = re.compile(rb"^\s*(?:map_\w+|bump|disp|decal|norm)\s+(?:-\S+(?:\s+[-\d.]+)*\s+)*(\S.*?)\s*$",
-                       re.MULTILINE)
 
 
 def _leaves(value: Any, prefix: str) -> Iterator[tuple[str, Any]]:
@@ -58,16 +55,6 @@ def file_sha256(path: Path) -> str:
     """Hex SHA-256 of a file's bytes."""
     with open(path, "rb") as handle:
         return hashlib.file_digest(handle, "sha256").hexdigest()
-
-
-def _referenced_by(path: Path) -> list[Path]:
-    """Files an OBJ (its MTL libraries) or an MTL (its texture maps) names, relative to its folder."""
-    suffix = path.suffix.lower()
-    if suffix not in (".obj", ".mtl") or path.stat().st_size > 512 * 2**20:
-        return []
-    pattern = _MTLLIB if suffix == ".obj" else _MTL_MAPS
-    names = [m.group(1).decode("utf-8", "replace") for m in pattern.finditer(path.read_bytes())]
-    return [path.parent / name for name in names]
 
 
 def _candidate_files(text: str, folder: Path) -> list[Path]:
@@ -102,7 +89,7 @@ def input_files(config: ConfigFile) -> list[Path]:
             continue
         seen[key] = path
         try:
-            queue.extend(_referenced_by(path))
+            queue.extend(referenced_files(path))
         except OSError:
             pass
     return list(seen.values())

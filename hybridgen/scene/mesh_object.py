@@ -10,6 +10,8 @@ import numpy as np
 from ..errors import InputError
 from .material import Material
 
+FLOAT32_MAX = float(np.finfo(np.float32).max)
+
 
 @dataclass(eq=False)
 class MeshObject:
@@ -41,6 +43,32 @@ class MeshObject:
                                  f"{len(self.vertices)} vertices")
         self.local2world = np.array(self.local2world, dtype=np.float64).reshape(4, 4)
         self.validate()
+        if self.vertex_normals is not None:
+            self._repair_zero_normals()
+
+    def _repair_zero_normals(self) -> None:
+        """Vertex normals of (near) zero length - ``vn 0 0 0`` in a file - would label pixels with normal
+        (0, 0, 0): they are recomputed from the area-weighted normals of the faces around the vertex, with a
+        notice."""
+        normals = self.vertex_normals
+        assert normals is not None
+        zero = np.einsum("ij,ij->i", normals, normals) < 1e-20
+        if not zero.any():
+            return
+        corners = self.vertices[self.faces]
+        weighted = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])  # length: twice the area
+        summed = np.zeros_like(normals)
+        for corner in range(3):
+            np.add.at(summed, self.faces[:, corner], weighted)
+        length = np.linalg.norm(summed, axis=1, keepdims=True)
+        fixed = zero & (length[:, 0] > 0)
+        normals = normals.copy()
+        normals[fixed] = summed[fixed] / length[fixed]
+        self.vertex_normals = normals
+        from ..config.notices import notice
+
+        notice(f"object '{self.name}': {int(fixed.sum())} zero-length vertex normal(s) recomputed from the faces "
+               "around them")
 
     def validate(self) -> None:
         """Raise :class:`InputError` for data no renderer can draw (empty, NaN/inf, bad indices)."""
@@ -49,6 +77,10 @@ class MeshObject:
         if not np.all(np.isfinite(self.vertices)):
             bad = int(np.count_nonzero(~np.all(np.isfinite(self.vertices), axis=1)))
             raise InputError(f"object '{self.name}' has {bad} vertices with NaN or inf coordinates")
+        beyond = np.abs(self.vertices).max(axis=1) > FLOAT32_MAX
+        if beyond.any():
+            raise InputError(f"object '{self.name}' has {int(beyond.sum())} vertices with coordinates beyond the "
+                             f"float32 range (|x| > {FLOAT32_MAX:.3g}), which the renderers store")
         if self.faces.min() < 0 or self.faces.max() >= len(self.vertices):
             raise InputError(f"object '{self.name}' has face indices outside 0..{len(self.vertices) - 1}")
         if not np.any(self.face_normals):

@@ -1,0 +1,56 @@
+"""Files a mesh file names: the MTL libraries of an OBJ and the texture maps of an MTL.
+
+Used to check that they exist before loading (trimesh renders a mesh untextured, without a word, when they
+are missing) and to include them in a run's fingerprint (an edited texture changes the output).
+"""
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+MAX_SCANNED_BYTES = 512 * 2**20
+_MTLLIB = re.compile(rb"^[ \t]*mtllib[ \t]+(.+?)[ \t]*\r?$", re.MULTILINE)
+_MAPS = re.compile(rb"^[ \t]*(?:map_\w+|bump|disp|decal|norm|refl)[ \t]+"  # statement
+                   rb"(?:-\S+(?:[ \t]+[-\d.]+)*[ \t]+)*"  # options such as -s 1 1 1 or -bm 0.5
+                   rb"(\S.*?)[ \t]*\r?$", re.MULTILINE)
+
+
+def referenced_files(path: Path) -> list[Path]:
+    """The files ``path`` (an .obj or .mtl) names, relative to its folder as OBJ readers resolve them;
+    empty for other formats and for files beyond :data:`MAX_SCANNED_BYTES`."""
+    suffix = path.suffix.lower()
+    if suffix not in (".obj", ".mtl") or path.stat().st_size > MAX_SCANNED_BYTES:
+        return []
+    pattern = _MTLLIB if suffix == ".obj" else _MAPS
+    names = [m.group(1).decode("utf-8", "replace") for m in pattern.finditer(path.read_bytes())]
+    return [path.parent / name.replace("\\", "/") for name in names]
+
+
+def missing_references(path: Path) -> list[Path]:
+    """The MTL files an OBJ names, and the textures those name, that do not exist."""
+    missing: list[Path] = []
+    for library in referenced_files(path):
+        if not library.is_file():
+            missing.append(library)
+            continue
+        missing.extend(texture for texture in referenced_files(library) if not texture.is_file())
+    return missing
+
+
+LENIENT_ENV = "HYBRIDGEN_LENIENT"
+
+
+def is_lenient() -> bool:
+    """``hybridgen run --lenient`` (inherited by worker processes): missing MTL/texture files are a notice."""
+    return os.environ.get(LENIENT_ENV, "") not in ("", "0")
+
+
+def check_references(path: Path) -> str | None:
+    """None when every file ``path`` names exists; else the one-line problem (raise it, or with
+    :func:`is_lenient` report it as a notice)."""
+    missing = missing_references(path)
+    if not missing:
+        return None
+    shown = ", ".join(f"'{p}'" for p in missing[:3]) + (f" and {len(missing) - 3} more" if len(missing) > 3 else "")
+    return f"mesh '{path}': missing file(s) it names: {shown}; it would render without its materials/textures"
