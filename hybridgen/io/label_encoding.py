@@ -10,9 +10,10 @@ as they are. Encodings:
 ``encoding = "octahedral_uint16"``
     unit normals (…, 3) stored as (…, 2) uint16 codes of the octahedral map: ``q = (code - 1) / 32767 - 1``
     in [-1, 1]^2, code (0, 0) is the background normal (0, 0, 0). ``max_error_rad`` states the bound on
-    the angle between a stored and a decoded normal: the quantization step 2/65534 moves the octahedral
-    point by at most sqrt(2)/65534 and the map stretches lengths by at most sqrt(6) on the way back to
-    the sphere, so the error is < 5.3e-5 rad (plus float32 rounding); the bound stated is 1e-4 rad.
+    the angle between a stored and a decoded normal: rounding moves the octahedral point by at most
+    sqrt(2)/65534; lifting it to (px, py, 1 - |px| - |py|) stretches by at most sqrt(3) and normalizing a
+    vector at least 1/sqrt(3) long by at most sqrt(3) more, so the error is below 3 sqrt(2)/65534 = 6.5e-5
+    rad (plus float32 rounding); the bound stated is 1e-4 rad.
 ``encoding = "derived_from_depth"``
     ``distance`` is not stored (no chunk is written; a plain read gives the NaN fill value): it is
     ``depth * |((u - cx) / fx, (v - cy) / fy, 1)|`` per pixel centre, the ray length rounded to float32

@@ -4,7 +4,8 @@ from __future__ import annotations
 from ..config.notices import notice
 from ..config.registry import register_module
 from ..config.schema import Param
-from ..io.mesh_loader import LOADERS, load_objects, unique_blender_name
+from ..io.mesh_cache import load_objects_cached
+from ..io.mesh_loader import LOADERS, unique_blender_name
 from ..run.context import RunContext
 from .base import Module
 from .placement import PLACEMENT_PARAMS, apply_placement, drawn_placement, placement_pose
@@ -28,10 +29,10 @@ class ObjLoader(Module):
 
     def run(self, context: RunContext) -> None:
         cfg = drawn_placement(self, context)
-        objects = load_objects(cfg["path"], name=cfg["name"], category_id=cfg["category_id"],
-                               local2world=placement_pose(cfg), up_axis=cfg["up_axis"],
-                               attributes=cfg["attributes"],
-                               notify=lambda line: notice(line, module=self.module_name, index=self.index))
+        objects = load_objects_cached(cfg["path"], name=cfg["name"], category_id=cfg["category_id"],
+                                      local2world=placement_pose(cfg), up_axis=cfg["up_axis"],
+                                      attributes=cfg["attributes"],
+                                      notify=lambda line: notice(line, module=self.module_name, index=self.index))
         add_with_blender_names(context, apply_placement(objects, cfg), renamed=cfg["name"] is None)
 
 

@@ -1,0 +1,149 @@
+"""A disk cache of parsed mesh files, so that a run's time to first keypoint is not spent re-parsing.
+
+:func:`load_objects_cached` returns what :func:`hybridgen.io.mesh_loader.load_objects` returns, but keeps
+the parsed objects (in the file's own frame, with the properties the label pass needs - face normals and
+whether each part is a closed volume - already computed) under ``$HYBRIDGEN_CACHE_DIR/meshes`` (default
+``$XDG_CACHE_HOME/hybridgen/meshes`` or ``~/.cache/hybridgen/meshes``, as the physics cache). The key is a SHA-256 over the bytes of the file and of every MTL / texture
+file it names, the options that change parsing (``name``, ``up_axis``), the hybridgen version and the
+source of the modules that build the objects - so an edited file, texture or loader never meets a stale
+entry. Entries are written to a temporary name and renamed (atomic); a damaged or unreadable entry is a
+miss. ``HYBRIDGEN_CACHE_DIR=off`` (or an unwritable folder) turns the cache off.
+
+Entries are pickles: the cache folder must be writable only by its user (as any ``~/.cache``).
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import pickle
+import tempfile
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from .._version import __version__
+from .mesh_references import referenced_files
+
+CACHE_ENV = "HYBRIDGEN_CACHE_DIR"
+_FORMAT = 1
+
+
+def cache_dir() -> Path | None:
+    """The folder of cached meshes (``meshes`` in hybridgen's cache folder), or None when turned off."""
+    from ..physics.shapes import cache_dir as hybridgen_cache_dir
+
+    if os.environ.get(CACHE_ENV, "").lower() in ("off", "0", "none"):
+        return None
+    return hybridgen_cache_dir() / "meshes"
+
+
+def _source_digest() -> str:
+    """SHA-256 of the modules whose code decides what a loaded object holds."""
+    from ..scene import material, mesh_object
+    from . import mesh_loader
+
+    digest = hashlib.sha256()
+    for module in (mesh_loader, mesh_object, material):
+        digest.update(Path(module.__file__ or "").read_bytes())
+    return digest.hexdigest()
+
+
+def cache_key(path: Path, options: dict[str, Any]) -> str:
+    """The entry name of ``path`` parsed with ``options`` (content, not file times, decides)."""
+    digest = hashlib.sha256(f"{_FORMAT}\0{__version__}\0{_source_digest()}\0{sorted(options.items())!r}".encode())
+    files, queue = [], [path]
+    while queue:  # the OBJ, the MTL libraries it names, the textures those name
+        file = queue.pop(0)
+        if file in files:
+            continue
+        files.append(file)
+        try:
+            queue += referenced_files(file)
+        except OSError:
+            pass
+    for file in files:
+        digest.update(f"\0{file.name}\0".encode())
+        try:
+            with open(file, "rb") as handle:
+                digest.update(hashlib.file_digest(handle, "sha256").digest())
+        except OSError:
+            digest.update(b"<missing>")
+    return digest.hexdigest()
+
+
+def load_objects_cached(path: str | Path, *, name: str | None = None, category_id: int | None = None,
+                        local2world: np.ndarray | None = None, up_axis: str = "auto",
+                        attributes: dict[str, Any] | None = None,
+                        notify: Callable[[str], None] | None = None) -> list[Any]:
+    """:func:`~hybridgen.io.mesh_loader.load_objects` through the cache (same arguments, same objects)."""
+    from .mesh_loader import load_objects
+
+    folder = cache_dir()
+    file = Path(path)
+    if folder is None or not file.is_file():  # a missing file: the loader's own error
+        return load_objects(path, name=name, category_id=category_id, local2world=local2world, up_axis=up_axis,
+                            attributes=attributes, notify=notify)
+    base = np.eye(4) if local2world is None else np.asarray(local2world, dtype=np.float64)
+    if not np.all(np.isfinite(base)):  # the loader's own error
+        return load_objects(path, name=name, category_id=category_id, local2world=local2world, up_axis=up_axis,
+                            attributes=attributes, notify=notify)
+    entry = folder / f"{cache_key(file, {'name': name, 'up_axis': str(up_axis)})}.pickle"
+    cached = _read(entry)
+    if cached is None:
+        notices: list[str] = []
+        objects = load_objects(file, name=name, up_axis=up_axis, notify=notices.append)
+        if not all(_exact_under_any_pose(obj.local2world) for obj in objects):  # e.g. glTF node transforms
+            for line in notices:
+                if notify is not None:
+                    notify(line)
+            return load_objects(path, name=name, category_id=category_id, local2world=local2world,
+                                up_axis=up_axis, attributes=attributes)
+        for obj in objects:  # what the label pass asks of every object, computed once
+            _ = obj.face_normals, obj.is_closed
+        cached = {"objects": objects, "notices": notices}
+        _write(entry, cached)
+    for line in cached["notices"]:
+        if notify is not None:
+            notify(line)
+    objects = cached["objects"]
+    for obj in objects:
+        obj.local2world = base @ obj.local2world  # exact: a signed permutation (see _exact_under_any_pose)
+        obj.category_id = category_id
+        obj.attributes.update(attributes or {})
+    return objects
+
+
+def _exact_under_any_pose(matrix: np.ndarray) -> bool:
+    """Whether ``pose @ matrix`` is bit-identical to what the loader computes for any ``pose``: the file's
+    own part transform is an axis turn (a signed permutation, no translation), so every product is exact
+    and a cached run writes the same bytes as an uncached one."""
+    rotation = matrix[:3, :3]
+    return bool(np.all(np.isin(rotation, (-1.0, 0.0, 1.0))) and np.all(np.abs(rotation).sum(axis=0) == 1)
+                and np.all(np.abs(rotation).sum(axis=1) == 1) and not np.any(matrix[:3, 3])
+                and np.array_equal(matrix[3], [0.0, 0.0, 0.0, 1.0]))
+
+
+def _read(entry: Path) -> dict[str, Any] | None:
+    try:
+        with open(entry, "rb") as handle:
+            value = pickle.load(handle)
+    except (OSError, EOFError, pickle.UnpicklingError, AttributeError, ImportError, TypeError, ValueError):
+        return None
+    return value if isinstance(value, dict) and "objects" in value else None
+
+
+def _write(entry: Path, value: dict[str, Any]) -> None:
+    """Store ``value`` under ``entry`` atomically; a cache that cannot be written is silently skipped."""
+    try:
+        entry.parent.mkdir(parents=True, exist_ok=True)
+        handle, temp = tempfile.mkstemp(dir=entry.parent, prefix=f".{entry.name}.", suffix=".tmp")
+        try:
+            with os.fdopen(handle, "wb") as out:
+                pickle.dump(value, out, protocol=pickle.HIGHEST_PROTOCOL)
+            os.replace(temp, entry)
+        except BaseException:
+            Path(temp).unlink(missing_ok=True)
+            raise
+    except OSError:
+        pass

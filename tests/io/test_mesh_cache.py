@@ -1,0 +1,105 @@
+"""The parsed-mesh cache (hybridgen.io.mesh_cache): a hit gives exactly the objects a fresh parse gives,
+content (not file times) decides, entries are written atomically, and a run writes the same bytes cold
+and warm."""
+from __future__ import annotations
+
+import hashlib
+import shutil
+
+import numpy as np
+import pytest
+
+import hybridgen as hg
+from hybridgen.io.mesh_cache import load_objects_cached
+from tests.conftest import REPO
+
+POSE = hg.object_pose([0.3, -1.1, 0.25], [0.4, -0.2, 1.3], 0.35)
+
+
+def _same(a: list, b: list) -> None:
+    assert [o.name for o in a] == [o.name for o in b]
+    for x, y in zip(a, b):
+        for field in ("vertices", "faces", "local2world"):
+            assert np.array_equal(getattr(x, field), getattr(y, field)), field  # bit-identical
+        assert (x.vertex_normals is None) == (y.vertex_normals is None)
+        if x.vertex_normals is not None:
+            assert np.array_equal(x.vertex_normals, y.vertex_normals)
+        assert x.category_id == y.category_id and x.attributes == y.attributes
+        assert x.is_closed == y.is_closed and np.array_equal(x.face_normals, y.face_normals)
+        for key, value in vars(x.material).items():  # textures are arrays
+            other = vars(y.material)[key]
+            assert np.array_equal(value, other) if isinstance(value, np.ndarray) else value == other, key
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch):
+    folder = tmp_path / "cache"
+    monkeypatch.setenv("HYBRIDGEN_CACHE_DIR", str(folder))
+    return folder / "meshes"
+
+
+@pytest.mark.parametrize("up_axis", ["auto", "Z"])
+def test_hit_equals_a_fresh_parse(cache, tmp_path, up_axis):
+    mesh = tmp_path / "knot.obj"
+    for name in ("knot.obj", "knot.mtl", "knot.png"):
+        shutil.copy(REPO / "configs/assets" / name, tmp_path / name)
+    fresh = hg.load_objects(mesh, name="k", category_id=3, local2world=POSE, up_axis=up_axis,
+                            attributes={"a": 1})
+    cold = load_objects_cached(mesh, name="k", category_id=3, local2world=POSE, up_axis=up_axis, attributes={"a": 1})
+    assert len(list(cache.glob("*.pickle"))) == 1 and not list(cache.glob("*.tmp"))
+    warm = load_objects_cached(mesh, name="k", category_id=3, local2world=POSE, up_axis=up_axis, attributes={"a": 1})
+    _same(fresh, cold)
+    _same(fresh, warm)
+    unposed = load_objects_cached(mesh, name="k", category_id=7, up_axis=up_axis)
+    _same(hg.load_objects(mesh, name="k", category_id=7, up_axis=up_axis), unposed)
+    assert len(list(cache.glob("*.pickle"))) == 1  # pose, category and attributes are not part of the key
+    # content decides: an edited texture (named by the MTL) is a new entry
+    (tmp_path / "knot.png").write_bytes((tmp_path / "knot.png").read_bytes() + b"\0")
+    load_objects_cached(mesh, name="k", category_id=3, local2world=POSE, up_axis=up_axis)
+    assert len(list(cache.glob("*.pickle"))) == 2
+
+
+def test_damaged_entry_is_a_miss_and_off_turns_it_off(cache, tmp_path, monkeypatch):
+    mesh = REPO / "configs/assets/crate.obj"
+    fresh = hg.load_objects(mesh, category_id=1)
+    load_objects_cached(mesh, category_id=1)
+    (entry,) = cache.glob("*.pickle")
+    entry.write_bytes(entry.read_bytes()[:100])  # truncated
+    _same(fresh, load_objects_cached(mesh, category_id=1))
+    _same(fresh, load_objects_cached(mesh, category_id=1))  # rewritten whole
+    monkeypatch.setenv("HYBRIDGEN_CACHE_DIR", "off")
+    shutil.rmtree(cache)
+    _same(fresh, load_objects_cached(mesh, category_id=1))
+    assert not cache.exists()
+
+
+def test_missing_file_is_the_loaders_error(cache, tmp_path):
+    with pytest.raises(hg.InputError, match="not found"):
+        load_objects_cached(tmp_path / "nope.obj")
+
+
+CONFIG = """
+global: {all: {output_dir: "<args:0>"}}
+modules:
+  - {name: main.Initializer, config: {seed: 3}}
+  - {name: loader.ObjLoader, config: {path: %s, name: knot, category_id: 2, location: [0.1, 0.2, 0.3],
+                                      rotation: [0.2, 0.1, 0.7], scale: 0.4}}
+  - name: camera.CameraLoader
+    config:
+      intrinsics: {resolution_x: 32, resolution_y: 24}
+      cam_poses: [{location: [2, -2, 1.5], rotation: {format: look_at, value: [0, 0, 0.3]}}]
+  - {name: renderer.SegMapRenderer}
+  - {name: writer.Hdf5Writer}
+"""
+
+
+def test_run_writes_the_same_bytes_cold_and_warm(gl_context, cache, tmp_path, run_cli, write_config):
+    config = write_config(CONFIG % (REPO / "configs/assets/knot.obj"))
+    digests = []
+    for _ in range(2):
+        shutil.rmtree(tmp_path / "out", ignore_errors=True)
+        code, _, err = run_cli("run", "-q", str(config), str(tmp_path / "out"))
+        assert code == 0, err
+        digests.append(hashlib.sha256((tmp_path / "out/data.hdf5").read_bytes()).hexdigest())
+        assert len(list(cache.glob("*.pickle"))) == 1
+    assert digests[0] == digests[1]
