@@ -1,10 +1,12 @@
 """Executes a config: validate every module first, then run them in order, then commit outputs."""
 from __future__ import annotations
 
+import errno
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any, Callable, Iterator, Mapping, Sequence
 
 from ..config.config_file import ConfigFile, load_config
 from ..config.paths import config_folder, resolve_module_paths
@@ -101,6 +103,20 @@ def writer_folders(modules: list[Module]) -> list[Path]:
             if m.module_name.startswith("writer.") and isinstance(m.config.get("output_dir"), str)]
 
 
+@contextmanager
+def disk_full_is_one_line(folders: list[Path]) -> Iterator[None]:
+    """A full disk (ENOSPC, also as h5py's OSError from a worker) becomes one InputError naming the output
+    folder; the writers have already deleted their temporary files."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.errno != errno.ENOSPC and "No space left on device" not in str(exc):
+            raise
+        where = ", ".join(f"'{folder}'" for folder in folders) or "the output folder"
+        raise InputError(f"no space left on the device writing into {where}; nothing incomplete was kept under "
+                         "a final name (rerun to resume once there is space)") from None
+
+
 def single_file_output(modules: list[Module]) -> Path | None:
     """The final path of the config's ``writer.Hdf5Writer`` with ``layout: single`` when it is the only
     writer (then an existing file is resumed or refused); None for other configs (appending writers such as
@@ -143,7 +159,7 @@ def run_config(path: str | Path, args: Sequence[str] = (), *, env: Mapping[str, 
     single = single_file_output(modules)
     if single is not None and single.is_dir():
         raise InputError(f"'{single}' is a directory; the output file cannot be written there")
-    with stop_on_signals(), output_locks(writer_folders(modules)):
+    with stop_on_signals(), output_locks(writer_folders(modules)), disk_full_is_one_line(writer_folders(modules)):
         if plan is not None:
             return run_sharded(plan, path, args, env, workers=workers, shard=shard, executor=executor,
                                address=address, log=say, start=start, policy=policy,

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 
 import h5py
+import pytest
 
 from hybridgen.io.integrity import verify
 
@@ -59,3 +60,39 @@ def test_shards_as_a_file_and_index_as_a_folder_fail_before_rendering(gl_context
     single = write_config(CONFIG.replace("SCENES", "1"), "single.yaml")
     code, _, err = run_cli("run", "-q", str(single), str(out))
     assert code == 2 and "is a directory" in err
+
+
+def test_disk_full_is_one_line_and_leaves_nothing(gl_context, tmp_path, write_config, run_cli, monkeypatch):
+    """ENOSPC from the HDF5 layer while committing: one line, no temporary file, no final file."""
+    import errno
+
+    import hybridgen.io.hdf5_single as single
+
+    def full(h5):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(single, "seal", full)
+    out = tmp_path / "out"
+    code, _, err = run_cli("run", "-q", str(write_config(CONFIG.replace("SCENES", "1"))), str(out))
+    assert code == 2 and "no space left on the device" in err and len(err.strip().splitlines()) == 1
+    assert not [p for p in out.rglob("*") if p.is_file()]
+
+
+def test_real_full_filesystem(gl_context, tmp_path, write_config, run_cli):
+    """The same on a 200 KiB tmpfs (needs permission to mount; skipped otherwise)."""
+    import subprocess
+
+    small = tmp_path / "small"
+    small.mkdir()
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=200k", "tmpfs", str(small)],
+                      capture_output=True).returncode != 0:
+        pytest.skip("cannot mount a tmpfs here")
+    try:
+        config = write_config(CONFIG.replace("SCENES", "1").replace(
+            "resolution_x: 8, resolution_y: 6", "resolution_x: 256, resolution_y: 192").replace(
+            "  - name: writer.Hdf5Writer", "  - name: writer.Hdf5Writer\n    config: {compression: none}"))
+        code, _, err = run_cli("run", "-q", str(config), str(small / "out"))
+        assert code == 2 and "no space left on the device" in err and len(err.strip().splitlines()) == 1
+        assert not [p for p in (small / "out").rglob("*") if p.is_file()]
+    finally:
+        subprocess.run(["umount", str(small)], check=True)
