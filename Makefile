@@ -5,7 +5,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.hybridgen-installed
 PIP    := $(BIN)/python -m pip --disable-pip-version-check
 
-.PHONY: setup system demo test bench clean
+.PHONY: setup system demo test bench mutate clean
 
 setup: system $(STAMP)
 
@@ -35,6 +35,15 @@ bench: setup
 	$(PIP) install -q -e '.[bench]'
 	$(BIN)/python tools/bench_labels.py
 	$(BIN)/python tools/bench_color.py
+
+# Mutation testing (not part of `make test`: about an hour on 2 cores). cosmic-ray lives in its own venv;
+# the tests run in .venv on a scratch copy of the committed tree. Report: tools/mutation/last_run.md.
+# MUTATE_ARGS="--packages render io --sample 20" narrows it; see tools/mutation/README.md.
+MUTVENV := .venv-mutation
+mutate: setup
+	@test -x $(MUTVENV)/bin/python || $(PYTHON) -m venv $(MUTVENV)
+	$(MUTVENV)/bin/python -m pip --disable-pip-version-check install -q -r tools/mutation/requirements.txt
+	nice -n 15 $(MUTVENV)/bin/python tools/mutation/run_mutation.py --python $(BIN)/python $(MUTATE_ARGS)
 
 clean:
 	rm -rf output .pytest_cache
