@@ -75,7 +75,12 @@ class KeypointDataset:
         position = int(index) + (count if int(index) < 0 else 0)
         if not 0 <= position < count:
             raise IndexError(f"keypoint {index} out of range for {count} keypoint(s)")
-        return self.layout.read(self._file(), position, self.keys)
+        try:
+            return self.layout.read(self._file(), position, self.keys)
+        except OSError as exc:  # a damaged chunk (checksum/filter failure) read past an intact header
+            detail = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise InputError(f"{self._where()}: keypoint {position} cannot be read, the file is damaged "
+                             f"({detail})") from None
 
     def __iter__(self) -> Iterator[dict[str, Any]]:
         for index in range(len(self)):

@@ -205,3 +205,26 @@ def test_changed_input_file_is_named(gl_context, tmp_path, write_config, run_cli
     mtl.write_text("newmtl red\nKd 0.1 0.8 0.1\n")
     code, _, err = run_cli("run", "-q", str(config), str(out))
     assert code == 2 and f"input:{mtl}" in err and "input:" + str(mesh) not in err
+
+
+def test_every_reader_command_on_a_damaged_or_foreign_file_is_one_line(gl_context, tmp_path, write_config, run_cli):
+    config = write_config(SINGLE.replace("SEED", "1"))
+    out = tmp_path / "out"
+    assert run_cli("run", "-q", str(config), str(out))[0] == 0
+    damaged = tmp_path / "damaged.hdf5"
+    data = bytearray((out / "data.hdf5").read_bytes())
+    with h5py.File(out / "data.hdf5") as h5:
+        info = h5["depth"].id.get_chunk_info(1)
+    data[info.byte_offset:info.byte_offset + info.size] = bytes(info.size)  # a zeroed deflate stream
+    damaged.write_bytes(bytes(data))
+    foreign = tmp_path / "foreign.hdf5"
+    with h5py.File(foreign, "w") as h5:
+        h5["x"] = np.arange(3)
+    garbage = tmp_path / "garbage.hdf5"
+    garbage.write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(range(256)) * 4)
+    for path in (damaged, foreign, garbage):
+        for argv in (("vis", str(path), "--save", str(tmp_path / "sheets")),
+                     ("extract", str(path), "--output_dir", str(tmp_path / "files"))):
+            code, _, err = run_cli(*argv)
+            assert code == 2 and len(err.strip().splitlines()) == 1 and "Traceback" not in err, (argv, err)
+    assert not (tmp_path / "files").exists()
