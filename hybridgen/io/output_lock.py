@@ -1,12 +1,12 @@
 """One writer per output folder: an advisory ``fcntl.flock`` on ``<output_dir>/.hybridgen.lock``.
 
 A run holds the lock of every writer's folder from before its first module runs until it ends
-(:func:`output_lock` with ``wait=False``); a second run into the same folder gets one line naming the
-holder's pid and host. Writers that append to a folder (COCO, BlenderProc layout, BOP) also take the lock
-around their commit, where they hand out image ids and file numbers (``wait=True``: callers of the Python
-API queue behind each other instead of failing). Inside one process the lock is re-entrant.
+(:func:`output_locks`); a second run into the same folder gets one line naming the holder's pid and host.
+Writers that append to a folder (COCO, BlenderProc layout, BOP) also hold it themselves
+(:func:`hold_output_lock`) from the moment they read the existing ids and file numbers until they commit or
+abort, so users of the Python API are protected too. Inside one process the lock is re-entrant (counted).
 
-``flock`` is advisory and local to one machine's kernel for most network filesystems (NFS emulates it
+``flock`` is advisory and, on most network filesystems, only seen by one machine's kernel (NFS emulates it
 with ``fcntl`` locks since Linux 2.6.12); the lock file records ``pid host`` for the message. The file is
 removed on release; a process that acquired the lock checks that it locked the file still at that name,
 so removal never lets two holders in.
