@@ -32,7 +32,7 @@ class Hdf5Writer(Module):
         Param("encoding", "str", "compact", choices=ENCODINGS,
               doc="single layout: compact (ids in the smallest integer type, normals octahedral uint16 within "
               "1e-4 rad, distance derived from depth; read them with hybridgen.data or "
-              "hybridgen.io.label_encoding.decode_dataset, docs/reading_outputs.md) or plain (the documented "
+              "hybridgen.io.label_encoding.decode_dataset, docs/outputs.md) or plain (the documented "
               "dtypes as they are); the blenderproc layout always stores BlenderProc's encodings"),
         Param("compression_level", "int", 1, doc="gzip level 0..9 (1: twice as fast as 4, files ~10 % larger)",
               check=lambda v: None if 0 <= v <= 9 else f"must be in 0..9, got {v}"),

@@ -1,6 +1,6 @@
 """Compact label storage (hybridgen.io.label_encoding): every encoding read back against the renderer's own
 values - ids and depth exact, normals within the stated bound, derived distance bit-identical to the
-rendered one - by decode_dataset and by the plain-h5py recipe of docs/reading_outputs.md."""
+rendered one - by decode_dataset and by the plain-h5py recipe printed in docs/outputs.md."""
 from __future__ import annotations
 
 import hashlib
@@ -27,36 +27,17 @@ def angles(a, b):
     return np.where(np.any(a, axis=-1) != np.any(b, axis=-1), np.pi, angle)
 
 
-def plain_h5py_recipe(f: h5py.File, key: str, i: int) -> np.ndarray:
-    """docs/reading_outputs.md, 'Reading with plain h5py', written out without hybridgen."""
-    dset = f[key]
-    encoding = dset.attrs.get("encoding")
-    if encoding is None:
-        return dset[i]
-    if encoding == "narrowed_integer":
-        return dset[i].astype(dset.attrs["decoded_dtype"])
-    if encoding == "octahedral_uint16":
-        code = dset[i].astype(np.float64)
-        p = (code - 1) / 32767 - 1
-        x, y = p[..., 0], p[..., 1]
-        z = 1 - np.abs(x) - np.abs(y)
-        fold = z < 0
-        x, y = (np.where(fold, (1 - np.abs(p[..., 1])) * np.where(p[..., 0] >= 0, 1, -1), x),
-                np.where(fold, (1 - np.abs(p[..., 0])) * np.where(p[..., 1] >= 0, 1, -1), y))
-        n = np.stack([x, y, z], -1)
-        n /= np.linalg.norm(n, axis=-1, keepdims=True)
-        n[(dset[i] == 0).all(-1)] = 0
-        return n.astype(np.float32)
-    if encoding == "derived_from_depth":
-        depth = f[dset.attrs["derived_from"]][i]
-        K = f["cam_K"][i]
-        h, w = depth.shape
-        u, v = np.meshgrid(np.arange(w, dtype=np.float64), np.arange(h, dtype=np.float64))
-        ray = np.sqrt(((u - K[0, 2]) / K[0, 0]) ** 2 + ((v - K[1, 2]) / K[1, 1]) ** 2 + 1).astype(np.float32)
-        distance = depth * ray
-        distance[depth == dset.attrs["depth_background"]] = dset.attrs["depth_background"]
-        return distance
-    raise AssertionError(f"undocumented encoding {encoding}")
+def _documented_recipe():
+    """The plain-h5py ``read(f, key, i)`` of docs/outputs.md, executed as printed there."""
+    text = (REPO / "docs/outputs.md").read_text()
+    blocks = [b.split("```", 1)[0] for b in text.split("```python\n")[1:]]
+    (code,) = [b for b in blocks if b.startswith("def read(f, key, i):")]
+    namespace = {"np": np}
+    exec(code, namespace)
+    return namespace["read"]
+
+
+plain_h5py_recipe = _documented_recipe()
 
 
 def _scene() -> hg.Scene:
