@@ -100,8 +100,8 @@ def _cmd_run(ns: argparse.Namespace) -> dict[str, Any]:
 
 
 def _cmd_modules(ns: argparse.Namespace) -> dict[str, Any]:
-    from .config.module_listing import describe_modules, describe_samplers, module_records
-    from .config.registry import all_modules, get_module
+    from .config.module_listing import describe_aliases, describe_modules, describe_samplers, module_records
+    from .config.registry import all_modules, get_module, module_aliases
 
     if ns.schema is not None:
         return _write_schema(ns)
@@ -110,7 +110,8 @@ def _cmd_modules(ns: argparse.Namespace) -> dict[str, Any]:
         print(describe_modules(modules))
         if not ns.name:
             print(describe_samplers())
-    return {"modules": module_records(modules)}
+            print(describe_aliases())
+    return {"modules": module_records(modules), "aliases": module_aliases()}
 
 
 def _write_schema(ns: argparse.Namespace) -> dict[str, Any]:

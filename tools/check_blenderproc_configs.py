@@ -109,7 +109,7 @@ def example_configs(path: Path, tag: str | None, into: Path) -> list[Path]:
     return configs
 
 
-def standin_args(config: Path, work: Path) -> list[str]:
+def standin_args(config: Path, work: Path, output: Path) -> list[str]:
     """A value for every ``<args:N>`` of ``config``, made from the names on its ``# Args:`` line."""
     text = config.read_text()
     count = 1 + max((int(n) for n in re.findall(r"<args:(\d+)>", text)), default=-1)
@@ -129,7 +129,7 @@ def standin_args(config: Path, work: Path) -> list[str]:
         elif "texture_file" in lower:
             value = work / "texture.png"
         elif "output" in lower:
-            value = work / "output"
+            value = output
         elif "obj" in lower or "scene" in lower or "mesh" in lower or "model" in lower or "file" in lower and \
                 "cam" not in lower:
             value = work / "scene.obj"
@@ -140,7 +140,7 @@ def standin_args(config: Path, work: Path) -> list[str]:
             value.mkdir(exist_ok=True)
         args.append(str(value))
     # the # Args: line is sometimes out of date: what a placeholder is used for decides where it is clear
-    usage = {"output_dir": work / "output", "folder_path": work / "cc_textures"}
+    usage = {"output_dir": output, "folder_path": work / "cc_textures"}
     for key, value in usage.items():
         for index in re.findall(rf'"{key}"\s*:\s*"<args:(\d+)>"', text):
             args[int(index)] = str(value)
@@ -152,10 +152,12 @@ def standin_args(config: Path, work: Path) -> list[str]:
 
 
 BOP_NAME = "lm"
+BOP_MODELS = 30
+"""Models per stand-in BOP dataset: enough for the BOP challenge configs' samples with instance limits."""
 
 
 def make_bop_standin(root: Path, name: str = BOP_NAME) -> Path:
-    """A small BOP dataset: three box models (mm, vertex colors), camera.json, models_info.json and scene
+    """A small BOP dataset: 30 box models (mm, vertex colors), camera.json, models_info.json and scene
     000001 (two images of the three objects) in the train, val and test splits; returns its folder."""
     import json
 
@@ -166,9 +168,10 @@ def make_bop_standin(root: Path, name: str = BOP_NAME) -> Path:
     for folder in ("models", "models_cad", "models_eval", "models_reconst"):
         (dataset / folder).mkdir(parents=True, exist_ok=True)
     info = {}
-    for obj_id, extents in ((1, [60, 40, 30]), (2, [30, 30, 80]), (3, [50, 50, 50])):
+    sizes = [[60, 40, 30], [30, 30, 80], [50, 50, 50]]
+    for obj_id, extents in enumerate((sizes[i % 3] for i in range(BOP_MODELS)), start=1):
         box = trimesh.creation.box(extents=extents)
-        box.visual.vertex_colors = np.tile([40 * obj_id, 200 - 40 * obj_id, 120, 255], (len(box.vertices), 1))
+        box.visual.vertex_colors = np.tile([(40 * obj_id) % 256, 200, 120, 255], (len(box.vertices), 1))
         for folder in ("models", "models_cad", "models_eval", "models_reconst"):
             box.export(dataset / folder / f"obj_{obj_id:06d}.ply")
         info[str(obj_id)] = {"diameter": float(np.linalg.norm(extents)), "min_x": -extents[0] / 2,
@@ -211,7 +214,7 @@ def make_standins(work: Path) -> None:
     (work / "camera_positions").write_text("0 -6 3 1.1 0 0\n4 -4 3 1.1 0 0.785\n")
 
 
-def check(config: Path, root: Path, run: bool, work: Path) -> Outcome:
+def check(config: Path, root: Path, run: bool, work: Path, output: Path) -> Outcome:
     """Validate (and run) one config on stand-ins."""
     from hybridgen.config.config_file import load_config
     from hybridgen.config.notices import set_sink
@@ -221,7 +224,7 @@ def check(config: Path, root: Path, run: bool, work: Path) -> Outcome:
     lines: list[str] = []
     set_sink(lines.append)
     name = str(config.relative_to(root))
-    args = standin_args(config, work)
+    args = standin_args(config, work, output)
     try:
         try:
             loaded = load_config(config, args)
@@ -255,12 +258,14 @@ def main() -> None:
         configs = example_configs(ns.path, ns.tag, root)
         base = root if ns.tag else ns.path
         outcomes = []
+        work = Path(tmp) / "standins"
+        work.mkdir()
+        make_standins(work)
         for config in configs:
             if ns.only not in str(config):
                 continue
-            work = Path(tempfile.mkdtemp(prefix="standins-", dir=tmp))
-            make_standins(work)
-            outcome = check(config, base, ns.run, work)
+            output = Path(tempfile.mkdtemp(prefix="output-", dir=tmp))
+            outcome = check(config, base, ns.run, work, output)
             outcomes.append(outcome)
             print(f"{outcome.status:11s} {outcome.config}  [{outcome.notices} notices] {outcome.detail}", flush=True)
     counts = {s: sum(o.status == s for o in outcomes) for s in ("valid", "ran", "unavailable", "invalid", "failed")}

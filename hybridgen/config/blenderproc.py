@@ -188,6 +188,10 @@ def samplers_as_blenderproc(value: Any, note: Note, key: str) -> Any:
         return value
     out = {k: samplers_as_blenderproc(v, note, f"{key}.{k}") for k, v in value.items()}
     provider = out.get("provider", out.get("name"))
+    if provider == "getter.Entity":  # a selector anywhere (getter.POI's, samplers' ...): type MESH always holds
+        out["conditions"] = _conditions(out.get("conditions"), note, f"{key}.conditions")
+        if out["conditions"] is None:
+            del out["conditions"]
     params = out.get("parameters", out)
     if provider in _UNIFORM and isinstance(params, dict) and "min" in params and "max" in params:
         low, high = params["min"], params["max"]

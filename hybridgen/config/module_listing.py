@@ -56,6 +56,17 @@ def describe_samplers() -> str:
     return "\n".join(lines)
 
 
+def describe_aliases() -> str:
+    """BlenderProc module names: the hybridgen module each one runs as, and those hybridgen cannot provide."""
+    from .blenderproc import ALIASES, UNAVAILABLE
+
+    lines = ["BlenderProc module names (read with BlenderProc's keys in configs of BlenderProc's form):"]
+    lines += [f"    {alias} -> {target}" for alias, target in sorted(ALIASES.items())]
+    lines.append("not available (each fails with this reason):")
+    lines += [f"    {name}: {why}" for name, why in sorted(UNAVAILABLE.items())]
+    return "\n".join(lines)
+
+
 def module_records(modules: Mapping[str, type]) -> list[dict[str, Any]]:
     """JSON-ready description of ``modules`` (for ``hybridgen modules --json``)."""
     records = []

@@ -19,7 +19,7 @@ from ..config.schema import Param
 from ..errors import InputError
 from ..run.context import RunContext
 from ..scene.material import Material
-from .material_library import material_library, material_matches
+from .material_library import LibraryMaterial, material_library, material_matches
 from .selecting import SelectingModule
 
 
@@ -54,13 +54,13 @@ class MaterialRandomizer(SelectingModule):
 
     def _candidates(self, context: RunContext) -> list[Material]:
         source = self.config["materials_to_replace_with"] or {}
-        pool: list[Material] = list(material_library(context))
-        seen = {id(m) for m in pool}
+        pool: list[LibraryMaterial] = list(material_library(context))
+        seen = {id(m.material) for m in pool}
         for obj in context.scene.objects:
             if id(obj.material) not in seen:
                 seen.add(id(obj.material))
-                pool.append(obj.material)
-        chosen = [m for m in pool if material_matches(m, source.get("conditions"))]
+                pool.append(LibraryMaterial(obj.material))
+        chosen = [m.material for m in pool if material_matches(m, source.get("conditions"))]
         count = source.get("random_samples")
         if count is not None and len(chosen) > count:
             picks = sorted(context.rng.choice(len(chosen), size=int(count), replace=False))
