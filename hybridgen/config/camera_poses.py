@@ -7,8 +7,9 @@ direction) or ``{cam2world_matrix}`` (a Blender-axes camera). Text files hold on
 one number).
 
 ``source_frame`` (a module key, as in BlenderProc, or a per-pose key) means what it means in BlenderProc
-(docs/conventions.md section 1): three axis names ``X, Y, Z, -X, -Y, -Z`` saying, for each axis of the
-given frame, which Blender axis it is. Default ``[X, Y, Z]``. For ``cam2world_matrix`` it names the
+(docs/conventions.md section 1): three axis names ``X, Y, Z, -X, -Y, -Z``; element i names the given
+frame's axis (with its sign) that Blender's axis i is, so a point ``p`` given in that frame is ``T @ p`` in
+Blender's axes (``T`` row i = that signed unit vector). Default ``[X, Y, Z]``. For ``cam2world_matrix`` it names the
 **camera** axes of the given matrix: ``[X, -Y, -Z]`` declares an OpenCV cam2world (BlenderProc's BOP
 loader, its 1.x camera interface up to 1.11 and ``change_source_coordinate_frame_of_transformation_matrix``;
 1.12's camera interface multiplies from the left instead, which agrees for its only example, an identity
@@ -42,9 +43,11 @@ _AXES = {"X": 0, "Y": 1, "Z": 2}
 
 
 def source_frame_axes(frame: Any, key: str = "source_frame") -> np.ndarray:
-    """3x3 ``T`` with row i = the Blender axis (signed unit vector) that axis i of ``frame`` is.
+    """3x3 ``T`` whose row i is the signed unit vector of the given frame's axis that ``frame[i]`` names.
 
-    A point given in ``frame`` is ``T @ p`` in Blender's axes (BlenderProc's ``change_coordinate_frame_of_point``).
+    A point given in ``frame`` is ``T @ p`` in Blender's axes (BlenderProc's ``change_coordinate_frame_of_point``:
+    ``[X, -Z, Y]`` turns (1, 2, 3) into (1, -3, 2)); a given cam2world ``M`` is ``M @ T.T`` in Blender camera
+    axes (BlenderProc's ``change_source_coordinate_frame_of_transformation_matrix``).
     """
     if not isinstance(frame, (list, tuple)) or len(frame) != 3:
         raise ConfigError(f"needs 3 axes like [X, -Y, -Z], got {frame!r}", key=key)
@@ -101,7 +104,7 @@ def pose_from_entry(entry: Any, where: str = "cam_poses[0]", defaults: dict[str,
             raise ConfigError("must be a rigid transform (orthonormal rotation, last row 0 0 0 1)",
                               key=f"{where}.cam2world_matrix")
         blender_axes = np.eye(4)
-        blender_axes[:3, :3] = axes.T  # the given camera's axis i is Blender camera axis axes[i]
+        blender_axes[:3, :3] = axes.T  # camera coordinates: v_given = T.T @ v_blender
         return matrix @ blender_axes @ BLENDER_TO_OPENCV
     if "location" not in entry:
         raise ConfigError("a pose needs 'location' (with 'rotation') or 'cam2world_matrix'", key=where)

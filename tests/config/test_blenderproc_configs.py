@@ -490,3 +490,21 @@ def test_bop_scene_replication_round_trips_through_the_bop_writer(tmp_path, noti
             np.testing.assert_allclose(inst_out["cam_R_m2c"], inst_in["cam_R_m2c"], atol=1e-6)
             np.testing.assert_allclose(inst_out["cam_t_m2c"], inst_in["cam_t_m2c"], atol=1e-3)
     assert (written / "rgb" / "000000.png").is_file() and (written / "depth" / "000001.png").is_file()
+
+
+def test_source_frame_as_blenderprocs_point_and_matrix_conversion():
+    from hybridgen.config.camera_poses import pose_from_entry
+
+    frame = ["X", "-Z", "Y"]  # BlenderProc's own example: (1, 2, 3) -> (1, -3, 2)
+    pose = pose_from_entry({"location": [1, 2, 3], "rotation": {"format": "forward_vec", "value": [0, 0, -1]}},
+                           source_frame=frame)
+    np.testing.assert_allclose(pose[:3, 3], [1, -3, 2])
+    # a forward vector (0, 0, -1) in a Y-up tool's frame is Blender's (0, 1, 0): the view axis (OpenCV z)
+    np.testing.assert_allclose(pose[:3, 2], [0, 1, 0], atol=1e-12)
+    # a cam2world given in that frame: its camera axes are converted (change_source_coordinate_frame)
+    given = make_pose(look_at_blender([2, -3, 1], [0, 0, 0]), [2, -3, 1])
+    T = np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]], float)
+    expected = given.copy()
+    expected[:3, :3] = given[:3, :3] @ T.T
+    np.testing.assert_allclose(pose_from_entry({"cam2world_matrix": given.tolist()}, source_frame=frame),
+                               expected @ np.diag([1.0, -1.0, -1.0, 1.0]), atol=1e-12)
