@@ -36,14 +36,15 @@ def _holder(path: Path) -> str:
     return f"pid {text[0]} on {text[1]}" if len(text) >= 2 else "another process"
 
 
-def _acquire(path: Path, wait: bool) -> int:
+def _acquire(path: Path, wait: bool, shared: bool) -> int:
+    mode = (fcntl.LOCK_SH if shared else fcntl.LOCK_EX) | (0 if wait else fcntl.LOCK_NB)
     while True:
         try:
             fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
         except OSError as exc:
             raise InputError(f"cannot lock output folder '{path.parent}': {exc.strerror or exc}") from None
         try:
-            fcntl.flock(fd, fcntl.LOCK_EX | (0 if wait else fcntl.LOCK_NB))
+            fcntl.flock(fd, mode)
         except OSError as exc:
             os.close(fd)
             if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
@@ -61,14 +62,14 @@ def _acquire(path: Path, wait: bool) -> int:
         os.close(fd)  # the previous holder removed the file after we opened it: lock the new one
 
 
-def _enter(directory: str | Path, wait: bool) -> tuple[str, Path]:
+def _enter(directory: str | Path, wait: bool, name: str = LOCK_NAME, shared: bool = False) -> tuple[str, Path]:
     folder = prepare_output_dir(Path(directory))
-    path = folder / LOCK_NAME
+    path = folder / name
     key = os.path.realpath(path)
     if key in _HELD:
         _HELD[key][1] += 1
     else:
-        _HELD[key] = [_acquire(path, wait), 1]
+        _HELD[key] = [_acquire(path, wait, shared), 1]
     return key, path
 
 
@@ -77,7 +78,8 @@ def _leave(key: str, path: Path) -> None:
     held[1] -= 1
     if held[1] == 0:
         del _HELD[key]
-        try:
+        try:  # remove the file only when nobody else holds it (shared holders: an exclusive try first)
+            fcntl.flock(held[0], fcntl.LOCK_EX | fcntl.LOCK_NB)
             os.unlink(path)
         except OSError:
             pass
@@ -85,9 +87,11 @@ def _leave(key: str, path: Path) -> None:
 
 
 @contextmanager
-def output_lock(directory: str | Path, *, wait: bool = False) -> Iterator[Path]:
-    """Hold the advisory lock of ``directory`` (created if missing) for the ``with`` block."""
-    key, path = _enter(directory, wait)
+def output_lock(directory: str | Path, *, wait: bool = False, name: str = LOCK_NAME,
+                shared: bool = False) -> Iterator[Path]:
+    """Hold the advisory lock ``name`` of ``directory`` (created if missing) for the ``with`` block;
+    ``shared``: several shared holders may hold it together, never with an exclusive one."""
+    key, path = _enter(directory, wait, name, shared)
     try:
         yield path.parent
     finally:
@@ -95,12 +99,18 @@ def output_lock(directory: str | Path, *, wait: bool = False) -> Iterator[Path]:
 
 
 @contextmanager
-def output_locks(directories: Iterable[str | Path]) -> Iterator[None]:
-    """Hold the locks of several folders (each once, in a fixed order so two runs cannot deadlock)."""
+def output_locks(directories: Iterable[str | Path], shard: tuple[int, int] | None = None) -> Iterator[None]:
+    """Hold the locks of several folders (each once, in a fixed order so two runs cannot deadlock).
+
+    With ``shard`` ``(i, n)`` (``hybridgen run --shard i/n``, tasks of one array job writing one folder
+    together) the folder lock is shared and ``.hybridgen.lock.shard-i-of-n`` exclusive: the tasks run side
+    by side, but not with a run without ``--shard`` nor with a second task of the same index."""
     unique = sorted({os.path.realpath(d) for d in directories})
     with ExitStack() as stack:
         for directory in unique:
-            stack.enter_context(output_lock(directory))
+            stack.enter_context(output_lock(directory, shared=shard is not None))
+            if shard is not None:
+                stack.enter_context(output_lock(directory, name=f"{LOCK_NAME}.shard-{shard[0]}-of-{shard[1]}"))
         yield
 
 

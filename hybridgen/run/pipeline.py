@@ -13,6 +13,7 @@ from ..config.paths import config_folder, resolve_module_paths
 from ..config.registry import get_module
 from ..config.schema import validate_config
 from ..errors import ConfigError, HybridgenError, InputError
+from ..io.atomic import prepare_output_dir
 from ..io.output_lock import output_locks
 from ..modules.base import Module
 from .context import RunContext
@@ -97,10 +98,18 @@ def execute(config: ConfigFile, modules: list[Module], *, unit: WorkUnit | None 
     return context
 
 
-def writer_folders(modules: list[Module]) -> list[Path]:
-    """The output folders of the config's writer modules (each is locked for the run)."""
-    return [Path(m.config["output_dir"]) for m in modules
-            if m.module_name.startswith("writer.") and isinstance(m.config.get("output_dir"), str)]
+def writer_folders(modules: list[Module], file: str) -> list[Path]:
+    """The output folders of the config's writer modules, created (each is locked for the run); one that
+    cannot be is an error naming its module."""
+    folders = []
+    for module in modules:
+        if module.module_name.startswith("writer.") and isinstance(module.config.get("output_dir"), str):
+            try:
+                folders.append(prepare_output_dir(Path(module.config["output_dir"])))
+            except InputError as exc:
+                raise ConfigError(str(exc), file=file, module=module.module_name, index=module.index,
+                                  key="output_dir") from None
+    return folders
 
 
 @contextmanager
@@ -159,7 +168,8 @@ def run_config(path: str | Path, args: Sequence[str] = (), *, env: Mapping[str, 
     single = single_file_output(modules)
     if single is not None and single.is_dir():
         raise InputError(f"'{single}' is a directory; the output file cannot be written there")
-    with stop_on_signals(), output_locks(writer_folders(modules)), disk_full_is_one_line(writer_folders(modules)):
+    folders = writer_folders(modules, config.path)
+    with stop_on_signals(), output_locks(folders, shard), disk_full_is_one_line(folders):
         if plan is not None:
             return run_sharded(plan, path, args, env, workers=workers, shard=shard, executor=executor,
                                address=address, log=say, start=start, policy=policy,

@@ -140,11 +140,14 @@ def check_existing(path: Path, policy: ResumePolicy, log: Callable[[str], None])
                      "--force-resume to keep it")
 
 
-def discard_outputs(plan: ShardingPlan) -> int:
-    """``--restart``: delete the plan's shards and index; returns how many files were removed."""
+def discard_outputs(plan: ShardingPlan, shard: tuple[int, int] | None = None) -> int:
+    """``--restart``: delete the plan's shards (with ``shard`` ``(i, n)``: only those of scenes ``s % n == i``)
+    and the index; returns how many files were removed."""
     removed = 0
     shards = plan.output_dir / SHARD_FOLDER
     candidates = list(shards.glob("scene_*_chunk_*.hdf5")) if shards.is_dir() else []
+    if shard is not None:
+        candidates = [p for p in candidates if p.name[6:12].isdigit() and int(p.name[6:12]) % shard[1] == shard[0]]
     for path in [*candidates, plan.output_dir / plan.file_name]:
         if path.is_file() or path.is_symlink():
             path.unlink()
@@ -271,7 +274,7 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
     if (plan.output_dir / plan.file_name).is_dir():
         raise InputError(f"'{plan.output_dir / plan.file_name}' is a directory; the index cannot be written there")
     if policy.restart:
-        removed = discard_outputs(plan)
+        removed = discard_outputs(plan, shard)
         if removed:
             log(f"--restart: discarded {removed} existing file(s)")
     call = (str(path), list(args), dict(env) if env is not None else None, policy.fingerprint_text)

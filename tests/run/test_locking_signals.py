@@ -190,3 +190,27 @@ def test_signal_stops_workers_and_removes_temporary_files(gl_context, tmp_path, 
     time.sleep(0.5)
     assert not [pid for pid in workers if _alive(pid)]
     assert not list(out.rglob("*.incomplete")) and not (out / ".hybridgen.lock").exists()
+
+
+def test_shard_tasks_share_the_folder_but_exclude_a_plain_run(gl_context, tmp_path, write_config, run_cli):
+    """--shard i/N tasks of one array job write one folder side by side; a run without --shard (or a second
+    task of the same index) is refused while one runs."""
+    config = write_config(SCENES.replace("SCENES", "2"))
+    out = tmp_path / "out"
+    task = ("import sys, time; from hybridgen.io.output_lock import output_locks\n"
+            "with output_locks([sys.argv[1]], shard=(1, 2)):\n    print('held', flush=True); time.sleep(60)\n")
+    holder = subprocess.Popen([sys.executable, "-c", task, str(out)], cwd=REPO, stdout=subprocess.PIPE, text=True)
+    try:  # another task, index 1, runs
+        assert holder.stdout.readline().strip() == "held"
+        code, _, err = run_cli("run", "-q", str(config), str(out), "--shard", "0/2")
+        assert code == 0, err
+        code, _, err = run_cli("run", "-q", str(config), str(out), "--shard", "1/2")
+        assert code == 2 and "in use" in err
+        code, _, err = run_cli("run", "-q", str(config), str(out))
+        assert code == 2 and "in use" in err
+    finally:
+        holder.kill()
+        holder.wait()
+    code, _, err = run_cli("run", "-q", str(config), str(out), "--shard", "1/2")
+    assert code == 0, err
+    assert verify(out / "data.hdf5") is None
