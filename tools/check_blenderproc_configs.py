@@ -9,7 +9,8 @@ line (a Y-up OBJ with several ``o`` objects, a camera pose file, a small BOP dat
 folder ...), then
 
 - validates: hybridgen reads the config and every module's keys (``load_config`` + ``build_modules``);
-- with ``--run``, runs the valid ones end to end on the stand-ins.
+- with ``--run``, runs the valid ones end to end on the stand-ins, each in its own process stopped after
+  ``--timeout`` seconds.
 
 Each config gets one line: ``valid``/``ran``, ``unavailable: <why>`` (a module needing Blender or a withdrawn
 dataset) or ``invalid: <the error line>``. Notices are counted, not printed. Exit status 0 always; the
@@ -83,7 +84,7 @@ class Outcome:
     """What happened to one config."""
 
     config: str
-    status: str  # valid | ran | unavailable | invalid | failed
+    status: str  # valid | ran | timeout | unavailable | invalid | failed
     detail: str = ""
     notices: int = 0
 
@@ -246,12 +247,32 @@ def check(config: Path, root: Path, run: bool, work: Path, output: Path) -> Outc
         set_sink(None)
 
 
+def check_in_process(config: Path, root: Path, run: bool, work: Path, output: Path, timeout: float) -> Outcome:
+    """:func:`check` in a child process, stopped after ``timeout`` seconds (then status ``timeout``)."""
+    import multiprocessing
+
+    context = multiprocessing.get_context("fork")
+    queue = context.Queue()
+    child = context.Process(target=lambda: queue.put(check(config, root, run, work, output)))
+    child.start()
+    child.join(timeout)
+    if child.is_alive():
+        child.terminate()
+        child.join()
+        return Outcome(str(config.relative_to(root)), "timeout", f"still running after {timeout:.0f} s (validated)")
+    if queue.empty():
+        return Outcome(str(config.relative_to(root)), "failed", f"the check process ended with {child.exitcode}")
+    return queue.get()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("path", type=Path, help="BlenderProc checkout, or bare git mirror with --tag")
     parser.add_argument("--tag", help="git tag to read from a bare mirror (e.g. v1.12.0, v1.0.0)")
     parser.add_argument("--run", action="store_true", help="also run the valid configs on stand-in inputs")
     parser.add_argument("--only", default="", help="only configs whose path contains this")
+    parser.add_argument("--timeout", type=float, default=900.0,
+                        help="with --run: seconds one config may run before it counts as 'timeout' (default 900)")
     ns = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="bp-configs-") as tmp:
         root = Path(tmp) / "checkout"
@@ -265,13 +286,16 @@ def main() -> None:
             if ns.only not in str(config):
                 continue
             output = Path(tempfile.mkdtemp(prefix="output-", dir=tmp))
-            outcome = check(config, base, ns.run, work, output)
+            outcome = check_in_process(config, base, ns.run, work, output, ns.timeout) if ns.run else \
+                check(config, base, ns.run, work, output)
             outcomes.append(outcome)
             print(f"{outcome.status:11s} {outcome.config}  [{outcome.notices} notices] {outcome.detail}", flush=True)
-    counts = {s: sum(o.status == s for o in outcomes) for s in ("valid", "ran", "unavailable", "invalid", "failed")}
-    validated = counts["valid"] + counts["ran"] + counts["failed"]
+    statuses = ("valid", "ran", "timeout", "unavailable", "invalid", "failed")
+    counts = {s: sum(o.status == s for o in outcomes) for s in statuses}
+    validated = counts["valid"] + counts["ran"] + counts["failed"] + counts["timeout"]
     print(f"{len(outcomes)} configs: {validated} validate, {counts['ran']} ran end to end"
-          + (f", {counts['failed']} failed while running" if ns.run else "")
+          + (f", {counts['failed']} failed while running, {counts['timeout']} still running after "
+             f"{ns.timeout:.0f} s" if ns.run else "")
           + f", {counts['unavailable']} need something hybridgen cannot have, {counts['invalid']} invalid")
 
 
