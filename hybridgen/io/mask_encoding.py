@@ -55,8 +55,82 @@ def rle_uncompressed(mask: np.ndarray) -> dict[str, Any]:
     return {"counts": counts, "size": [int(mask.shape[0]), int(mask.shape[1])]}
 
 
-# Directions in image coordinates (x right, y down) and their right turn for the outline walk.
-_RIGHT_TURN = {(1, 0): (0, 1), (0, 1): (-1, 0), (-1, 0): (0, -1), (0, -1): (1, 0)}
+# The four sides of a pixel as directed boundary edges, walked with the pixel (inside) on the right (x right,
+# y down): walking direction, start corner relative to the pixel's top-left corner. Side k + 1 is side k
+# turned right, side k + 3 turned left.
+_SIDE_STEPS = np.array([(1, 0), (0, 1), (-1, 0), (0, -1)])  # top, right, bottom, left
+_SIDE_STARTS = np.array([(0, 0), (1, 0), (1, 1), (0, 1)])
+
+
+def _outline_walk(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Corner points (n, 2) of every outline loop, concatenated in loop order, and each loop's corner count.
+
+    Every boundary edge (a pixel side with the pixel inside and its neighbour outside) gets its successor
+    from the 2x2 pixels around its end corner: turn right if the pixel ahead is outside, else go straight if
+    the pixel ahead-left is outside, else turn left (so corner-touching pixels stay apart). The successor map
+    is a permutation whose cycles are the loops. Pointer jumping (array operations, log2 of the longest loop
+    rounds) finds each loop's smallest start corner (its root) and every edge's place after it.
+    """
+    m = np.pad(np.asarray(mask, dtype=bool), 1)
+    height, width = m.shape
+    plane = height * width
+    inside = m.ravel()
+    step = _SIDE_STEPS[:, 1] * width + _SIDE_STEPS[:, 0]  # flat offset of each side's walking direction
+    inward = np.roll(step, -1)  # ... and of its right-hand (inward) normal
+    # boundary edge id = side * plane + flat pixel index (padded grid); the outside neighbour is pixel - inward
+    pixels = np.flatnonzero(inside)
+    ids = np.concatenate([side * plane + pixels[~inside[pixels - inward[side]]] for side in range(4)])
+    count = ids.size
+    if count == 0:
+        return np.zeros((0, 2), np.int64), np.zeros(0, np.int64)
+    side, pixel = np.divmod(ids, plane)
+    ahead = pixel + step[side]
+    ahead_left = ahead - inward[side]
+    right_turn = ~inside[ahead]
+    straight = ~right_turn & ~inside[ahead_left]
+    next_side = np.where(right_turn, (side + 1) % 4, np.where(straight, side, (side + 3) % 4))
+    next_pixel = np.where(right_turn, pixel, np.where(straight, ahead, ahead_left))
+    index = np.empty(4 * plane, np.int64)
+    index[ids] = np.arange(count)
+    successor = index[next_side * plane + next_pixel]
+    # start corners (x, y) in unpadded pixel coordinates: padded pixel (py, px) is pixel (px - 1, py - 1)
+    py, px = np.divmod(pixel, width)
+    start_x = px - 1 + _SIDE_STARTS[side, 0]
+    start_y = py - 1 + _SIDE_STARTS[side, 1]
+    key = start_x * (height + 1) + start_y  # order of corners: x, then y (unique per loop edge start)
+    # each loop's smallest key: min over 2^k successors after k rounds, until 2^k covers every loop
+    smallest, nxt, span = key.copy(), successor, 1
+    while span < count:
+        smallest = np.minimum(smallest, smallest[nxt])
+        nxt = nxt[nxt]
+        span *= 2
+    roots = np.flatnonzero(key == smallest)  # the loop's smallest corner has exactly one outgoing edge
+    # distance from each edge forward to its root (the root absorbs), and the root it reaches
+    nxt = successor.copy()
+    nxt[roots] = roots
+    dist = np.ones(count, np.int64)
+    dist[roots] = 0
+    while True:
+        jumped = nxt[nxt]
+        if np.array_equal(jumped, nxt):
+            break
+        dist += dist[nxt]
+        nxt = jumped
+    root_rank = np.empty(count, np.int64)
+    root_rank[roots[np.argsort(key[roots])]] = np.arange(roots.size)  # loops in order of their smallest corner
+    loop = root_rank[nxt]
+    length = np.bincount(loop, minlength=roots.size)
+    offset = np.concatenate(([0], np.cumsum(length)[:-1]))
+    slot = offset[loop] + (length[loop] - dist) % length[loop]  # root first, then along the loop
+    walked_side = np.empty(count, np.int64)
+    walked_side[slot] = side
+    points = np.empty((count, 2), np.int64)
+    points[slot, 0], points[slot, 1] = start_x, start_y
+    previous = np.roll(walked_side, 1)
+    previous[offset] = walked_side[offset + length - 1]  # a loop's first edge follows its last
+    corner = walked_side != previous  # a start point where the direction changes
+    corners_per_loop = np.add.reduceat(corner.astype(np.int64), offset)
+    return points[corner], corners_per_loop
 
 
 def outline_loops(mask: np.ndarray) -> list[np.ndarray]:
@@ -64,57 +138,11 @@ def outline_loops(mask: np.ndarray) -> list[np.ndarray]:
 
     Outer boundaries run clockwise on screen (positive shoelace area with y down), holes the other way.
     Pixels touching only at a corner belong to separate loops (4-connectivity). Only corners are listed
-    (no collinear points); loops are closed implicitly.
+    (no collinear points); loops are closed implicitly. Each loop starts at its smallest corner (x, then y),
+    and loops come in that order.
     """
-    m = np.pad(np.asarray(mask, dtype=bool), 1)
-    inside = m[1:-1, 1:-1]
-    edges: dict[tuple[int, int], list[tuple[int, int]]] = {}
-    # (boundary pixels, start corner relative to the pixel's top-left corner, step) per side; interior on the right
-    sides = ((inside & ~m[:-2, 1:-1], (0, 0), (1, 0)),   # top edge, walking +x
-             (inside & ~m[1:-1, 2:], (1, 0), (0, 1)),    # right edge, walking +y
-             (inside & ~m[2:, 1:-1], (1, 1), (-1, 0)),   # bottom edge, walking -x
-             (inside & ~m[1:-1, :-2], (0, 1), (0, -1)))  # left edge, walking -y
-    for boundary, (dx, dy), step in sides:
-        for y, x in zip(*np.nonzero(boundary)):
-            edges.setdefault((int(x) + dx, int(y) + dy), []).append(step)
-
-    def take(point: tuple[int, int], step: tuple[int, int]) -> None:
-        outgoing = edges[point]
-        outgoing.remove(step)
-        if not outgoing:
-            del edges[point]
-
-    def choose(heading: tuple[int, int], options: list[tuple[int, int]]) -> tuple[int, int]:
-        # right turn first, then straight on, then left: corner-touching pixels stay in separate loops
-        right = _RIGHT_TURN[heading]
-        for step in (right, heading, (-right[0], -right[1])):
-            if step in options:
-                return step
-        raise AssertionError("pixel outline is not closed")  # cannot happen for edges of a pixel set
-
-    loops = []
-    while edges:
-        start = min(edges)
-        first = edges[start][0]
-        take(start, first)
-        corners, heading = [start], first
-        point = (start[0] + first[0], start[1] + first[1])
-        while True:
-            options = list(edges.get(point, ()))
-            if point == start:
-                options.append(first)
-            step = choose(heading, options)
-            if point == start and step == first:
-                break
-            take(point, step)
-            if step != heading:
-                corners.append(point)
-            heading = step
-            point = (point[0] + step[0], point[1] + step[1])
-        if heading == first:  # the start lies on a straight run: not a corner
-            corners = corners[1:]
-        loops.append(np.array(corners, dtype=np.int64))
-    return loops
+    points, counts = _outline_walk(mask)
+    return np.split(points, np.cumsum(counts)[:-1]) if counts.size else []
 
 
 def signed_area(loop: np.ndarray) -> float:
@@ -129,8 +157,14 @@ def mask_to_polygons(mask: np.ndarray) -> list[list[float]]:
     COCO polygons cannot describe holes (several polygons are a union), so holes are filled: use RLE for
     masks with holes.
     """
-    polygons = []
-    for loop in outline_loops(mask):
-        if len(loop) >= 3 and signed_area(loop) > 0:
-            polygons.append(loop.astype(np.float64).ravel().tolist())
-    return polygons
+    points, counts = _outline_walk(mask)
+    if counts.size == 0:
+        return []
+    starts = np.concatenate(([0], np.cumsum(counts)[:-1]))
+    following = np.arange(1, len(points) + 1)  # index of each corner's successor within its loop
+    following[starts + counts - 1] = starts
+    x, y = points[:, 0], points[:, 1]
+    twice_area = np.add.reduceat(x * y[following] - x[following] * y, starts)  # shoelace, per loop
+    flat = points.astype(np.float64).ravel().tolist()
+    return [flat[2 * start:2 * (start + n)] for start, n, area in zip(starts.tolist(), counts.tolist(),
+                                                                      twice_area.tolist()) if n >= 3 and area > 0]
