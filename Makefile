@@ -3,11 +3,16 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.hybridgen-installed
+STAMP_TEST := $(VENV)/.hybridgen-test-installed
 PIP    := $(BIN)/python -m pip --disable-pip-version-check
 
-.PHONY: setup system demo test bench mutate clean
+.PHONY: setup setup-test system demo test bench mutate clean
 
+# `make demo` needs the core dependencies only; `make test` adds the test extras (pytest, Ray, BlenderProc,
+# pycocotools, ... about 1.4 GB).
 setup: system $(STAMP)
+
+setup-test: system $(STAMP_TEST)
 
 system:
 	@bash tools/install_system_deps.sh
@@ -19,15 +24,20 @@ $(BIN)/python:
 # Reinstall whenever the project's dependency list changes.
 $(STAMP): pyproject.toml | $(BIN)/python
 	$(PIP) install -q --upgrade pip
-	$(PIP) install -q -e '.[test]'
+	$(PIP) install -q -e .
 	@touch $(STAMP)
+
+$(STAMP_TEST): pyproject.toml | $(BIN)/python
+	$(PIP) install -q --upgrade pip
+	$(PIP) install -q -e '.[test]'
+	@touch $(STAMP) $(STAMP_TEST)
 
 demo: setup
 	$(BIN)/hybridgen run configs/quickstart.yaml output/quickstart
 	$(BIN)/hybridgen vis output/quickstart/data.hdf5 --save output/quickstart/preview
 	@echo "preview images: output/quickstart/preview/"
 
-test: setup
+test: setup-test
 	@bash tools/install_system_deps.sh --test
 	$(BIN)/python -m pytest -q
 
@@ -40,7 +50,7 @@ bench: setup
 # the tests run in .venv on a scratch copy of the committed tree. Report: tools/mutation/last_run.md.
 # MUTATE_ARGS="--packages render io --sample 20" narrows it; see tools/mutation/README.md.
 MUTVENV := .venv-mutation
-mutate: setup
+mutate: setup-test
 	@test -x $(MUTVENV)/bin/python || $(PYTHON) -m venv $(MUTVENV)
 	$(MUTVENV)/bin/python -m pip --disable-pip-version-check install -q -r tools/mutation/requirements.txt
 	nice -n 15 $(MUTVENV)/bin/python tools/mutation/run_mutation.py --python $(BIN)/python $(MUTATE_ARGS)
