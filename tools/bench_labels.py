@@ -15,7 +15,6 @@ Readback and turning the raw buffers into arrays are included on both sides:
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import multiprocessing as mp
 import os
 import shutil
@@ -24,8 +23,6 @@ import subprocess
 import sys
 import tempfile
 import time
-import types
-import zlib
 from pathlib import Path
 from typing import Any
 
@@ -39,7 +36,6 @@ def _ours_worker(conn: Any) -> None:
     import numpy as np
 
     import hybridgen as hg
-    from hybridgen.io import hdf5_single
     from hybridgen.render.keypoint_loop import run_keypoints
     from hybridgen.render.passes import PASSES
     from hybridgen.render.render_labels import LabelProducer
@@ -82,22 +78,15 @@ def _ours_worker(conn: Any) -> None:
             conn.send(len(keypoints) / label_pass(scene, view, keypoints, []))
         elif kind == "hdf5":  # writer built, every keypoint written, file finalized: all timed
             compression = options[0]
-            if compression == "gzip-isal":  # experiment: the writer's zlib.compress swapped for ISA-L's
-                from isal import isal_zlib  # same zlib stream format, read by HDF5's gzip filter
-
-                hdf5_single.zlib = types.SimpleNamespace(compress=isal_zlib.compress)
-            try:
-                with tempfile.TemporaryDirectory() as tmp:
-                    path = Path(tmp) / "data.hdf5"
-                    start = time.perf_counter()
-                    writer = (hg.Hdf5SingleFileWriter(path) if compression == "default" else
-                              hg.Hdf5SingleFileWriter(path, compression=compression.split("-")[0]))
-                    label_pass(scene, view, keypoints, [writer])
-                    writer.finalize({"object_states": [o.state() for o in scene.objects]})
-                    elapsed = time.perf_counter() - start
-                    conn.send((len(keypoints) / elapsed, path.stat().st_size / len(keypoints)))
-            finally:
-                hdf5_single.zlib = zlib
+            with tempfile.TemporaryDirectory() as tmp:
+                path = Path(tmp) / "data.hdf5"
+                start = time.perf_counter()
+                writer = (hg.Hdf5SingleFileWriter(path) if compression == "default" else
+                          hg.Hdf5SingleFileWriter(path, compression=compression))
+                label_pass(scene, view, keypoints, [writer])
+                writer.finalize({"object_states": [o.state() for o in scene.objects]})
+                elapsed = time.perf_counter() - start
+                conn.send((len(keypoints) / elapsed, path.stat().st_size / len(keypoints)))
         elif kind == "frame":
             raw = view.render_raw(keypoints[0])
             conn.send((PASSES["depth"].compute(raw), raw.instance.astype(np.int32)))
@@ -383,10 +372,8 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="smoke check: 640x480 only, 4 frames, 2 rounds, gzip")
     parser.add_argument("--scenes", nargs="+", help="scene names (default: the three standard ones); "
                         "'1.3M icosphere' is an extra")
-    parser.add_argument("--compression", nargs="+", choices=["gzip", "gzip-isal", "lzf", "none"],
-                        help="HDF5 compressions to time end to end (default: gzip, gzip-isal if the isal package "
-                        "is installed, lzf, none; --quick: gzip). gzip-isal is an experiment: hybridgen's writer "
-                        "with zlib.compress swapped for isal_zlib.compress (same stream format)")
+    parser.add_argument("--compression", nargs="+", choices=["gzip", "lzf", "none"],
+                        help="HDF5 compressions to time end to end with --inner (default: all; --quick: gzip)")
     parser.add_argument("--check", action=argparse.BooleanOptionalAction, default=None,
                         help="depth/id agreement of both engines with a ray cast (default: on unless --quick)")
     parser.add_argument("--breakdown", action="store_true", help="also time our stages serially per keypoint")
@@ -408,9 +395,7 @@ def main() -> None:
     resolutions = ["640x480"] if args.quick else list(bs.RESOLUTIONS)
     frames = 4 if args.quick else args.frames
     rounds = 2 if args.quick else args.rounds
-    compressions = args.compression or (["gzip"] if args.quick else
-                                        ["gzip", *(["gzip-isal"] if importlib.util.find_spec("isal") else []),
-                                         "lzf", "none"])
+    compressions = args.compression or (["gzip"] if args.quick else ["gzip", "lzf", "none"])
     check = (not args.quick) if args.check is None else args.check
 
     spawn = mp.get_context("spawn")

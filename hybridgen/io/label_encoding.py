@@ -52,25 +52,24 @@ def narrowest_integer_dtype(low: int, high: int) -> np.dtype:
 
 def encode_octahedral(normals: np.ndarray) -> np.ndarray:
     """(…, 3) unit normals (float32, any strides) -> (…, 2) uint16 octahedral codes; (0, 0, 0) -> (0, 0)."""
-    x, y, z = (np.asarray(normals[..., i], dtype=np.float32) for i in range(3))
-    l1 = np.abs(x) + np.abs(y)
+    x, y, z = normals[..., 0], normals[..., 1], normals[..., 2]
+    l1 = np.abs(x, dtype=np.float32)
+    l1 += np.abs(y)
     l1 += np.abs(z)
     background = l1 == 0
-    l1[background] = 1.0
-    np.reciprocal(l1, out=l1)
-    px, py = x * l1, y * l1
-    lower = z < 0
-    if lower.any():  # fold the lower hemisphere over the diagonals
-        fx = (1.0 - np.abs(py[lower])) * np.where(px[lower] >= 0, 1.0, -1.0)
-        fy = (1.0 - np.abs(px[lower])) * np.where(py[lower] >= 0, 1.0, -1.0)
-        px[lower], py[lower] = fx, fy
-    codes = np.empty((*px.shape, 2), dtype=np.uint16)
-    for channel, p in ((0, px), (1, py)):
-        p += 1.0
-        p *= _OCT_SCALE
+    inverse = np.divide(np.float32(1), l1, out=np.zeros_like(l1), where=~background)
+    px, py = x * inverse, y * inverse
+    lower = z < 0  # fold the lower hemisphere over the diagonals
+    fold_x = np.copysign(1 - np.abs(py), px)
+    fold_y = np.copysign(1 - np.abs(px), py)
+    codes = np.empty((*l1.shape, 2), dtype=np.uint16)
+    for channel, p, fold in ((0, px, fold_x), (1, py, fold_y)):
+        np.copyto(p, fold, where=lower)
+        p += 1
+        p *= np.float32(_OCT_SCALE)
         np.rint(p, out=p)
-        p += 1.0
-        p[background] = 0.0
+        p += 1
+        p[background] = 0
         codes[..., channel] = p
     return codes
 
@@ -81,8 +80,8 @@ def decode_octahedral(codes: np.ndarray) -> np.ndarray:
     px, py = q[..., 0], q[..., 1]
     z = 1.0 - np.abs(px) - np.abs(py)
     lower = z < 0
-    x = np.where(lower, (1.0 - np.abs(py)) * np.where(px >= 0, 1.0, -1.0), px)
-    y = np.where(lower, (1.0 - np.abs(px)) * np.where(py >= 0, 1.0, -1.0), py)
+    x = np.where(lower, np.copysign(1.0 - np.abs(py), px), px)
+    y = np.where(lower, np.copysign(1.0 - np.abs(px), py), py)
     out = np.stack([x, y, z], axis=-1)
     out /= np.linalg.norm(out, axis=-1, keepdims=True)
     out[(codes[..., 0] == 0) & (codes[..., 1] == 0)] = 0.0
