@@ -340,6 +340,7 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
                 out = work / "out"
                 ours_cmd = [*hybridgen, "run", "--quiet", str(config), str(out)]
                 theirs_cmd = [sys.executable, __file__, PYRENDER_SCRIPT, str(spec)]
+                shutil.rmtree(work / "warm", ignore_errors=True)  # an existing output would be resumed
                 run_timed([*hybridgen, "run", "--quiet", str(config1), str(work / "warm")], env)  # warms caches
                 times: dict[str, list[float]] = {"ours": [], "theirs": [], "ours1": [], "theirs1": []}
                 size = 0
