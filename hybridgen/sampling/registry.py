@@ -62,7 +62,7 @@ def _known() -> list[str]:
 
 
 def _load_builtins() -> None:
-    from . import getters, samplers  # noqa: F401  (registration side effects)
+    from . import attribute_merger, getters, samplers  # noqa: F401  (registration side effects)
 
 
 @dataclass

@@ -162,3 +162,18 @@ def test_world_manipulator_state_writers_and_replacer(tmp_path):
     assert sum("object_states" in line for line in lines) == 1
     with pytest.raises(ConfigError, match="writer.Hdf5Writer"):
         run_config_text(tmp_path, HEADER % tmp_path + '{"module": "writer.ObjectStateWriter"}]}')
+
+
+def test_attribute_merger_sums_or_averages_drawn_elements():
+    from hybridgen.sampling.registry import DrawContext, draw, parse_value
+
+    spec = {"provider": "getter.AttributeMerger", "transform_by": "sum",
+            "elements": [[1.0, 2.0, 3.0], {"provider": "sampler.Uniform3d", "min": [0.5, 0.5, 0.5],
+                                           "max": [0.5, 0.5, 0.5]}]}
+    ctx = DrawContext(np.random.default_rng(0), None)
+    np.testing.assert_allclose(draw(parse_value(spec, "value"), ctx), [1.5, 2.5, 3.5])
+    spec["transform_by"] = "avg"
+    np.testing.assert_allclose(draw(parse_value(spec, "value"), ctx), [0.75, 1.25, 1.75])
+    spec["transform_by"] = "max"
+    with pytest.raises(ConfigError, match="transform_by"):
+        parse_value(spec, "value")
