@@ -257,7 +257,7 @@ def check_in_process(config: Path, root: Path, run: bool, work: Path, output: Pa
     child.start()
     child.join(timeout)
     if child.is_alive():
-        child.terminate()
+        child.kill()  # SIGKILL: a run traps SIGTERM to finish its current work unit cleanly
         child.join()
         return Outcome(str(config.relative_to(root)), "timeout", f"still running after {timeout:.0f} s (validated)")
     if queue.empty():
