@@ -47,7 +47,9 @@ def test_python_api_example_and_h5py_recipe(tmp_path: Path) -> None:
         assert lit.mean() > 20  # the sun lights the floor and the knot: not a black image
         assert np.isinf(depth).any() and np.isfinite(depth).any()
 
-    [recipe] = python_blocks("Reading the output")
+    recipe, reader = python_blocks("Reading the output")
+    printed = run_python(reader.replace('"output/quickstart"', '"out"'), tmp_path)
+    assert printed == "2 (240, 320)\n"
     recipe = recipe.replace("output/quickstart/data.hdf5", "out/data.hdf5")
     recipe += ("\nassert colors.shape == (240, 320, 3) and depth.dtype.name == 'float32'"
                "\nassert {v['name'] for v in visible} <= {'knot', 'floor'} and visible"
