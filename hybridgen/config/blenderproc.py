@@ -101,8 +101,6 @@ UNAVAILABLE = {
     "composite.CameraObjectSampler": "not implemented yet: it re-samples objects and cameras together per "
                                      "scene; use main.Initializer number_of_scenes with object.ObjectPoseSampler "
                                      "and camera.CameraSampler (each scene draws both anew)",
-    "object.Hide": "not implemented yet: remove objects with manipulators.EntityManipulator by moving them "
-                   "out of view",
     "writer.MyWriter": "an example of a user plugin; write it as a hybridgen plugin (entry point "
                        "'hybridgen.modules')",
 }
@@ -644,6 +642,7 @@ TRANSLATORS: dict[str, Callable[..., list[tuple[str, dict[str, Any]]]]] = {
     "loader.BopLoader": _bop_loader,
     "object.ObjectReplacer": _replacer,
     "object.FloorExtractor": _passthrough("object.FloorExtractor", "selector"),
+    "object.Hide": _passthrough("object.Hide", "selector"),
     "manipulators.FloorExtractor": _passthrough("object.FloorExtractor", "selector"),
 }
 KEYS_ONLY_BLENDERPROC = ("constructor.BasicMeshInitializer", "object.ObjectReplacer", "renderer.NormalRenderer",

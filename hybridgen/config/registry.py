@@ -40,6 +40,7 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.bop_loader",
     "hybridgen.modules.material_library",
     "hybridgen.modules.material_randomizer",
+    "hybridgen.modules.hide_objects",
 )
 
 MODULES: dict[str, type["Module"]] = {}

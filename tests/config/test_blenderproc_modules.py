@@ -177,3 +177,13 @@ def test_attribute_merger_sums_or_averages_drawn_elements():
     spec["transform_by"] = "max"
     with pytest.raises(ConfigError, match="transform_by"):
         parse_value(spec, "value")
+
+
+def test_hide_takes_objects_out_of_the_scene_keeping_ids(tmp_path):
+    context = run_config_text(tmp_path, HEADER % tmp_path + """\
+      {"module": "constructor.BasicMeshInitializer", "config": {"meshes_to_add": [
+        {"type": "cube", "name": "a"}, {"type": "cube", "name": "b"}, {"type": "cube", "name": "c"}]}},
+      {"module": "object.Hide", "config": {"selector": {"provider": "getter.Entity", "conditions": {"name": "b"}}}}
+    ]}
+    """)
+    assert [(o.name, o.instance_id) for o in context.scene.objects] == [("a", 1), ("c", 3)]

@@ -1,0 +1,21 @@
+"""``object.Hide``: take selected objects out of every render and label (Blender's hide_render)."""
+from __future__ import annotations
+
+from ..config.registry import register_module
+from ..config.schema import Param
+from ..run.context import RunContext
+from .selecting import SelectingModule
+
+
+@register_module("object.Hide")
+class Hide(SelectingModule):
+    """Removes the selected objects from the scene: no color, depth or segmentation sees them. Their instance
+    ids are not given to other objects, so the remaining objects keep theirs."""
+
+    params = (
+        Param("selector", "dict|list", doc="objects to hide (getter.Entity conditions, random_samples)"),
+    )
+
+    def run(self, context: RunContext) -> None:
+        hidden = {id(o) for o in self.selected(context)}
+        context.scene.objects[:] = [o for o in context.scene.objects if id(o) not in hidden]
