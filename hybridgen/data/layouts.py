@@ -36,16 +36,6 @@ def open_hdf5(path: Path) -> h5py.File:
         raise InputError(f"cannot open '{path}' as HDF5: {exc}") from None
 
 
-def missing_shards(h5: h5py.File, folder: Path) -> list[str]:
-    """Source files of ``h5``'s virtual datasets that do not exist (relative names resolved from ``folder``,
-    the index file's folder, as HDF5 does). Reading such a dataset would silently give fill values."""
-    sources: set[str] = set()
-    for dset in h5.values():
-        if isinstance(dset, h5py.Dataset) and dset.is_virtual:
-            sources.update(source.file_name for source in dset.virtual_sources())
-    return sorted(name for name in sources if not (folder / name).exists())
-
-
 def _is_single_file(h5: h5py.File) -> bool:
     cam_K = h5.get("cam_K")
     return isinstance(cam_K, h5py.Dataset) and cam_K.ndim == 3
@@ -73,15 +63,16 @@ class SingleFileLayout:
             self.scene_slot = {scene: slot for slot, scene in enumerate(scenes)}  # row of the per-scene records
 
     def open(self) -> h5py.File:
-        """The file, after checking that every shard its virtual datasets read exists."""
+        """The file, after checking that every shard its virtual datasets read exists and is the one the
+        index was built over (virtual datasets over missing shards would read fill values silently)."""
+        from ..run.shard_index import check_index_sources
+
         h5 = open_hdf5(self.path)
-        missing = missing_shards(h5, self.path.parent)
-        if missing:
+        try:
+            check_index_sources(self.path, h5)
+        except BaseException:
             h5.close()
-            shown = ", ".join(missing[:8]) + (f" and {len(missing) - 8} more" if len(missing) > 8 else "")
-            raise InputError(f"'{self.path}': {len(missing)} shard file(s) of this sharded dataset are missing "
-                             f"({shown}); keep shards/ beside it, or rerun the same `hybridgen run` command to "
-                             "recreate them")
+            raise
         return h5
 
     def _datasets(self, h5: h5py.File) -> dict[str, h5py.Dataset]:

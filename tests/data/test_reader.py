@@ -129,8 +129,9 @@ def test_missing_shards_are_one_clear_error(outputs, tmp_path):
     with pytest.raises(InputError) as caught:
         KeypointDataset(copy)
     message = str(caught.value)
-    assert "2 shard file(s)" in message and "shards/scene_000000_chunk_00001.hdf5" in message \
+    assert "2 missing" in message and "shards/scene_000000_chunk_00001.hdf5" in message \
         and "shards/scene_000001_chunk_00000.hdf5" in message and str(copy / "data.hdf5") in message
+    assert "\n" not in message
     with pytest.raises(InputError, match="missing"):  # a worker process opens its own handle: checked there too
         pickle.loads(pickle.dumps(data))[0]
 
