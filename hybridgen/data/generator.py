@@ -167,16 +167,14 @@ class GeneratorDataset:
 
     def scene_samples(self, scene: int, config: ConfigFile | None = None) -> list[dict[str, Any]]:
         """Render scene ``scene`` (in this process) and return its keypoints' samples in keypoint order."""
+        from ..modules.hdf5_writer import scene_records
         from ..run.pipeline import execute
 
         config = config or self._load()
         output = _MemoryOutput(self.seed)
         context = execute(config, [output, *self._modules(config)], unit=WorkUnit(scene))
         sink = output.sink
-        records = {"object_states": [o.state() for o in context.scene.objects],
-                   "light_states": [{"name": light.name, "type": light.type, "energy": light.energy,
-                                     "color": list(light.color), "local2world": light.local2world.tolist()}
-                                    for light in context.scene.lights]}
+        records = scene_records(context.scene)  # what the writer stores for the scene
         samples = []
         for index, frame in enumerate(sink.frames):
             sample: dict[str, Any] = {}

@@ -2,12 +2,14 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 from ..config.registry import register_module
 from ..config.schema import Param
 from ..io.hdf5_blenderproc import BlenderProcHdf5Writer
 from ..io.hdf5_single import COMPRESSIONS, ENCODINGS, Hdf5SingleFileWriter
 from ..run.context import RunContext
+from ..scene.scene import Scene
 from .base import Module
 
 
@@ -15,6 +17,14 @@ def _file_name_check(value: str) -> str | None:
     if "/" in value or value in ("", ".", ".."):
         return f"must be a plain file name inside output_dir, got {value!r}"
     return None if value.endswith((".hdf5", ".h5")) else f"must end in .hdf5 or .h5, got {value!r}"
+
+
+def scene_records(scene: Scene) -> dict[str, list[dict[str, Any]]]:
+    """The scene-level JSON records of an output: ``object_states`` and ``light_states``."""
+    return {"object_states": [o.state() for o in scene.objects],
+            "light_states": [{"name": light.name, "type": light.type, "energy": light.energy,
+                              "color": list(light.color), "local2world": light.local2world.tolist()}
+                             for light in scene.lights]}
 
 
 @register_module("writer.Hdf5Writer")
@@ -59,11 +69,7 @@ class Hdf5Writer(Module):
         context.cleanups.append(self.writer.abort)
 
     def run(self, context: RunContext) -> None:
-        scene = context.scene
-        records = {"object_states": [o.state() for o in scene.objects],
-                   "light_states": [{"name": light.name, "type": light.type, "energy": light.energy,
-                                     "color": list(light.color), "local2world": light.local2world.tolist()}
-                                    for light in scene.lights]}
+        records = scene_records(context.scene)
         if isinstance(self.writer, BlenderProcHdf5Writer):
             context.outputs += self.writer.finalize(records, context.run_attributes())
         else:
