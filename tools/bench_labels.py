@@ -203,7 +203,7 @@ PYRENDER_SCRIPT = "pyrender-script"
 """argv[1] of this file that makes it the pyrender reference: a script a user would write."""
 
 
-def pyrender_script(spec_path: str) -> None:
+def pyrender_script(spec_path: str, hit_fraction: bool = False) -> None:
     """The reference a user compares with: load the same mesh files with trimesh, render depth + segmentation
     (colour-coded ids, decoded) of the same poses with pyrender, write nothing. Runs as its own process."""
     os.environ["PYOPENGL_PLATFORM"] = "egl"
@@ -238,6 +238,9 @@ def pyrender_script(spec_path: str) -> None:
         color, depth = renderer.render(scene, flags=pyrender.RenderFlags.SEG, seg_node_map=seg)
         ids = color[..., 0].astype(np.int32) + 256 * color[..., 1].astype(np.int32)
         assert depth.shape == ids.shape == (height, width)
+        if hit_fraction:  # --hit-fraction: keypoint 0's share of pixels that hit a surface, then stop
+            print(float(np.mean(depth > 0)))
+            break
     renderer.delete()
 
 
@@ -295,7 +298,8 @@ def write_configs(name: str, resolution: str, count: int, folder: Path) -> tuple
                  f"resolution_y: {height}, cam_K: {K}, clip_start: {intr.clip_start}, clip_end: {intr.clip_end}}}\n"
                  "      cam_poses:")
     for pose in poses:
-        lines.append(f"        - {{cam2world_matrix: {[float(v) for v in pose.ravel()]}, source_frame: [X, Y, Z]}}")
+        # source_frame as in BlenderProc: the OpenCV camera's axes in Blender camera axes
+        lines.append(f"        - {{cam2world_matrix: {[float(v) for v in pose.ravel()]}, source_frame: [X, -Y, -Z]}}")
     lines.append("  - {name: renderer.SegMapRenderer, config: {render_depth: true, render_normals: true, "
                  "map_by: [class, instance]}}")
     lines.append("  - {name: writer.Hdf5Writer}")
@@ -307,6 +311,24 @@ def write_configs(name: str, resolution: str, count: int, folder: Path) -> tuple
     spec.write_text(json.dumps({"meshes": meshes, "K": intr.K.tolist(), "resolution": [width, height],
                                 "clip": [intr.clip_start, intr.clip_end], "poses": [p.tolist() for p in poses]}))
     return config, spec
+
+
+def check_output(path: Path, spec: Path) -> None:
+    """Stop if the run did not see what pyrender sees (a pose convention gone wrong renders empty images
+    very fast): the hit fraction of keypoint 0 must match a pyrender render's within 2 %."""
+    import json
+
+    import h5py
+    import numpy as np
+
+    with h5py.File(path, "r") as h5:
+        ours = float(np.mean(np.isfinite(h5["depth"][0])))
+    done = subprocess.run([sys.executable, __file__, PYRENDER_SCRIPT, str(spec), "--hit-fraction"],
+                          capture_output=True, text=True, check=True)
+    theirs = float(done.stdout.split()[-1])
+    if abs(ours - theirs) > 0.02:
+        raise SystemExit(f"hybridgen sees {ours:.1%} of the pixels hit, pyrender {theirs:.1%}: poses differ "
+                         f"({json.loads(spec.read_text())['meshes'][0]['path']})")
 
 
 def run_timed(command: list[str], env: dict[str, str]) -> float:
@@ -355,6 +377,7 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
                             shutil.rmtree(out, ignore_errors=True)
                             times["ours"].append(run_timed(ours_cmd, env))
                             size = sum(f.stat().st_size for f in out.rglob("*.hdf5"))
+                            check_output(out / "data.hdf5", spec)
                             shutil.rmtree(work / "one", ignore_errors=True)
                             times["ours1"].append(run_timed([*hybridgen, "run", "--quiet", str(config1),
                                                              str(work / "one")], env))
@@ -487,7 +510,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    if len(sys.argv) == 3 and sys.argv[1] == PYRENDER_SCRIPT:
-        pyrender_script(sys.argv[2])
+    if len(sys.argv) in (3, 4) and sys.argv[1] == PYRENDER_SCRIPT:
+        pyrender_script(sys.argv[2], hit_fraction=sys.argv[3:] == ["--hit-fraction"])
     else:
         main()
