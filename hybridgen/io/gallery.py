@@ -5,7 +5,8 @@ beside it; every path in the page is relative, nothing is fetched from a network
 (open the file in a browser). Previews and legends are those of :mod:`hybridgen.io.preview`: depth and
 distance in viridis with their scale in metres, segmentation ids with a table naming each id (object name
 and category), flow in the Middlebury color wheel with its largest magnitude. Clicking a thumbnail
-enlarges it; the scene and keypoint selectors (also ``index.html#scene=1&keypoint=0``) filter the page.
+enlarges it; the scene and keypoint selectors (also ``index.html#scene=1&keypoint=0``) filter the page;
+``#open=000003_depth`` opens with that preview enlarged.
 
 A script in the page records, once loaded, each image's ``naturalWidth`` in ``data-natural-width`` and a
 summary in ``#image-check`` (``data-total``, ``data-loaded``, ``data-failed``), so a headless browser can

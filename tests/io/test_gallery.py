@@ -106,6 +106,14 @@ def test_scene_filter_and_screenshot(gallery, tmp_path):
     assert len(sections) == 6
     for attrs in sections:
         assert ("hidden" in attrs["class"]) == (attrs["data-scene"] != "1")
+    # the enlarged view, as a click opens it (the page's #open= runs the click handler's function)
+    done = chromium(tmp_path, "--virtual-time-budget=10000", "--dump-dom", page.as_uri() + "#open=000004_depth")
+    dom = _Elements()
+    dom.feed(done.stdout)
+    check = next(attrs for tag, attrs in dom.elements if attrs.get("id") == "image-check")
+    assert check["data-lightbox"] == "flex" and check["data-lightbox-width"] == "40"
+    enlarged = next(attrs for tag, attrs in dom.elements if tag == "img" and attrs.get("alt") == "enlarged pass")
+    assert enlarged["src"] == "images/000004_depth.png"
     shot = tmp_path / "shot.png"
     done = chromium(tmp_path, "--window-size=900,700", f"--screenshot={shot}", "--virtual-time-budget=10000",
                     page.as_uri())
