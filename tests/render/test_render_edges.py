@@ -14,16 +14,31 @@ from hybridgen.errors import InputError
 from hybridgen.render.projection import near_plane_corner_distance
 
 
-def test_near_plane_corner_distance_is_the_farthest_image_corner():
+@pytest.mark.parametrize("cx, cy", [(10.0, 25.0), (55.0, 3.0)])
+def test_near_plane_corner_distance_is_the_farthest_image_corner(cx, cy):
     """Image corners are pixel edges: u in {-0.5, W - 0.5}, v in {-0.5, H - 0.5}; the near-plane point under
-    (u, v) is near * ((u - cx) / fx, (v - cy) / fy, 1)."""
-    K = np.array([[50.0, 0, 10.0], [0, 40.0, 25.0], [0, 0, 1]])  # principal point far off-centre
+    (u, v) is near * ((u - cx) / fx, (v - cy) / fy, 1). Principal points far off-centre both ways, so each
+    of the four edges is the farthest once."""
+    K = np.array([[50.0, 0, cx], [0, 40.0, cy], [0, 0, 1]])
     width, height, near = 64, 32, 0.2
-    corners = [np.array([(u - 10.0) / 50.0, (v - 25.0) / 40.0, 1.0]) * near
+    corners = [np.array([(u - cx) / 50.0, (v - cy) / 40.0, 1.0]) * near
                for u in (-0.5, width - 0.5) for v in (-0.5, height - 0.5)]
-    expected = max(np.linalg.norm(c) for c in corners)  # (63.5 - 10) / 50 and (-0.5 - 25) / 40
+    expected = max(np.linalg.norm(c) for c in corners)
     assert near_plane_corner_distance(K, width, height, near) == pytest.approx(expected, rel=1e-12)
-    assert expected == pytest.approx(0.2 * np.sqrt(1 + 1.07 ** 2 + 0.6375 ** 2), rel=1e-12)
+
+
+def test_an_object_cut_by_the_near_plane_shows_its_inside(gl_context):
+    """Back-face culling is an optimisation that must never show: a flat closed box (scaled 0.2 in z) whose
+    top face lies between the camera and the near plane shows, everywhere, its bottom face from inside at
+    camera z = 0.05 + 0.2 m - as a ray cast started at the near plane sees it."""
+    scene = hg.Scene()
+    scene.add(hg.make_primitive("cube", 1.0, name="slab", category_id=1,
+                                local2world=hg.object_pose([0, 0, -0.1], [0, 0, 0], [4.0, 4.0, 0.2])))
+    scene.camera.intrinsics = hg.Intrinsics(np.array([[20.0, 0, 7.5], [0, 20.0, 5.5], [0, 0, 1]]), 16, 12,
+                                            clip_start=0.1)
+    scene.camera.add_keypoint(np.array([[1.0, 0, 0, 0], [0, -1, 0, 0], [0, 0, -1, 0.05], [0, 0, 0, 1]]))
+    depth = hg.RasterView(scene).render(scene.camera.keypoints[0], ["depth"])["depth"]
+    np.testing.assert_allclose(depth, 0.25, rtol=1e-5)
 
 
 def _small_scene() -> hg.Scene:
@@ -106,9 +121,13 @@ def test_albedo_pass_follows_a_change_of_image_size(gl_context):
     view = hg.RasterView(scene)
     albedo = AlbedoPass(view)
     pose = scene.camera.keypoints[0]
+    full_size = scene.camera.intrinsics
     large = albedo.render(pose)
-    scene.camera.intrinsics = scene.camera.intrinsics.resized(12, 8)
+    scene.camera.intrinsics = full_size.resized(12, 8)
     small = albedo.render(pose)
-    assert large.shape == (16, 24, 3) and small.shape == (8, 12, 3)
-    fresh = AlbedoPass(hg.RasterView(scene)).render(pose)
-    np.testing.assert_array_equal(small, fresh)
+    scene.camera.intrinsics = full_size.resized(48, 32)
+    larger = albedo.render(pose)
+    assert large.shape == (16, 24, 3) and small.shape == (8, 12, 3) and larger.shape == (32, 48, 3)
+    for image in (small, larger):
+        scene.camera.intrinsics = full_size.resized(image.shape[1], image.shape[0])
+        np.testing.assert_array_equal(image, AlbedoPass(hg.RasterView(scene)).render(pose))
