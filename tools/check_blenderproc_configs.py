@@ -3,7 +3,8 @@
     .venv/bin/python tools/check_blenderproc_configs.py PATH [--tag v1.12.0] [--run] [--only SUBSTRING]
 
 PATH is a BlenderProc working tree (its ``examples/`` is read) or a bare git mirror, read at ``--tag``
-(``git ls-tree`` + ``git show``; nothing of BlenderProc is stored in this repository). For each
+(``git ls-tree`` + ``git show`` into a temporary folder; nothing of BlenderProc is stored in this
+repository). Configs run from the checkout's root, as BlenderProc runs them, so paths they name resolve. For each
 ``examples/**/*.yaml`` the tool makes stand-in inputs for its ``<args:N>`` from the config's ``# Args:``
 line (a Y-up OBJ with several ``o`` objects, a camera pose file, a small BOP dataset, a texture, an output
 folder ...), then
@@ -19,6 +20,7 @@ summary line gives the counts.
 from __future__ import annotations
 
 import argparse
+import os
 import re
 import subprocess
 import sys
@@ -98,16 +100,16 @@ def example_configs(path: Path, tag: str | None, into: Path) -> list[Path]:
     names = subprocess.run(["git", "-C", str(path), "ls-tree", "-r", "--name-only", tag, "examples"],
                            check=True, capture_output=True, text=True).stdout.split()
     configs = []
-    for name in names:
-        if not name.endswith(".yaml"):
-            continue
-        text = subprocess.run(["git", "-C", str(path), "show", f"{tag}:{name}"], check=True, capture_output=True,
-                              text=True).stdout
+    for name in names:  # every example file the mirror holds (inputs a config names by path, too)
+        shown = subprocess.run(["git", "-C", str(path), "show", f"{tag}:{name}"], capture_output=True)
+        if shown.returncode != 0:
+            continue  # a blob the mirror lacks (large files)
         target = into / name
         target.parent.mkdir(parents=True, exist_ok=True)
-        target.write_text(text)
-        configs.append(target)
-    return configs
+        target.write_bytes(shown.stdout)
+        if name.endswith(".yaml"):
+            configs.append(target)
+    return sorted(configs)
 
 
 def standin_args(config: Path, work: Path, output: Path) -> list[str]:
@@ -277,7 +279,8 @@ def main() -> None:
     with tempfile.TemporaryDirectory(prefix="bp-configs-") as tmp:
         root = Path(tmp) / "checkout"
         configs = example_configs(ns.path, ns.tag, root)
-        base = root if ns.tag else ns.path
+        base = (root if ns.tag else ns.path).resolve()
+        os.chdir(base)  # configs name example files relative to the checkout, as BlenderProc runs them
         outcomes = []
         work = Path(tmp) / "standins"
         work.mkdir()
