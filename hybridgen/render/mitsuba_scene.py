@@ -29,6 +29,7 @@ from ..scene.light import Light
 from ..scene.material import Material
 from ..scene.mesh_object import MeshObject
 from ..scene.scene import Scene, World
+from . import light_selection
 
 ENVMAP_TO_WORLD = np.array([[0.0, 0, 1, 0], [1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 0, 1]])
 """Lays Mitsuba's lat-long map (local +Y up, u = atan2(x, -z) / 2 pi mod 1) out as Blender's equirectangular
@@ -106,11 +107,12 @@ def _world_normals(obj: MeshObject) -> np.ndarray:
     return normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
 
 
-def mesh_shape(obj: MeshObject, *, back_side: bool = False) -> Any:
+def mesh_shape(obj: MeshObject, *, back_side: bool = False, sampling_weight: float = 1.0) -> Any:
     """An in-memory Mitsuba mesh of ``obj`` in world coordinates, with its BSDF (and emitter if emissive).
 
     ``back_side`` gives the emitting back of an emissive mesh: faces flipped and moved a hair (1e-6 of the
     object's size) behind the surface, so each side emits once, like Blender's two-sided emission.
+    ``sampling_weight``: the emitter's share of light samples (see :mod:`hybridgen.render.light_selection`).
     """
     import mitsuba as mi
 
@@ -118,7 +120,8 @@ def mesh_shape(obj: MeshObject, *, back_side: bool = False) -> Any:
     props["bsdf"] = mi.load_dict(bsdf_dict(obj.material, obj.name))
     radiance = emitted_radiance(obj)
     if np.any(radiance > 0):
-        props["emitter"] = mi.load_dict({"type": "area", "radiance": _rgb(radiance)})
+        props["emitter"] = mi.load_dict({"type": "area", "radiance": _rgb(radiance),
+                                         "sampling_weight": float(sampling_weight)})
     smooth = obj.vertex_normals is not None
     has_uv = obj.uvs is not None and len(obj.uvs) == len(obj.vertices)
     name = obj.name + (".back" if back_side else "")
@@ -177,7 +180,7 @@ def light_dict(light: Light) -> dict[str, Any]:
 
 def world_dict(world: World) -> dict[str, Any] | None:
     """The background emitter; None for a black world (an emitter of zero radiance would still take its
-    share of the light samples: Mitsuba picks the emitter to sample uniformly)."""
+    share of the light samples)."""
     import mitsuba as mi
 
     if world.strength < 0 or not math.isfinite(world.strength):
@@ -198,16 +201,44 @@ def world_dict(world: World) -> dict[str, Any] | None:
     return {"type": "constant", "radiance": _rgb(radiance)}
 
 
+def _hdri_mean_radiance(world: World) -> float:
+    """Mean linear pixel value of the world's HDRI times its strength."""
+    import mitsuba as mi
+
+    bitmap = mi.Bitmap(str(world.hdri_path)).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, False)
+    return float(np.mean(np.array(bitmap))) * world.strength
+
+
 def scene_dict(scene: Scene) -> dict[str, Any]:
-    """Everything but the sensor and integrator, keyed by stable names."""
+    """Everything but the sensor and integrator, keyed by stable names; every emitter carries a
+    ``sampling_weight`` proportional to its power (:mod:`hybridgen.render.light_selection`)."""
     out: dict[str, Any] = {"type": "scene"}
+    radius = light_selection.scene_radius(scene)
+    powers: dict[str, float] = {}
     world = world_dict(scene.world)
     if world is not None:
-        out["world"] = world
-    for obj in scene.objects:
-        out[f"object_{obj.instance_id}"] = mesh_shape(obj)
-        if np.any(emitted_radiance(obj) > 0):
-            out[f"object_{obj.instance_id}_back"] = mesh_shape(obj, back_side=True)
+        mean = (_hdri_mean_radiance(scene.world) if scene.world.hdri_path
+                else float(np.mean(np.asarray(scene.world.color, float)[:3])) * scene.world.strength)
+        powers["world"] = light_selection.world_power(scene.world, mean, radius)
+    emissive = [obj for obj in scene.objects if np.any(emitted_radiance(obj) > 0)]
+    for obj in emissive:
+        powers[f"object_{obj.instance_id}"] = light_selection.mesh_side_power(obj, emitted_radiance(obj))
     for index, light in enumerate(scene.lights):
-        out[f"light_{index}"] = light_dict(light)
+        powers[f"light_{index}"] = light_selection.light_power(light, radius)
+    weights = light_selection.normalised(powers)
+    if world is not None:
+        out["world"] = {**world, "sampling_weight": weights["world"]}
+    for obj in scene.objects:
+        key = f"object_{obj.instance_id}"
+        out[key] = mesh_shape(obj, sampling_weight=weights.get(key, 1.0))
+        if key in weights:
+            out[f"{key}_back"] = mesh_shape(obj, back_side=True, sampling_weight=weights[key])
+    for index, light in enumerate(scene.lights):
+        description = light_dict(light)
+        weight = weights[f"light_{index}"]
+        if "emitter" in description:  # an AREA light: an emitting rectangle
+            description["emitter"]["sampling_weight"] = weight
+        else:
+            description["sampling_weight"] = weight
+        out[f"light_{index}"] = description
     return out
