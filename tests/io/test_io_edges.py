@@ -1,0 +1,47 @@
+"""io/ values the mutation run (tools/mutation) found unchecked: temporary names for the longest allowed file
+name, the multi-material notice of the mesh loader, the flow preview's scale without any finite flow."""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+import hybridgen as hg
+from tests.conftest import REPO
+
+
+def test_longest_allowed_final_name_gets_a_temporary_file_that_fits(tmp_path):
+    from hybridgen.io.atomic import commit, temporary_path
+
+    longest = os.pathconf(tmp_path, "PC_NAME_MAX")
+    final = tmp_path / ("d" * (longest - 5) + ".hdf5")
+    temp = temporary_path(final)
+    assert temp.parent == tmp_path and temp.name.startswith(".d") and temp.name.endswith(".incomplete")
+    assert len(os.fsencode(temp.name)) <= longest and temp.exists()
+    temp.write_bytes(b"done")
+    commit(temp, final)
+    assert final.read_bytes() == b"done" and not temp.exists()
+
+
+def test_mesh_loader_notices_only_objects_with_several_materials(tmp_path):
+    notices: list[str] = []
+    hg.load_objects(REPO / "configs/assets/knot.obj", name="knot", category_id=1, notify=notices.append)
+    assert notices == []
+    (tmp_path / "two.mtl").write_text("newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n")
+    (tmp_path / "two.obj").write_text(
+        "mtllib two.mtl\no slab\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+        "usemtl red\nf 1 2 3\nusemtl blue\nf 1 3 4\n"
+        "o post\nv 3 0 0\nv 4 0 0\nv 4 0 1\nusemtl red\nf 5 6 7\n")
+    objects = hg.load_objects(tmp_path / "two.obj", category_id=1, notify=notices.append)
+    assert sorted(o.name for o in objects) == ["post", "slab", "slab"]
+    assert len(notices) == 1 and "'slab'" in notices[0] and "'post'" not in notices[0]
+
+
+def test_flow_preview_scale_without_finite_flow_starts_and_ends_at_zero():
+    from hybridgen.io.preview import preview
+
+    flow = np.full((3, 4, 2), np.nan, np.float32)
+    legend = preview("forward_flow", flow).legend
+    assert (legend.low, legend.high) == (0.0, 0.0)
+    flow[1, 2] = (3.0, 4.0)
+    assert preview("forward_flow", flow).legend.high == 5.0
