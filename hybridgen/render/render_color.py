@@ -7,13 +7,12 @@ import numpy as np
 
 from ..io.frame_sink import FrameSink, PassLayout
 from ..scene.scene import Scene
-from .albedo_pass import AlbedoPass
 from .denoise import denoise as oidn_denoise
 from .denoise import require_oidn
+from .denoise_guides import DenoiseGuides
 from .keypoint_loop import ProgressFactory, Producer, StereoProducer, run_keypoints
 from .label_request import LabelRequest
 from .path_trace import PathTraceSettings, PathTraceView
-from .raster import RasterView
 from .render_labels import LabelProducer
 from .tonemap import to_srgb8
 
@@ -28,7 +27,7 @@ class ColorProducer:
     ``colors_hdr`` (float16) from one Mitsuba scene loaded at construction.
 
     With ``denoise`` the linear image goes through Open Image Denoise, guided by the raster view's albedo and
-    normals, before it is encoded; ``keep_raw`` also stores the image before denoising as ``colors_raw``
+    normals (box-filtered over the pixel, :mod:`hybridgen.render.denoise_guides`), before it is encoded; ``keep_raw`` also stores the image before denoising as ``colors_raw``
     (sRGB uint8, encoded like ``colors``). ``sample_counts`` stores the samples each pixel received
     (uint32, ``sample_counts``; constant unless adaptive sampling is on).
     """
@@ -38,11 +37,10 @@ class ColorProducer:
                  keep_raw: bool = False, sample_counts: bool = False) -> None:
         self.scene, self.settings, self.seed, self.hdr, self.denoise = scene, settings, int(seed), hdr, denoise
         self.keep_raw, self.sample_counts = keep_raw and denoise, sample_counts
-        self._guides: tuple[RasterView, AlbedoPass] | None = None
+        self._guides: DenoiseGuides | None = None
         if denoise:
             require_oidn()
-            raster = RasterView(scene)
-            self._guides = (raster, AlbedoPass(raster))
+            self._guides = DenoiseGuides(scene)
         self.view = view or PathTraceView(scene, settings, variant=variant)
 
     def layouts(self) -> list[PassLayout]:
@@ -77,8 +75,7 @@ class ColorProducer:
         if self.sample_counts:
             values["sample_counts"] = counts
         if self._guides is not None:
-            raster, albedo = self._guides
-            linear = oidn_denoise(linear, albedo.render(cam2world), raster.render(cam2world, ["normals"])["normals"])
+            linear = oidn_denoise(linear, *self._guides.render(cam2world))
         values["colors"] = to_srgb8(linear)
         if self.hdr:
             values["colors_hdr"] = linear.astype(np.float16)
@@ -87,8 +84,7 @@ class ColorProducer:
     def close(self) -> None:
         """Release the denoising guides' GL resources (the Mitsuba scene goes with this producer)."""
         if self._guides is not None:
-            self._guides[1].release()
-            self._guides[0].release()
+            self._guides.release()
             self._guides = None
 
 

@@ -1,0 +1,50 @@
+"""The denoiser's guide images, box-filtered over each pixel's footprint like the color.
+
+The color pixel (u, v) averages radiance over ``[u - 0.5, u + 0.5] x [v - 0.5, v + 0.5]`` (a one-pixel box
+filter); a guide sampled only at the pixel centre is aliased at every silhouette and texture edge, and
+Open Image Denoise, told the guides are clean, follows their hard edges: measured on the tabletop scene of
+tools/color_quality.py (160x120, 64 spp, against a 1024-spp reference) 40.4 dB with centre-sampled guides,
+42.9 / 43.3 / 43.3 dB with 2x2 / 3x3 / 4x4 supersampled ones. So the raster view draws albedo and normals at
+``factor`` times the resolution (K scaled so that sub-pixel centres tile the pixel, see
+:meth:`hybridgen.scene.camera.Intrinsics.resized`) and averages ``factor x factor`` blocks. Averaged normals
+are not renormalised: at a silhouette the shorter mixed vector is what the pixel sees.
+"""
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+
+from ..scene.scene import Scene
+from .albedo_pass import AlbedoPass
+from .raster import RasterView
+
+DEFAULT_FACTOR = 3
+
+
+class DenoiseGuides:
+    """Box-filtered linear albedo and camera-space normals (float32 H x W x 3 each) of ``scene``'s camera."""
+
+    def __init__(self, scene: Scene, factor: int = DEFAULT_FACTOR) -> None:
+        intr = scene.camera.intrinsics
+        self.factor, self.width, self.height = int(factor), intr.width, intr.height
+        fine = copy.copy(scene)  # shares objects and lights; only the camera differs
+        fine.camera = copy.copy(scene.camera)
+        fine.camera.intrinsics = intr.resized(intr.width * self.factor, intr.height * self.factor)
+        self.raster = RasterView(fine)
+        self.albedo = AlbedoPass(self.raster)
+
+    def _box(self, image: np.ndarray) -> np.ndarray:
+        f = self.factor
+        blocks = np.nan_to_num(image, nan=0.0, posinf=0.0, neginf=0.0).reshape(self.height, f, self.width, f, -1)
+        return np.ascontiguousarray(blocks.mean(axis=(1, 3), dtype=np.float32))
+
+    def render(self, cam2world: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(albedo, normals) of one keypoint (OpenCV-axes ``cam2world``)."""
+        albedo = self.albedo.render(cam2world)
+        normals = self.raster.render(cam2world, ["normals"])["normals"]
+        return self._box(albedo), self._box(normals)
+
+    def release(self) -> None:
+        self.albedo.release()
+        self.raster.release()
