@@ -1,6 +1,7 @@
-"""Throughput of hybridgen.data: the reader (samples/s over a single file, a sharded index and the BlenderProc
-layout of 320x240 images: every key, and colors + depth + ids) and the on-the-fly generator (samples/s per worker, labels only and
-with color, 1 and 2 workers). Numbers depend on machine load; compare rows of one run.
+"""Throughput of hybridgen.data: the reader (samples/s over a single file, a sharded index and the
+BlenderProc layout of 320x240 images: every key, and colors + depth + ids) and the on-the-fly generator
+(samples/s per worker, labels only and with color, 1 and 2 workers). Numbers depend on machine load;
+compare rows of one run.
 
     .venv/bin/python tools/bench_data.py [--scenes 4]
 """
