@@ -101,7 +101,8 @@ def main() -> None:
                 count, rate = _reader_rate(root / name, keys)
                 print(f"  {name:12s} {'every key' if keys is None else ', '.join(keys):36s} {count:3d} samples "
                       f"{rate:8.1f} samples/s")
-        print(f"generator ({ns.scenes} scenes x 8 keypoints, 320x240; workers spawned, startup not counted per worker):")
+        print(f"generator ({ns.scenes} scenes x 8 keypoints, 320x240; spawned workers, per worker: startup not "
+              "counted):")
         for color in (False, True):
             for workers in (1, 2):
                 total, per_worker, overall = _generator_rate(str(configs["sharded"]), ns.scenes, color, workers)
