@@ -181,3 +181,12 @@ def test_two_dataloader_workers_read_disjoint_keypoints(outputs, layout):
     assert len(by_pid) == 2 and os.getpid() not in by_pid
     first, second = by_pid.values()
     assert not first & second and first | second == set(range(len(data)))
+
+
+def test_importing_hybridgen_data_does_not_import_torch():
+    import subprocess
+    import sys
+
+    code = "import sys, hybridgen.data; assert 'torch' not in sys.modules; print('ok')"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr
