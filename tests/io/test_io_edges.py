@@ -45,3 +45,24 @@ def test_flow_preview_scale_without_finite_flow_starts_and_ends_at_zero():
     assert (legend.low, legend.high) == (0.0, 0.0)
     flow[1, 2] = (3.0, 4.0)
     assert preview("forward_flow", flow).legend.high == 5.0
+
+
+def test_bop_depth_png_values_in_units_of_depth_scale_and_too_far_as_zero():
+    """value * depth_scale = mm, rounded; background, non-finite and beyond-16-bit depths are 0 and the
+    too-far ones are counted (worked out by hand: depth_scale 0.5 -> 2 units per mm)."""
+    from hybridgen.io.bop_writer import depth_png_values
+
+    depth = np.array([[1.0, 32.7675, 32.768, np.inf], [0.0, np.nan, 0.00025, 5.0]])
+    values, too_far = depth_png_values(depth, 0.5, background=5.0)
+    assert values.dtype == np.uint16
+    np.testing.assert_array_equal(values, [[2000, 65535, 0, 0], [0, 0, 0, 0]])  # 0.5 units rounds to even
+    assert too_far == 1
+
+
+def test_box_of_an_empty_mask_is_the_toolkits_no_box():
+    from hybridgen.io.mask_encoding import bbox_of
+
+    assert bbox_of(np.zeros((4, 5), bool)) == [-1, -1, -1, -1]
+    mask = np.zeros((4, 5), bool)
+    mask[1:3, 2:5] = True
+    assert bbox_of(mask) == [2, 1, 3, 2]
