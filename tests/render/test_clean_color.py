@@ -189,3 +189,25 @@ def test_emitters_are_sampled_in_proportion_to_their_power(variant, monkeypatch)
     noise_uniform, mean_uniform = noise_and_mean()
     assert noise_power < noise_uniform / 2  # lamp picked with p = 0.89 instead of 0.5: std ratio ~2.8
     assert mean_power == pytest.approx(mean_uniform, rel=0.03)
+
+
+def test_adaptive_rounds_reuse_one_compiled_kernel(variant):
+    """Every round of every keypoint launches one kernel, compiled at most once: sample counts, pixel lists
+    and seeds are opaque, so nothing is recompiled per pass or per pose."""
+    if not is_jit(variant):
+        pytest.skip("kernel compilation is a JIT-variant matter")
+    import drjit as dr
+
+    scene = _half_lit_scene()
+    view = PathTraceView(scene, PathTraceSettings(samples=128, noise_threshold=0.05, min_samples=8), variant=variant)
+    view.render(scene.camera.keypoints[0], seed=0)  # compiles (or finds in the disk cache)
+    dr.set_flag(dr.JitFlag.KernelHistory, True)
+    try:
+        dr.kernel_history()
+        _, counts = view.render_with_counts(hg.look_at([0.1, -0.2, 2.4], [0, 0, 0]), seed=1)
+        launched = [k for k in dr.kernel_history() if k["type"] == dr.KernelType.JIT]
+    finally:
+        dr.set_flag(dr.JitFlag.KernelHistory, False)
+    rounds = len(np.unique(counts))  # counts 8, 16, 32, ... each ended after one more round
+    assert rounds >= 3 and len(launched) >= rounds
+    assert all(k["cache_hit"] for k in launched)
