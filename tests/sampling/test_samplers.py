@@ -87,6 +87,8 @@ def test_value_color_path(tmp_path):
     assert set(ints.tolist()) == {2, 3, 4}
     normal = _draws({"provider": "sampler.Value", "mode": "normal", "mean": 3.0, "std_dev": 0.5})
     assert abs(normal.mean() - 3.0) < 0.03 and abs(normal.std() - 0.5) < 0.03
+    standard = _draws({"provider": "sampler.Value", "mode": "normal"})  # defaults: mean 0, std_dev 1
+    assert abs(standard.mean()) < 0.06 and abs(standard.std() - 1.0) < 0.05
     colors = _draws({"provider": "sampler.Color", "min": [0, 0.5, 0, 1], "max": [0.2, 0.5, 1, 1]}, n=200)
     assert (colors[:, 1] == 0.5).all() and colors[:, 0].max() <= 0.2
     for name in ("b.png", "a.png", "c.txt"):
