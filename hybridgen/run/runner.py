@@ -38,7 +38,7 @@ from ..io.atomic import prepare_output_dir
 from ..io.integrity import verify
 from ..modules.base import Module
 from .fingerprint import FINGERPRINT_ATTR, describe_difference, differing_keys, parse_fingerprint
-from .signals import die_with_parent
+from .signals import die_with_parent, reclaim_sigterm
 from .units import SHARD_FOLDER, WorkUnit, chunk_count
 
 EXECUTORS = ("pool", "ray")
@@ -240,6 +240,7 @@ class _Ray:
                 ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False, runtime_env=runtime_env,
                          _node_ip_address="127.0.0.1")
             self.started = True
+            reclaim_sigterm()  # ray.init replaced it with a handler that exits without stopping the cluster
         self.remote = ray.remote(run_unit)
         self.call = call
 

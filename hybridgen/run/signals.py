@@ -23,6 +23,7 @@ from ..io.atomic import remove_live_temporaries
 EXIT_SIGTERM = 128 + signal.SIGTERM  # 143
 EXIT_SIGINT = 128 + signal.SIGINT  # 130
 _PR_SET_PDEATHSIG = 1
+_ACTIVE: list[bool] = []  # stop_on_signals blocks in progress
 
 
 def _terminate(signum: int, frame: FrameType | None) -> None:
@@ -37,13 +38,23 @@ def stop_on_signals() -> Iterator[None]:
         yield
         return
     previous = signal.signal(signal.SIGTERM, _terminate)
+    _ACTIVE.append(True)
     try:
         yield
     except (KeyboardInterrupt, SystemExit):
         remove_live_temporaries()
         raise
     finally:
+        _ACTIVE.pop()
         signal.signal(signal.SIGTERM, previous)
+
+
+def reclaim_sigterm() -> None:
+    """Install the run's SIGTERM handler again, after a library replaced it (``ray.init`` installs its own,
+    which exits with status 15 without unwinding the run)."""
+    if threading.current_thread() is threading.main_thread() and signal.getsignal(signal.SIGTERM) is not _terminate:
+        if _ACTIVE:
+            signal.signal(signal.SIGTERM, _terminate)
 
 
 def _worker_terminate(signum: int, frame: FrameType | None) -> None:

@@ -214,3 +214,23 @@ def test_shard_tasks_share_the_folder_but_exclude_a_plain_run(gl_context, tmp_pa
     code, _, err = run_cli("run", "-q", str(config), str(out), "--shard", "1/2")
     assert code == 0, err
     assert verify(out / "data.hdf5") is None
+
+
+def test_sigterm_stops_the_ray_cluster_the_run_started(gl_context, tmp_path, write_config):
+    pytest.importorskip("ray")
+    config = write_config(SCENES.replace("SCENES", "40"))
+    out = tmp_path / "out"
+    process = _cli("run", "-q", str(config), str(out), "--executor", "ray", "--workers", "2")
+    deadline = time.monotonic() + 180
+    started: set[int] = set()
+    while time.monotonic() < deadline and not list((out / "shards").glob("*.hdf5")):
+        started |= _descendants(process.pid)
+        time.sleep(0.2)
+    started |= _descendants(process.pid)
+    assert process.poll() is None and len(started) >= 3  # gcs, raylet, workers ...
+    os.kill(process.pid, signal.SIGTERM)
+    assert process.wait(timeout=120) == 143
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline and [pid for pid in started if _alive(pid)]:
+        time.sleep(0.5)
+    assert not [pid for pid in started if _alive(pid)]
