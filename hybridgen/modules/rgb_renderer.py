@@ -47,8 +47,13 @@ class RgbRenderer(Module):
               check=_non_negative),
         Param("max_bounces", "int", 3, doc="indirect bounces, 0 = direct light only (Mitsuba max_depth = "
               "max_bounces + 2); 3 is BlenderProc's default", check=_non_negative),
-        Param("glossy_bounces", "int|null", None, doc="must be >= max_bounces if given: Mitsuba has one depth "
-              "limit for all lobes", check=lambda v: None if v is None else _non_negative(v)),
+        Param("diffuse_bounces", "int|null", None, doc="Cycles' per-lobe limit (null: max_bounces); below "
+              "max_bounces needs a JIT Mitsuba variant", check=_optional_non_negative),
+        Param("glossy_bounces", "int|null", None, doc="Cycles' limit on glossy/specular reflections (null: "
+              "max_bounces; BlenderProc's default is 0); below max_bounces needs a JIT Mitsuba variant",
+              check=_optional_non_negative),
+        Param("transmission_bounces", "int|null", None, doc="Cycles' limit on glossy/specular transmission "
+              "(null: max_bounces); below max_bounces needs a JIT Mitsuba variant", check=_optional_non_negative),
         Param("resolution_x", "int|null", None, "px", "overrides the camera width (K scaled)"),
         Param("resolution_y", "int|null", None, "px", "overrides the camera height (K scaled)"),
         Param("output_hdr", "bool", False, doc="also write linear colors_hdr (float16)"),
@@ -76,7 +81,8 @@ class RgbRenderer(Module):
         threshold = cfg["noise_threshold"] if cfg["noise_threshold"] is not None else cfg["use_adaptive_sampling"]
         settings = PathTraceSettings(cfg["samples"], cfg["min_bounces"], cfg["max_bounces"], cfg["glossy_bounces"],
                                      noise_threshold=threshold, min_samples=cfg["min_samples"],
-                                     clamp_indirect=cfg["clamp_indirect"])
+                                     clamp_indirect=cfg["clamp_indirect"], diffuse_bounces=cfg["diffuse_bounces"],
+                                     transmission_bounces=cfg["transmission_bounces"])
         plan = settings.plan()
         variant = choose_variant(cfg["variant"])
         sampling = (f"adaptive {plan.min_samples}..{plan.max_samples} spp (noise threshold {plan.noise_threshold})"

@@ -11,6 +11,12 @@ Clamping removes the rare, very bright samples (fireflies: caustics of glossy ob
 surface) at the price of a small downward bias of bright indirect light; ``tools/bench_color.py`` measures
 it against an unclamped reference.
 
+Per-lobe bounce limits as Cycles' ``diffuse_bounces`` / ``glossy_bounces`` / ``transmission_bounces``
+(``max_diffuse`` / ``max_glossy`` / ``max_transmission``; -1 = only ``max_depth`` limits): a path that
+exceeds one still collects the emission its last BSDF sample finds (so MIS with next-event estimation
+stays complete, as at ``max_depth``) and then ends. Glossy counts glossy and specular reflection;
+transmission counts glossy and specular transmission; passing through a ``mask`` (alpha) counts as none.
+
 Depth is counted as Mitsuba's ``max_depth`` (path segments; ``max_depth = 2`` is direct light only). The
 plugin is written in Python and traced once into the JIT kernel, so it costs what the built-in integrator
 costs in the ``llvm``/``cuda`` variants; in ``scalar_rgb`` it would run Python per sample, so the color
@@ -36,6 +42,7 @@ def register(variant: str) -> None:
             self.max_depth = int(props.get("max_depth", 5))
             self.rr_depth = int(props.get("rr_depth", 5))
             self.clamp_indirect = float(props.get("clamp_indirect", 0.0))
+            self.limits = tuple(int(props.get(k, -1)) for k in ("max_diffuse", "max_glossy", "max_transmission"))
 
         @staticmethod
         def _mis_weight(pdf_a: Any, pdf_b: Any) -> Any:
@@ -68,6 +75,10 @@ def register(variant: str) -> None:
             bsdf_pdf_prev = mi.Float(1.0)
             bsdf_delta_prev = mi.Bool(True)
             max_depth, rr_depth = mi.UInt32(self.max_depth), mi.UInt32(self.rr_depth)
+            big = 2 ** 30
+            max_diffuse, max_glossy, max_transmission = (mi.UInt32(big if v < 0 else v) for v in self.limits)
+            n_diffuse, n_glossy, n_transmission = mi.UInt32(0), mi.UInt32(0), mi.UInt32(0)
+            last_segment = mi.Bool(False)  # a lobe limit was exceeded: collect emission, then stop
 
             while dr.hint(active, max_iterations=-1, label="hybridgen clamped path"):
                 si = scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=depth == 0, active=active)
@@ -80,7 +91,7 @@ def register(variant: str) -> None:
                 emitted = throughput * mis_bsdf * ds.emitter.eval(si, active)
                 radiance += self._clamped(emitted, depth >= 2)
 
-                active_next = active & (depth + 1 < max_depth) & si.is_valid()
+                active_next = active & (depth + 1 < max_depth) & si.is_valid() & ~last_segment
 
                 # Next-event estimation: one emitter sample, MIS-weighted against BSDF sampling.
                 active_em = active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth)
@@ -95,6 +106,17 @@ def register(variant: str) -> None:
                 # BSDF sampling: the next segment.
                 bsdf_sample, bsdf_weight = bsdf.sample(bsdf_ctx, si, sampler.next_1d(), sampler.next_2d(),
                                                        active_next)
+                sampled = bsdf_sample.sampled_type
+                transmits = mi.has_flag(sampled, mi.BSDFFlags.GlossyTransmission) | \
+                    mi.has_flag(sampled, mi.BSDFFlags.DeltaTransmission)
+                glossy = mi.has_flag(sampled, mi.BSDFFlags.GlossyReflection) | \
+                    mi.has_flag(sampled, mi.BSDFFlags.DeltaReflection)
+                diffuse = mi.has_flag(sampled, mi.BSDFFlags.Diffuse)
+                n_diffuse[active_next & diffuse] += 1
+                n_glossy[active_next & glossy] += 1
+                n_transmission[active_next & transmits] += 1
+                last_segment = ((n_diffuse > max_diffuse) | (n_glossy > max_glossy)
+                                | (n_transmission > max_transmission))
                 ray = si.spawn_ray(si.to_world(bsdf_sample.wo))
                 throughput *= bsdf_weight
                 eta *= bsdf_sample.eta
@@ -117,6 +139,7 @@ def register(variant: str) -> None:
             return []
 
         def to_string(self) -> str:
-            return f"HybridgenClampedPath[max_depth={self.max_depth}, clamp_indirect={self.clamp_indirect}]"
+            return (f"HybridgenClampedPath[max_depth={self.max_depth}, clamp_indirect={self.clamp_indirect}, "
+                    f"lobe limits (diffuse, glossy, transmission)={self.limits}]")
 
     mi.register_integrator(PLUGIN_NAME, lambda props: ClampedPath(props))

@@ -37,9 +37,10 @@ class PathTraceSettings:
 
     Bounces count as in Cycles: ``max_bounces`` 0 is direct light only (default 3, BlenderProc's). Mitsuba's
     ``path`` integrator counts path segments, so ``max_depth = max_bounces + 2`` and Russian roulette starts
-    at ``rr_depth = min(min_bounces, max_bounces) + 2``. Mitsuba has a single depth limit for all lobes, so
-    ``glossy_bounces`` can only be honoured when it is not smaller than ``max_bounces``; a smaller value is
-    rejected rather than silently ignored.
+    at ``rr_depth = min(min_bounces, max_bounces) + 2``. Per-lobe limits ``diffuse_bounces``,
+    ``glossy_bounces``, ``transmission_bounces`` (None: ``max_bounces``; BlenderProc's defaults are 3, 0, 0)
+    are honoured by :mod:`hybridgen.render.clamped_path` in the JIT variants; ``scalar_rgb`` (Mitsuba's
+    ``path``, one depth limit for all lobes) rejects a value below ``max_bounces`` rather than ignoring it.
 
     Sampling (see :mod:`hybridgen.render.adaptive_sampling`): with ``samples`` not given, every pixel is
     sampled adaptively from ``min_samples`` until its noise estimate is below ``noise_threshold`` (default
@@ -60,15 +61,17 @@ class PathTraceSettings:
     noise_threshold: float | None = None
     min_samples: int = 16
     clamp_indirect: float = 10.0
+    diffuse_bounces: int | None = None
+    transmission_bounces: int | None = None
 
     def __post_init__(self) -> None:
         if self.samples is not None and self.samples < 1:
             raise InputError(f"samples must be >= 1, got {self.samples}")
         if self.min_bounces < 0 or self.max_bounces < 0:
             raise InputError("min_bounces and max_bounces must be >= 0")
-        if self.glossy_bounces is not None and self.glossy_bounces < self.max_bounces:
-            raise InputError(f"glossy_bounces ({self.glossy_bounces}) < max_bounces ({self.max_bounces}) cannot "
-                             "be honoured: Mitsuba's path tracer has one depth limit for every lobe")
+        for name, value in self._lobe_bounces().items():
+            if value is not None and value < 0:
+                raise InputError(f"{name} must be >= 0, got {value}")
         if not (math.isfinite(self.clamp_indirect) and self.clamp_indirect >= 0):
             raise InputError(f"clamp_indirect must be >= 0 (0 = off), got {self.clamp_indirect}")
         self.plan()  # validates the sampling knobs
@@ -88,15 +91,33 @@ class PathTraceSettings:
         return {"type": "path", "max_depth": self.max_bounces + 2, "rr_depth": rr_depth,
                 "hide_emitters": False}
 
+    def _lobe_bounces(self) -> dict[str, int | None]:
+        return {"diffuse_bounces": self.diffuse_bounces, "glossy_bounces": self.glossy_bounces,
+                "transmission_bounces": self.transmission_bounces}
+
+    def lobe_limits(self) -> dict[str, int]:
+        """The per-lobe limits below ``max_bounces`` (the others are implied by it)."""
+        return {name: value for name, value in self._lobe_bounces().items()
+                if value is not None and value < self.max_bounces}
+
     def integrator_for(self, variant: str) -> dict[str, Any]:
-        """The integrator used in ``variant``: the clamped path tracer where it can run (JIT variants, clamp
-        on), else :meth:`integrator`."""
-        if self.clamp_indirect > 0 and is_jit(variant):
-            clamped_path.register(variant)
-            plain = self.integrator()
-            return {"type": clamped_path.PLUGIN_NAME, "max_depth": plain["max_depth"],
-                    "rr_depth": plain["rr_depth"], "clamp_indirect": float(self.clamp_indirect)}
-        return self.integrator()
+        """The integrator used in ``variant``: hybridgen's clamped path tracer where it can run (JIT variants)
+        and is needed (clamp on, or per-lobe limits), else :meth:`integrator`."""
+        limits = self.lobe_limits()
+        if not is_jit(variant):
+            if limits:
+                raise InputError(f"{', '.join(f'{k} ({v})' for k, v in limits.items())} < max_bounces "
+                                 f"({self.max_bounces}) needs a JIT Mitsuba variant (llvm_ad_rgb or cuda_ad_rgb): "
+                                 f"{variant}'s path tracer has one depth limit for every lobe")
+            return self.integrator()
+        if self.clamp_indirect <= 0 and not limits:
+            return self.integrator()
+        clamped_path.register(variant)
+        plain = self.integrator()
+        keys = {"diffuse_bounces": "max_diffuse", "glossy_bounces": "max_glossy",
+                "transmission_bounces": "max_transmission"}
+        return {"type": clamped_path.PLUGIN_NAME, "max_depth": plain["max_depth"], "rr_depth": plain["rr_depth"],
+                "clamp_indirect": float(self.clamp_indirect), **{keys[k]: v for k, v in limits.items()}}
 
 
 def sensor_dict(intr: Intrinsics, cam2world: np.ndarray, variant: str) -> dict[str, Any]:

@@ -62,6 +62,7 @@ class ColorProducer:
                 "noise_threshold": plan.noise_threshold, "adaptive_sampling": plan.adaptive,
                 "clamp_indirect": s.clamp_indirect if self.view.clamped else 0.0,
                 "min_bounces": s.min_bounces, "max_bounces": s.max_bounces, "mitsuba_max_depth": s.max_bounces + 2,
+                **{name: value for name, value in s.lobe_limits().items()},
                 "color_encoding": "sRGB transfer of linear radiance clipped to [0, 1]", "denoised": self.denoise}
 
     def records(self) -> dict[str, np.ndarray]:

@@ -211,3 +211,25 @@ def test_adaptive_rounds_reuse_one_compiled_kernel(variant):
     rounds = len(np.unique(counts))  # counts 8, 16, 32, ... each ended after one more round
     assert rounds >= 3 and len(launched) >= rounds
     assert all(k["cache_hit"] for k in launched)
+
+
+def test_glossy_bounce_limit_ends_paths_after_a_glossy_reflection(variant):
+    """Cycles' glossy_bounces: 0 (BlenderProc's default): a mirror shows the lamp's highlight (direct light)
+    but no longer reflects the lit floor. The floor itself, lit directly, is unchanged."""
+    if not is_jit(variant):
+        pytest.skip("per-lobe limits need a JIT variant")
+    scene = _lamp_over_floor(wall=True)
+    scene.camera.keypoints[0] = hg.look_at([-1.5, -0.3, 1.2], [0.8, 0.0, 0.5])  # at the mirror and the floor
+    scene.camera.intrinsics = hg.Intrinsics.from_fov(0.9, 24, 16)
+    ids = hg.RasterView(scene).render(scene.camera.keypoints[0], ["instance_segmaps"])["instance_segmaps"]
+    mirror = ids == 2
+    assert mirror.sum() > 50
+    settings = dict(samples=32, clamp_indirect=0.0)
+    full = PathTraceView(scene, PathTraceSettings(**settings), variant=variant).render(scene.camera.keypoints[0], 1)
+    limited = PathTraceView(scene, PathTraceSettings(glossy_bounces=0, **settings), variant=variant).render(
+        scene.camera.keypoints[0], 1)
+    # the mirror reflects the bright floor in full; with glossy_bounces 0 only (little) direct light is left
+    assert limited[mirror].mean() < 0.2 * full[mirror].mean()
+    floor = ids == 1
+    assert floor.sum() > 50
+    np.testing.assert_allclose(limited[floor].mean(), full[floor].mean(), rtol=0.05)

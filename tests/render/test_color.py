@@ -157,11 +157,18 @@ def test_scene_is_loaded_once_for_all_keypoints(variant, monkeypatch):
     assert len({f["colors"].tobytes() for f in sink.frames}) == 8
 
 
-def test_path_trace_settings_validation():
+def test_path_trace_settings_validation(variant):
     with pytest.raises(hg.InputError, match="samples"):
         PathTraceSettings(samples=0)
+    with pytest.raises(hg.InputError, match="glossy_bounces"):  # scalar_rgb's path has one depth limit
+        PathTraceSettings(max_bounces=8, glossy_bounces=4).integrator_for("scalar_rgb")
     with pytest.raises(hg.InputError, match="glossy_bounces"):
-        PathTraceSettings(max_bounces=8, glossy_bounces=4)
+        PathTraceSettings(glossy_bounces=-1)
+    if is_jit(variant):  # hybridgen's own path tracer honours per-lobe limits
+        from hybridgen.render.mitsuba_variant import activate
+
+        activate(variant)
+        assert PathTraceSettings(max_bounces=8, glossy_bounces=4).integrator_for(variant)["max_glossy"] == 4
     assert PathTraceSettings(min_bounces=1, max_bounces=3).integrator() == {
         "type": "path", "max_depth": 5, "rr_depth": 3, "hide_emitters": False}
 
