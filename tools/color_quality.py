@@ -53,13 +53,23 @@ def _floor(size: float = 6.0, albedo: float = 0.6) -> Any:
     return floor
 
 
-def _pybullet_mesh(file: str, name: str, category_id: int, pose: np.ndarray) -> list[Any]:
+def _pybullet_mesh(file: str, name: str, category_id: int, size: float, xy: tuple[float, float],
+                   yaw: float = 0.0) -> list[Any]:
+    """A pybullet_data mesh scaled to ``size`` m (largest extent), turned by ``yaw`` about +Z and standing
+    on the floor at ``xy``."""
     import pybullet_data
 
     import hybridgen as hg
 
-    return hg.load_objects(Path(pybullet_data.getDataPath()) / file, name=name, category_id=category_id,
-                           local2world=pose)
+    objects = hg.load_objects(Path(pybullet_data.getDataPath()) / file, name=name, category_id=category_id)
+    vertices = np.concatenate([obj.world_vertices() for obj in objects])
+    low, high = vertices.min(axis=0), vertices.max(axis=0)
+    centre = np.array([(low[0] + high[0]) / 2, (low[1] + high[1]) / 2, low[2]])
+    move = hg.object_pose([xy[0], xy[1], 0.0], [0.0, 0.0, yaw]) @ np.diag([size / np.max(high - low)] * 3 + [1.0])
+    move = move @ hg.object_pose((-centre).tolist())
+    for obj in objects:
+        obj.local2world = move @ obj.local2world
+    return objects
 
 
 def checker(size: int = 256, squares: int = 8, a: tuple[int, ...] = (200, 190, 170),
@@ -81,12 +91,12 @@ def tabletop(width: int, height: int) -> Any:
 
     scene = hg.Scene()
     scene.add(_floor())
-    for obj in _pybullet_mesh("duck.obj", "duck", 2, hg.object_pose([-0.35, 0.1, 0.0], [math.pi / 2, 0, 0.5], 1.5)):
+    for obj in _pybullet_mesh("duck.obj", "duck", 2, 0.3, (-0.35, 0.1), 0.5):
         scene.add(obj)
-    for obj in _pybullet_mesh("bunny.obj", "bunny", 3, hg.object_pose([0.3, 0.25, 0.0], [math.pi / 2, 0, 0], 1.8)):
+    for obj in _pybullet_mesh("bunny.obj", "bunny", 3, 0.3, (0.3, 0.25)):
         obj.material.specular = 0.0
         scene.add(obj)
-    for obj in _pybullet_mesh("soccerball.obj", "football", 4, hg.object_pose([0.35, -0.3, 0.12], scale=0.12)):
+    for obj in _pybullet_mesh("soccerball.obj", "football", 4, 0.22, (0.35, -0.3)):
         scene.add(obj)
     mug = hg.make_primitive("cylinder", 0.22, name="mug", category_id=5, color=(0.75, 0.2, 0.15),
                             local2world=hg.object_pose([-0.05, -0.35, 0.11]))
