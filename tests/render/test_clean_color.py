@@ -233,3 +233,15 @@ def test_glossy_bounce_limit_ends_paths_after_a_glossy_reflection(variant):
     floor = ids == 1
     assert floor.sum() > 50
     np.testing.assert_allclose(limited[floor].mean(), full[floor].mean(), rtol=0.05)
+
+
+def test_scalar_variant_samples_adaptively_through_whole_frames():
+    """scalar_rgb has no per-pixel tracer: each round renders the frame, but counts and mean follow the plan."""
+    scene = _half_lit_scene()
+    settings = PathTraceSettings(samples=64, noise_threshold=0.05, min_samples=8)
+    view = PathTraceView(scene, settings, variant="scalar_rgb")
+    assert not view.clamped  # the clamped integrator needs a JIT variant
+    image, counts = view.render_with_counts(scene.camera.keypoints[0], seed=1)
+    assert counts.min() == 8 and counts.max() == 64 and set(np.unique(counts)) <= {8, 16, 32, 64}
+    reference = view.render(scene.camera.keypoints[0], seed=2, spp=256)
+    assert image.mean() == pytest.approx(reference.mean(), rel=0.03)
