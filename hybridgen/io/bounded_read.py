@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..config.paths import not_found
 from ..errors import InputError
 
 MAX_POSE_FILE_BYTES = 64 * 2**20
@@ -21,6 +22,8 @@ def read_bounded_text(path: str | Path, limit: int, what: str, *, latin1_fallbac
     try:
         with open(path, "rb") as handle:
             data = handle.read(limit + 1)
+    except FileNotFoundError:
+        raise InputError(not_found(what, path)) from None  # names both places a config run looked
     except OSError as exc:
         raise InputError(f"cannot read {what} '{path}': {exc.strerror or exc}") from None
     if len(data) > limit:

@@ -120,3 +120,19 @@ def test_missing_texture_names_both_places(tmp_path, monkeypatch):
         message = not_found("texture file", "t/wood.png")
     assert message == (f"texture file not found: 't/wood.png' (tried {tmp_path}/t/wood.png from the working "
                        f"directory and {tmp_path}/project/t/wood.png from the config's folder)")
+
+
+def test_missing_pose_file_names_both_places(tmp_path, run_cli, monkeypatch):
+    project = tmp_path / "project"
+    project.mkdir()
+    (project / "scene.yaml").write_text(CONFIG.replace("      cam_poses: [{location: [0, 0, 5], rotation: {format: "
+                                                       "look_at, value: [0, 0, 0]}}]", "      path: poses/p.txt"))
+    _block(project / "assets" / "block.ply", 1.0)
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run_cli("run", "-q", str(project / "scene.yaml"), "out")
+    assert code == 2 and "camera pose file not found: 'poses/p.txt'" in err
+    assert f"tried {tmp_path}/poses/p.txt from the working directory and {project}/poses/p.txt" in err
+    (project / "poses").mkdir()
+    (project / "poses" / "p.txt").write_text("0 0 5 0 0 0\n")  # found beside the config
+    code, _, err = run_cli("run", "-q", str(project / "scene.yaml"), "out")
+    assert code == 0, err
