@@ -50,9 +50,12 @@ def _signature_of(item: Any, copy: Path, wanted: set) -> tuple | None:
     from cosmic_ray.plugins import get_operator
 
     mutation = item.mutations[0]
-    if (str(mutation.module_path), mutation.operator_name) not in {(w[0], w[1]) for w in wanted}:
-        return None
     code = (copy / mutation.module_path).read_text()
+    # cheap filter first: the mutated line must be one a wanted mutant removes
+    line = code.split("\n")[mutation.start_pos[0] - 1].strip()
+    if not any(w[0] == str(mutation.module_path) and w[1] == mutation.operator_name and w[2] and
+               w[2][0][1:].strip() == line for w in wanted):
+        return None
     mutated = mutate_code(code, get_operator(mutation.operator_name)(**mutation.operator_args), mutation.occurrence)
     if mutated is None:
         return None
