@@ -112,15 +112,17 @@ def run_package(name: str, spec: dict, settings: dict, copy: Path, python: str, 
                      [f"--ignore-glob={shlex.quote(g)}" for g in spec.get("ignore", [])])
     command = f"{shlex.quote(python)} -m pytest -x -q -p no:cacheprovider {tests}"
     env = dict(os.environ, PYTHONPATH=str(copy), PYTHONDONTWRITEBYTECODE="1")
+    start = time.monotonic()
     baseline = subprocess.run(shlex.split(command.replace(" -x ", " ")), cwd=copy, env=env, capture_output=True,
                               text=True)
+    baseline_s = time.monotonic() - start
     failing = sorted({line.split()[1] for line in baseline.stdout.splitlines() if line.startswith(("FAILED ", "ERROR "))})
     if failing:  # tests that fail without any mutation cannot judge mutants: deselected, and reported
         print(f"{name}: deselecting {len(failing)} test(s) that fail unmutated: {failing}", flush=True)
         command += "".join(f" --deselect {shlex.quote(node)}" for node in failing)
-    start = time.monotonic()
-    baseline = subprocess.run(shlex.split(command), cwd=copy, env=env, capture_output=True, text=True)
-    baseline_s = time.monotonic() - start
+        start = time.monotonic()
+        baseline = subprocess.run(shlex.split(command), cwd=copy, env=env, capture_output=True, text=True)
+        baseline_s = time.monotonic() - start
     if baseline.returncode != 0:
         raise SystemExit(f"{name}: the test selection fails without any mutation:\n{baseline.stdout[-3000:]}")
     timeout = settings["timeout_factor"] * baseline_s + 20
