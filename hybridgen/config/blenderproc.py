@@ -35,10 +35,9 @@ through the config, so a missing one is a notice, not an error."""
 
 GLOBAL_IGNORED = {
     "sys_paths": "Blender's Python import paths; hybridgen needs none",
-    "diffuse_bounces": "Cycles' per-lobe bounce limit; Mitsuba has one limit (max_bounces)",
-    "transmission_bounces": "Cycles' per-lobe bounce limit; Mitsuba has one limit (max_bounces)",
-    "transparency_bounces": "Cycles' per-lobe bounce limit; Mitsuba has one limit (max_bounces)",
-    "volume_bounces": "Cycles' per-lobe bounce limit; Mitsuba has one limit (max_bounces)",
+    "transparency_bounces": "Cycles' limit on alpha-transparent surfaces; hybridgen's materials are opaque or "
+                            "refractive (transmission_bounces)",
+    "volume_bounces": "hybridgen renders no volumes",
     "output_is_temp": "hybridgen keeps no temporary per-frame files; writers write the final files",
     "pixel_aspect_x": "hybridgen cameras have square pixels unless cam_K says otherwise",
     "pixel_aspect_y": "hybridgen cameras have square pixels unless cam_K says otherwise",
@@ -365,8 +364,8 @@ def _rgb(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]]]
     _pop(cfg, "transparent_background", note, "hybridgen color has no alpha; the background is the world color")
     for key in ("use_motion_blur", "motion_blur_length", "use_rolling_shutter", "rolling_shutter_length"):
         _pop(cfg, key, note, "motion blur and rolling shutter are not simulated: each keypoint is a still frame")
-    for key in ("cpu_threads", "simplify_subdivision_render", "light_sampling", "adaptive_threshold",
-                "use_adaptive_sampling", "auto_tile_size", "tile_x", "tile_y"):
+    for key in ("cpu_threads", "simplify_subdivision_render", "light_sampling", "auto_tile_size", "tile_x",
+                "tile_y"):
         _pop(cfg, key, note, "a Cycles performance setting")
     return [("renderer.RgbRenderer", cfg)]
 

@@ -92,7 +92,7 @@ BASIC_V3 = """\
       },
       "modules": [
         {"module": "main.Initializer", "config": {"global": {"output_dir": "<args:2>", "max_bounces": 2,
-                                                              "diffuse_bounces": 2}}},
+                                                              "transparency_bounces": 2}}},
         {"module": "loader.ObjectLoader", "config": {"path": "<args:1>",
                                                      "add_properties": {"cp_category_id": "1"}}},
         {"module": "lighting.LightLoader", "config": {"lights": [{"type": "POINT", "location": [5, -5, 5],
@@ -121,7 +121,7 @@ def test_basic_v3_runs_unchanged_and_the_floor_is_horizontal(tmp_path, notices, 
     assert summary.frames == 2
     # one notice line each for the Blender setup keys and the Cycles-only global key; none is an error
     assert any("blender_install_path" in n and "ignored" in n for n in notices)
-    assert any("diffuse_bounces" in n for n in notices)
+    assert any("transparency_bounces" in n for n in notices)
     with h5py.File(out / "data.hdf5") as f:
         assert "depth" in f and "distance" not in f  # Dist2Depth: depth instead of distance
     from hybridgen.data import KeypointDataset
