@@ -29,7 +29,7 @@ from ..config.camera_poses import source_frame_axes
 from ..config.notices import notice
 from ..config.registry import register_module
 from ..config.schema import Param
-from ..errors import InputError
+from ..errors import ConfigError
 from ..io.mesh_loader import load_objects
 from ..run.context import RunContext
 from ..scene.camera import Intrinsics
@@ -38,13 +38,14 @@ from .base import Module
 from .obj_loader import add_with_blender_names
 
 
-def _read_json(path: Path) -> Any:
+def _read_json(path: Path, key: str) -> Any:
+    """Parse a BOP JSON file; a missing or broken one is a :class:`ConfigError` on ``key`` naming the file."""
     try:
         return json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
-        raise InputError(f"BOP file not found: '{path}'") from None
-    except (OSError, json.JSONDecodeError) as exc:
-        raise InputError(f"cannot read BOP file '{path}': {exc}") from None
+        raise ConfigError(f"BOP file not found: '{path}'", key=key) from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ConfigError(f"cannot read BOP file '{path}': {exc}", key=key) from None
 
 
 def _pose(rotation: Any, translation: Any, scale: float) -> np.ndarray:
@@ -80,10 +81,11 @@ class BopLoader(Module):
         cfg = self.config
         root = Path(cfg["bop_dataset_path"])
         if not root.is_dir():
-            raise InputError(f"BOP dataset folder not found: '{root}'")
+            raise ConfigError(f"BOP dataset folder not found: '{root}'", key="bop_dataset_path")
         scale = 0.001 if cfg["mm2m"] else 1.0
         models = root / ("models" + (f"_{cfg['model_type']}" if cfg["model_type"] else ""))
-        camera = _read_json(root / ("camera" + (f"_{cfg['cam_type']}" if cfg["cam_type"] else "") + ".json"))
+        camera = _read_json(root / ("camera" + (f"_{cfg['cam_type']}" if cfg["cam_type"] else "") + ".json"),
+                            "cam_type")
         labels: dict[str, Any] = {}
         custom_properties(cfg["add_properties"], labels)
         if cfg["scene_id"] < 0:
@@ -108,18 +110,33 @@ class BopLoader(Module):
 
     def _object_ids(self, context: RunContext, models: Path) -> list[int]:
         cfg = self.config
+        info_path = models / "models_info.json"
         ids = [int(i) for i in cfg["obj_ids"]]
-        if not ids:
-            info = _read_json(models / "models_info.json")
-            ids = sorted(int(k) for k in info)
+        if ids and not info_path.is_file():  # listed ids need no models_info.json, only their model files
+            missing = [i for i in ids if not (models / f"obj_{i:06d}.ply").is_file()]
+            if missing:
+                raise ConfigError(f"obj_id {missing[0]} has no model '{models / f'obj_{missing[0]:06d}.ply'}'",
+                                  key="obj_ids")
+            return self._sample(context, ids)
+        known = sorted(int(k) for k in _read_json(info_path, "model_type"))
+        unknown = [i for i in ids if i not in known]
+        if unknown:
+            raise ConfigError(f"obj_id {unknown[0]} is not a model of '{info_path}' (it lists {known})",
+                              key="obj_ids")
+        return self._sample(context, ids or known)
+
+    def _sample(self, context: RunContext, ids: list[int]) -> list[int]:
+        """``ids`` as they are, or with ``sample_objects`` the drawn ones (with replacement, instance limit)."""
+        cfg = self.config
         if not cfg["sample_objects"]:
             return ids
         count = cfg["num_of_objs_to_sample"]
         if count is None or count < 1:
-            raise InputError("sample_objects needs num_of_objs_to_sample >= 1")
+            raise ConfigError("sample_objects needs num_of_objs_to_sample >= 1", key="num_of_objs_to_sample")
         limit = cfg["obj_instances_limit"]
         if limit != -1 and len(set(ids)) * limit < count:
-            raise InputError(f"{len(set(ids))} models with at most {limit} copies each cannot give {count} objects")
+            raise ConfigError(f"{len(set(ids))} models with at most {limit} copies each cannot give {count} "
+                              "objects", key="obj_instances_limit")
         drawn: list[int] = []
         copies: dict[int, int] = {}
         while len(drawn) < count:
@@ -133,10 +150,22 @@ class BopLoader(Module):
                    scale: float) -> tuple[list[int], list[np.ndarray]]:
         cfg = self.config
         scene_dir = root / cfg["split"] / f"{cfg['scene_id']:06d}"
-        gt = _read_json(scene_dir / "scene_gt.json")
-        cams = _read_json(scene_dir / "scene_camera.json")
+        if not scene_dir.is_dir():
+            raise ConfigError(f"BOP scene folder not found: '{scene_dir}' (no scene_gt.json there)", key="scene_id")
+        gt = _read_json(scene_dir / "scene_gt.json", "scene_id")
+        cams = _read_json(scene_dir / "scene_camera.json", "scene_id")
         if not gt:
-            raise InputError(f"'{scene_dir / 'scene_gt.json'}' lists no image")
+            raise ConfigError(f"'{scene_dir / 'scene_gt.json'}' lists no image", key="scene_id")
+        try:
+            return self._scene_poses(context, gt, cams, camera, scale)
+        except (KeyError, IndexError, TypeError, ValueError) as exc:
+            raise ConfigError(f"malformed BOP scene files in '{scene_dir}' (scene_gt.json / scene_camera.json): "
+                              f"{type(exc).__name__}: {exc}", key="scene_id") from None
+
+    def _scene_poses(self, context: RunContext, gt: dict[str, Any], cams: dict[str, Any], camera: dict[str, Any],
+                     scale: float) -> tuple[list[int], list[np.ndarray]]:
+        """Object ids and model-to-world poses of the first image; one keypoint per image (see module doc)."""
+        cfg = self.config
         axes = np.eye(4)
         axes[:3, :3] = source_frame_axes(cfg["source_frame"]).T
         first = None
