@@ -6,7 +6,8 @@ split folders ``<split>/<scene_id:06d>/scene_gt.json`` + ``scene_camera.json``.
 
 - Without ``scene_id``: loads ``obj_ids`` (default: every model) - or, with ``sample_objects``,
   ``num_of_objs_to_sample`` random draws among them (at most ``obj_instances_limit`` copies each) - at the
-  origin, and sets the camera intrinsics from the dataset's camera file.
+  origin, and sets the camera intrinsics from the dataset's camera file (for ``tless``, as BlenderProc, with
+  the principal point at ``(width / 2, height / 2)``).
 - With ``scene_id``: replicates the scene as BlenderProc does. The world is the first image's camera frame
   (OpenCV axes); every object gets its ``cam_R_m2c``/``cam_t_m2c`` of that image; every image of the scene
   becomes a keypoint whose cam2world is ``m2w_ref @ inv(m2c_ref)`` (ref: the image's first object), read in
@@ -14,7 +15,9 @@ split folders ``<split>/<scene_id:06d>/scene_gt.json`` + ``scene_camera.json``.
 
 Objects are named as Blender's PLY importer names them (``obj_000001``, clashes ``.001``), get
 ``category_id`` = their BOP obj_id and the attribute ``bop_dataset_name`` (the folder's name), which
-writer.BopWriter uses. ``mm2m`` scales models and poses from millimetres to metres.
+writer.BopWriter uses. ``mm2m`` scales models and poses from millimetres to metres. A model's texture
+(ycbv-style ``comment TextureFile`` with ``texture_u``/``texture_v``) becomes its base-colour texture; vertex
+colours become one base colour (their mean: hybridgen materials have no per-vertex colour yet).
 """
 from __future__ import annotations
 
@@ -91,9 +94,12 @@ class BopLoader(Module):
         if cfg["scene_id"] < 0:
             ids = self._object_ids(context, models)
             poses = [np.eye(4)] * len(ids)
+            width, height = int(camera["width"]), int(camera["height"])
+            cx, cy = camera["cx"], camera["cy"]
+            if root.name == "tless":  # as BlenderProc: T-LESS images are crops, principal point = image centre
+                cx, cy = width / 2, height / 2
             context.scene.camera.intrinsics = Intrinsics(
-                [[camera["fx"], 0, camera["cx"]], [0, camera["fy"], camera["cy"]], [0, 0, 1]],
-                int(camera["width"]), int(camera["height"]))
+                [[camera["fx"], 0, cx], [0, camera["fy"], cy], [0, 0, 1]], width, height)
         else:
             ids, poses = self._replicate(context, root, camera, scale)
         for obj_id, pose in zip(ids, poses):

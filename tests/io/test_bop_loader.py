@@ -261,3 +261,52 @@ def test_listed_ids_need_only_their_model_files(tmp_path):
     assert [o.category_id for o in scene.objects] == [2]
     with pytest.raises(ConfigError, match="obj_ids.*obj_id 4 has no model"):
         _load(tmp_path, bop_dataset_path=str(dataset), obj_ids=[2, 4])
+
+
+TEXTURED_PLY = """ply
+format ascii 1.0
+comment TextureFile obj_000001.png
+element vertex 3
+property float x
+property float y
+property float z
+property float texture_u
+property float texture_v
+element face 1
+property list uchar int vertex_indices
+end_header
+0 0 0 0 0
+10 0 0 1 0
+0 10 0 0 1
+3 0 1 2
+"""
+
+
+def test_model_colours_vertex_colours_and_ycbv_style_textures(tmp_path):
+    from PIL import Image
+
+    dataset = make_dataset(tmp_path)
+    scene = _load(tmp_path, bop_dataset_path=str(dataset), obj_ids=[2])
+    # hybridgen materials have one base colour: a model's (here uniform) vertex colour becomes it
+    np.testing.assert_allclose(scene.objects[0].material.base_color, np.array([120, 100, 90, 255]) / 255)
+
+    textured = tmp_path / "yc"  # a ycbv-like model: texture_u/texture_v and a 'comment TextureFile' image
+    (textured / "models").mkdir(parents=True)
+    (textured / "models" / "obj_000001.ply").write_text(TEXTURED_PLY)
+    Image.fromarray(np.full((4, 4, 3), [10, 200, 30], np.uint8)).save(textured / "models" / "obj_000001.png")
+    (textured / "models" / "models_info.json").write_text(json.dumps({"1": {"diameter": 14.1}}))
+    (textured / "camera.json").write_text(json.dumps({"cx": 80, "cy": 60, "fx": 100, "fy": 100, "width": 160,
+                                                      "height": 120}))
+    obj = _load(tmp_path, bop_dataset_path=str(textured)).objects[0]
+    assert obj.attributes["bop_dataset_name"] == "yc" and obj.category_id == 1
+    np.testing.assert_allclose(obj.uvs, [[0, 0], [1, 0], [0, 1]])
+    assert tuple(obj.material.base_color_texture[0, 0, :3]) == (10, 200, 30)
+
+
+def test_tless_objects_get_the_image_centre_as_principal_point(tmp_path):
+    dataset = make_dataset(tmp_path, name="tless")  # camera.json's cx, cy are off-centre
+    scene = _load(tmp_path, bop_dataset_path=str(dataset), obj_ids=[1])
+    np.testing.assert_allclose(scene.camera.intrinsics.K, [[K[0, 0], 0, WIDTH / 2], [0, K[1, 1], HEIGHT / 2],
+                                                           [0, 0, 1]])
+    replicated = _load(tmp_path, bop_dataset_path=str(dataset), scene_id=SCENE_ID)  # scenes keep their cam_K
+    np.testing.assert_allclose(replicated.camera.intrinsics.K, K)
