@@ -48,3 +48,12 @@ def test_inside_out_closed_mesh_is_drawn_from_outside(gl_context):
         assert (out["instance_segmaps"] == 1).sum() > 50
         depths.append(out["depth"])
     np.testing.assert_allclose(depths[1], depths[0], rtol=1e-6)
+
+
+def test_rotation_about_a_non_unit_axis():
+    from hybridgen.scene.frames import rotation_about_axis
+
+    quarter = rotation_about_axis(np.array([0.0, 0.0, 2.5]), np.pi / 2)  # any length: only the direction counts
+    np.testing.assert_allclose(quarter, [[0, -1, 0], [1, 0, 0], [0, 0, 1]], atol=1e-12)
+    tilted = rotation_about_axis(np.array([3.0, 0.0, 0.0]), 0.3)
+    np.testing.assert_allclose(tilted @ [0, 1, 0], [0, np.cos(0.3), np.sin(0.3)], atol=1e-12)
