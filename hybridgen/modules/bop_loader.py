@@ -2,7 +2,10 @@
 
 A BOP dataset folder (``bop_dataset_path``, e.g. ``.../bop/lm``) holds ``models[_<model_type>]/obj_<id:06d>.ply``
 (millimetres), ``models*/models_info.json``, ``camera[_<cam_type>].json`` (fx, fy, cx, cy, width, height) and
-split folders ``<split>/<scene_id:06d>/scene_gt.json`` + ``scene_camera.json``.
+split folders ``<split>[_<sensor>]/<scene_id:06d>/scene_gt.json`` + ``scene_camera.json``. Where a type is ''
+the dataset's bop_toolkit default applies (T-LESS: ``models_cad``, ``camera_primesense.json``,
+``test_primesense``; YCB-V: ``camera_uw.json``, ``train_real``; TUD-L: ``train_render``), falling back to the
+plain name when that folder or file is absent (a type the config names has no fallback).
 
 - Without ``scene_id``: loads ``obj_ids`` (default: every model) - or, with ``sample_objects``,
   ``num_of_objs_to_sample`` random draws among them (at most ``obj_instances_limit`` copies each) - at the
@@ -51,6 +54,23 @@ def _read_json(path: Path, key: str) -> Any:
         raise ConfigError(f"cannot read BOP file '{path}': {exc}", key=key) from None
 
 
+# bop_toolkit's per-dataset defaults (dataset_params.py), which BlenderProc gets through it: the camera file
+# and models folder used when cam_type / model_type are '', and the sensor suffix of split folders.
+DEFAULT_CAM_TYPE = {"tless": "primesense", "ycbv": "uw"}
+DEFAULT_MODEL_TYPE = {"tless": "cad"}
+DEFAULT_SPLIT_TYPE = {("tless", "train"): "primesense", ("tless", "test"): "primesense",
+                      ("tudl", "train"): "render", ("ycbv", "train"): "real"}
+
+
+def _first_existing(candidates: list[Path], key: str, what: str) -> Path:
+    """The first of ``candidates`` that exists, else a :class:`ConfigError` on ``key`` naming them all."""
+    for path in candidates:
+        if path.exists():
+            return path
+    tried = " or ".join(f"'{p}'" for p in dict.fromkeys(candidates))
+    raise ConfigError(f"BOP {what} not found: {tried}", key=key)
+
+
 def _pose(rotation: Any, translation: Any, scale: float) -> np.ndarray:
     pose = np.eye(4)
     pose[:3, :3] = np.asarray(rotation, dtype=np.float64).reshape(3, 3)
@@ -86,9 +106,15 @@ class BopLoader(Module):
         if not root.is_dir():
             raise ConfigError(f"BOP dataset folder not found: '{root}'", key="bop_dataset_path")
         scale = 0.001 if cfg["mm2m"] else 1.0
-        models = root / ("models" + (f"_{cfg['model_type']}" if cfg["model_type"] else ""))
-        camera = _read_json(root / ("camera" + (f"_{cfg['cam_type']}" if cfg["cam_type"] else "") + ".json"),
-                            "cam_type")
+        model_type = cfg["model_type"] or DEFAULT_MODEL_TYPE.get(root.name, "")
+        models = _first_existing([root / ("models" + (f"_{model_type}" if model_type else ""))]
+                                 + ([root / "models"] if not cfg["model_type"] else []), "model_type", "models folder")
+        cam_type = cfg["cam_type"] or DEFAULT_CAM_TYPE.get(root.name, "")
+        camera = _read_json(_first_existing([root / ("camera" + (f"_{cam_type}" if cam_type else "") + ".json")]
+                                            + ([root / "camera.json"] if not cfg["cam_type"] else []),
+                                            "cam_type", "camera file"), "cam_type")
+        if not all(isinstance(camera.get(k), (int, float)) for k in ("fx", "fy", "cx", "cy", "width", "height")):
+            raise ConfigError("the BOP camera file needs numbers fx, fy, cx, cy, width, height", key="cam_type")
         labels: dict[str, Any] = {}
         custom_properties(cfg["add_properties"], labels)
         if cfg["scene_id"] < 0:
@@ -155,9 +181,10 @@ class BopLoader(Module):
     def _replicate(self, context: RunContext, root: Path, camera: dict[str, Any],
                    scale: float) -> tuple[list[int], list[np.ndarray]]:
         cfg = self.config
-        scene_dir = root / cfg["split"] / f"{cfg['scene_id']:06d}"
-        if not scene_dir.is_dir():
-            raise ConfigError(f"BOP scene folder not found: '{scene_dir}' (no scene_gt.json there)", key="scene_id")
+        split_type = DEFAULT_SPLIT_TYPE.get((root.name, cfg["split"]))
+        scene_dir = _first_existing(
+            [root / (cfg["split"] + (f"_{split_type}" if split_type else "")) / f"{cfg['scene_id']:06d}",
+             root / cfg["split"] / f"{cfg['scene_id']:06d}"], "scene_id", "scene folder")
         gt = _read_json(scene_dir / "scene_gt.json", "scene_id")
         cams = _read_json(scene_dir / "scene_camera.json", "scene_id")
         if not gt:

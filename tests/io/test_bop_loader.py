@@ -2,8 +2,8 @@
 models_info.json, camera.json, a test scene's scene_gt.json / scene_camera.json with known poses).
 
 The oracle is independent of hybridgen: trimesh ray casting of the dataset's own meshes, posed by each image's
-``cam_R_m2c`` / ``cam_t_m2c`` in that image's camera frame, through the pixel centres (integer coordinates, as BOP and OpenCV count them) of the dataset's ``cam_K``.
-Replicating the scene and rendering labels must give the same depth and the same per-object masks.
+``cam_R_m2c`` / ``cam_t_m2c`` in that image's camera frame, through the pixel centres (integer coordinates, as
+BOP and OpenCV count them) of the dataset's ``cam_K``. Replicating the scene and rendering labels must give the same depth and the same per-object masks.
 """
 from __future__ import annotations
 
@@ -303,10 +303,22 @@ def test_model_colours_vertex_colours_and_ycbv_style_textures(tmp_path):
     assert tuple(obj.material.base_color_texture[0, 0, :3]) == (10, 200, 30)
 
 
-def test_tless_objects_get_the_image_centre_as_principal_point(tmp_path):
+def test_tless_layout_defaults_and_principal_point(tmp_path):
     dataset = make_dataset(tmp_path, name="tless")  # camera.json's cx, cy are off-centre
-    scene = _load(tmp_path, bop_dataset_path=str(dataset), obj_ids=[1])
+    (dataset / "camera.json").rename(dataset / "camera_primesense.json")  # T-LESS as published
+    (dataset / "test").rename(dataset / "test_primesense")
+    scene = _load(tmp_path, bop_dataset_path=str(dataset), obj_ids=[1], mm2m=True)
     np.testing.assert_allclose(scene.camera.intrinsics.K, [[K[0, 0], 0, WIDTH / 2], [0, K[1, 1], HEIGHT / 2],
-                                                           [0, 0, 1]])
-    replicated = _load(tmp_path, bop_dataset_path=str(dataset), scene_id=SCENE_ID)  # scenes keep their cam_K
-    np.testing.assert_allclose(replicated.camera.intrinsics.K, K)
+                                                           [0, 0, 1]])  # as BlenderProc: the image centre
+    box = scene.objects[0].world_vertices()  # model_type '' is T-LESS's CAD models (models_cad: twice as big)
+    np.testing.assert_allclose(box.max(axis=0) - box.min(axis=0), [0.12, 0.08, 0.06], atol=1e-9)
+    replicated = _load(tmp_path, bop_dataset_path=str(dataset), scene_id=SCENE_ID)  # from test_primesense/
+    np.testing.assert_allclose(replicated.camera.intrinsics.K, K)  # scenes keep their cam_K
+    assert len(replicated.camera) == len(CAMERA_EYES)
+    with pytest.raises(ConfigError, match="key 'cam_type': BOP camera file not found: .*camera_kinect.json'$"):
+        _load(tmp_path, bop_dataset_path=str(dataset), cam_type="kinect")
+    with pytest.raises(ConfigError, match="key 'model_type': BOP models folder not found: .*models_reconst'$"):
+        _load(tmp_path, bop_dataset_path=str(dataset), model_type="reconst")  # named types do not fall back
+    (dataset / "camera_primesense.json").write_text(json.dumps({"fx": 100.0}))
+    with pytest.raises(ConfigError, match="key 'cam_type': the BOP camera file needs numbers"):
+        _load(tmp_path, bop_dataset_path=str(dataset))
