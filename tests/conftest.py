@@ -61,3 +61,13 @@ def pixel_rays_world(intr: hg.Intrinsics, cam2world: np.ndarray) -> tuple[np.nda
     rays = intr.pixel_rays().reshape(-1, 3)
     unit = rays / np.linalg.norm(rays, axis=1, keepdims=True)
     return unit @ cam2world[:3, :3].T, unit[:, 2]
+
+
+def silhouette(ids: np.ndarray) -> np.ndarray:
+    """Pixels whose 8-neighbourhood holds more than one id (where coverage rounding may differ)."""
+    padded = np.pad(ids, 1, mode="edge")
+    edge = np.zeros(ids.shape, bool)
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            edge |= padded[1 + dy:1 + dy + ids.shape[0], 1 + dx:1 + dx + ids.shape[1]] != ids
+    return edge

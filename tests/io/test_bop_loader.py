@@ -19,6 +19,7 @@ import hybridgen as hg
 from hybridgen.config.config_file import load_config
 from hybridgen.errors import ConfigError
 from hybridgen.run.pipeline import build_modules, execute
+from tests.conftest import silhouette
 
 K = np.array([[190.0, 0.0, 83.0], [0.0, 185.0, 57.5], [0.0, 0.0, 1.0]])  # off-centre principal point, fx != fy
 WIDTH, HEIGHT = 160, 120
@@ -124,15 +125,6 @@ def _raycast_gt(instances: list[dict], scale: float) -> tuple[np.ndarray, np.nda
     return depth.reshape(HEIGHT, WIDTH), ids.reshape(HEIGHT, WIDTH)
 
 
-def _silhouette(ids: np.ndarray) -> np.ndarray:
-    padded = np.pad(ids, 1, mode="edge")
-    edge = np.zeros(ids.shape, bool)
-    for dy in (-1, 0, 1):
-        for dx in (-1, 0, 1):
-            edge |= padded[1 + dy:1 + dy + ids.shape[0], 1 + dx:1 + dx + ids.shape[1]] != ids
-    return edge
-
-
 def _load(tmp_path: Path, **loader: object) -> hg.Scene:
     """Run main.Initializer + loader.BopLoader with ``loader`` keys; return the scene."""
     config = {"version": 3, "modules": [
@@ -162,7 +154,7 @@ def test_replicated_scene_renders_its_own_ground_truth(tmp_path, gl_context, mm2
         ref_depth, ref_index = _raycast_gt(instances, scale)
         to_index = {obj.instance_id: i + 1 for i, obj in enumerate(scene.objects)}
         our_index = np.vectorize(lambda i: to_index.get(int(i), 0))(ours["instance_segmaps"])
-        edge = _silhouette(ref_index)
+        edge = silhouette(ref_index)
         for index in range(1, len(instances) + 1):  # every object's mask, pixel by pixel off its silhouette
             ref_mask, our_mask = ref_index == index, our_index == index
             assert ref_mask.sum() > 30, (image_id, index)  # every object is visible in every image
@@ -354,7 +346,7 @@ def test_replicated_scene_written_by_the_bop_writer_is_the_scene_again(tmp_path)
         np.testing.assert_allclose(cameras_out[image_id]["cam_K"], K.ravel())
         ref_depth_mm, ref_index = _raycast_gt(instances, 1.0)
         depth_mm = np.asarray(Image.open(scene_out / "depth" / f"{int(image_id):06d}.png"), np.float64) * 0.1
-        edge = _silhouette(ref_index)
+        edge = silhouette(ref_index)
         inside = (ref_index > 0) & ~edge
         np.testing.assert_allclose(depth_mm[inside], ref_depth_mm[inside], atol=0.051 + 2e-5 * 300)
         assert not depth_mm[(ref_index == 0) & ~edge].any()  # 0 where the dataset sees nothing

@@ -7,7 +7,7 @@ import trimesh
 
 import hybridgen as hg
 from hybridgen.scene.primitives import make_primitive
-from tests.conftest import REPO, pixel_rays_world
+from tests.conftest import REPO, pixel_rays_world, silhouette
 
 
 def _scene() -> hg.Scene:
@@ -47,16 +47,6 @@ def _raycast(scene: hg.Scene, intr: hg.Intrinsics, pose: np.ndarray) -> tuple[np
     return depth.reshape(intr.height, intr.width), ids.reshape(intr.height, intr.width)
 
 
-def _silhouette(ids: np.ndarray) -> np.ndarray:
-    """Pixels whose 8-neighbourhood holds more than one id."""
-    padded = np.pad(ids, 1, mode="edge")
-    edge = np.zeros(ids.shape, bool)
-    for dy in (-1, 0, 1):
-        for dx in (-1, 0, 1):
-            edge |= padded[1 + dy:1 + dy + ids.shape[0], 1 + dx:1 + dx + ids.shape[1]] != ids
-    return edge
-
-
 @pytest.mark.parametrize("location,target", [
     ([4.5, -4.0, 3.0], [0, 0, 0]),
     ([-4.0, 3.5, 1.0], [0.5, 0, 0.3]),
@@ -74,7 +64,7 @@ def test_depth_and_ids_agree_with_ray_casting(gl_context, location, target):
     assert both.mean() > 0.9  # the room surrounds the camera: nearly every pixel hits something
     disagree_hit = ours_hit != ref_hit
     assert disagree_hit.mean() < 1e-3
-    assert not (disagree_hit & ~_silhouette(ref_ids)).any()
+    assert not (disagree_hit & ~silhouette(ref_ids)).any()
     assert np.median(np.abs(out["depth"][both] - ref_depth[both])) <= 1e-5
     same_id = out["instance_segmaps"][both] == ref_ids[both]
     assert same_id.mean() >= 0.999
