@@ -11,7 +11,7 @@ from hybridgen.render.mitsuba_variant import choose_variant, is_jit
 from hybridgen.render.path_trace import PathTraceSettings, PathTraceView, mitsuba_pixel_centre_depth
 from hybridgen.render.render_color import ColorProducer, keypoint_seed, render_color
 from hybridgen.render.tonemap import to_srgb8
-from tests.render.test_vs_raycast import _silhouette
+from tests.conftest import silhouette as _silhouette
 
 
 @pytest.fixture(scope="session")
