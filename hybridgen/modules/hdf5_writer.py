@@ -9,6 +9,8 @@ from ..config.schema import Param
 from ..io.hdf5_blenderproc import BlenderProcHdf5Writer
 from ..io.hdf5_single import COMPRESSIONS, ENCODINGS, Hdf5SingleFileWriter
 from ..run.context import RunContext
+from ..run.staged_output import DEFAULT_CHUNK_KEYPOINTS, JournalingWriter
+from ..run.units import SHARD_FOLDER
 from ..scene.scene import Scene
 from .base import Module
 
@@ -46,6 +48,11 @@ class Hdf5Writer(Module):
               "dtypes as they are); the blenderproc layout always stores BlenderProc's encodings"),
         Param("compression_level", "int", 1, doc="gzip level 0..9 (1: twice as fast as 4, files ~10 % larger)",
               check=lambda v: None if 0 <= v <= 9 else f"must be in 0..9, got {v}"),
+        Param("resume_chunk_keypoints", "int", DEFAULT_CHUNK_KEYPOINTS,
+              doc="single layout, run without sharding as the only writer: render this many keypoints per "
+              "verified part in the hidden folder .<file_name>.parts, merged at the end into the same bytes a "
+              "direct write gives, so a killed run resumes (0: write directly, a killed run starts over)",
+              check=lambda v: None if v >= 0 else f"must be >= 0, got {v}"),
     )
 
     def prepare(self, context: RunContext) -> None:
@@ -55,11 +62,10 @@ class Hdf5Writer(Module):
             self.writer = BlenderProcHdf5Writer(cfg["output_dir"], append=cfg["append_to_existing_output"],
                                                 compression=cfg["compression"],
                                                 compression_level=cfg["compression_level"])
-        elif context.unit is not None:  # one work unit of a sharded run: its own complete file
-            self.writer = Hdf5SingleFileWriter(context.unit.shard_path(cfg["output_dir"]),
-                                               compression=cfg["compression"],
-                                               compression_level=cfg["compression_level"],
-                                               encoding=cfg["encoding"])
+        elif context.unit is not None:  # one work unit of a sharded run (or part of a staged one): its own file
+            writer_class = JournalingWriter if context.unit.folder != SHARD_FOLDER else Hdf5SingleFileWriter
+            self.writer = writer_class(context.unit.shard_path(cfg["output_dir"]), compression=cfg["compression"],
+                                       compression_level=cfg["compression_level"], encoding=cfg["encoding"])
         else:
             self.writer = Hdf5SingleFileWriter(Path(cfg["output_dir"]) / cfg["file_name"],
                                                compression=cfg["compression"],

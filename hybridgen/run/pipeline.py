@@ -18,7 +18,7 @@ from ..io.output_lock import output_locks
 from ..modules.base import Module
 from .context import RunContext
 from .fingerprint import FINGERPRINT_ATTR, fingerprint_text, run_fingerprint
-from .runner import DEFAULT_MAX_TASKS_PER_CHILD
+from .runner import DEFAULT_MAX_TASKS_PER_CHILD, ShardingPlan
 from .signals import stop_on_signals
 from .units import WorkUnit
 
@@ -136,6 +136,19 @@ def single_file_output(modules: list[Module]) -> Path | None:
     return Path(writers[0].config["output_dir"]) / writers[0].config["file_name"]
 
 
+def staged_plan(modules: list[Module]) -> ShardingPlan | None:
+    """The plan of a non-sharded run that renders in resumable parts (:mod:`hybridgen.run.staged_output`):
+    its only writer is ``writer.Hdf5Writer`` (``layout: single``) with ``resume_chunk_keypoints`` > 0."""
+    from .staged_output import staging_folder_name
+
+    single = single_file_output(modules)
+    writer = next((m for m in modules if m.module_name == "writer.Hdf5Writer"), None)
+    if single is None or writer is None or writer.config["resume_chunk_keypoints"] <= 0:
+        return None
+    return ShardingPlan(1, writer.config["resume_chunk_keypoints"], single.parent, single.name,
+                        folder=staging_folder_name(single.name), staged=True)
+
+
 def run_config(path: str | Path, args: Sequence[str] = (), *, env: Mapping[str, str] | None = None,
                progress: Callable[[int, str], Any] | None = None,
                log: Callable[[str], None] | None = None, workers: int = 1, shard: tuple[int, int] | None = None,
@@ -178,6 +191,10 @@ def run_config(path: str | Path, args: Sequence[str] = (), *, env: Mapping[str, 
             say(f"'{single}' is complete and verified (same config and inputs): nothing to do; "
                 "--restart renders it again")
             return RunSummary(0, time.perf_counter() - start, [single])
+        staged = staged_plan(modules)
+        if staged is not None:  # rendered in verified parts, merged into the same bytes: a killed run resumes
+            return run_sharded(staged, path, args, env, workers=1, shard=None, executor="pool", address=None,
+                               log=say, start=start, policy=policy, max_tasks_per_child=max_tasks_per_child)
         context = execute(config, modules, progress=progress, log=log,
                           attributes={FINGERPRINT_ATTR: policy.fingerprint_text})
     return RunSummary(context.frames_rendered, time.perf_counter() - start, context.outputs)

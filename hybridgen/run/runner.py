@@ -48,12 +48,20 @@ RAY_CONNECT_TIMEOUT_S = 10.0
 
 @dataclass(frozen=True)
 class ShardingPlan:
-    """How a config splits into units and where their files go."""
+    """How a config splits into units and where their files go (``<output_dir>/<folder>``). ``staged``: a
+    non-sharded run whose units are merged into one ordinary file at the end
+    (:mod:`hybridgen.run.staged_output`) instead of indexed."""
 
     scenes: int
     chunk_size: int
     output_dir: Path
     file_name: str
+    folder: str = SHARD_FOLDER
+    staged: bool = False
+
+    def unit(self, scene: int, chunk: int = 0) -> WorkUnit:
+        """The plan's unit of ``scene``, ``chunk``."""
+        return WorkUnit(scene, chunk, self.chunk_size, self.folder)
 
 
 @dataclass(frozen=True)
@@ -144,7 +152,7 @@ def discard_outputs(plan: ShardingPlan, shard: tuple[int, int] | None = None) ->
     """``--restart``: delete the plan's shards (with ``shard`` ``(i, n)``: only those of scenes ``s % n == i``)
     and the index; returns how many files were removed."""
     removed = 0
-    shards = plan.output_dir / SHARD_FOLDER
+    shards = plan.output_dir / plan.folder
     candidates = list(shards.glob("scene_*_chunk_*.hdf5")) if shards.is_dir() else []
     if shard is not None:
         candidates = [p for p in candidates if p.name[6:12].isdigit() and int(p.name[6:12]) % shard[1] == shard[0]]
@@ -252,9 +260,9 @@ class _Ray:
             self.ray.shutdown()
 
 
-def _scene_units(scenes: int, index: int, count: int, chunk_size: int) -> Iterator[WorkUnit]:
-    for scene in range(index, scenes, count):
-        yield WorkUnit(scene, 0, chunk_size)
+def _scene_units(plan: ShardingPlan, index: int, count: int) -> Iterator[WorkUnit]:
+    for scene in range(index, plan.scenes, count):
+        yield plan.unit(scene)
 
 
 def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: Mapping[str, str] | None, *,
@@ -271,7 +279,7 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
     index, count = shard or (0, 1)
     if not 0 <= index < count:
         raise InputError(f"--shard i/N needs 0 <= i < N, got {index}/{count}")
-    prepare_output_dir(plan.output_dir / SHARD_FOLDER)
+    prepare_output_dir(plan.output_dir / plan.folder)
     if (plan.output_dir / plan.file_name).is_dir():
         raise InputError(f"'{plan.output_dir / plan.file_name}' is a directory; the index cannot be written there")
     if policy.restart:
@@ -285,7 +293,7 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
         pool = _Local(lambda unit: run_unit(*call[:3], unit, call[3]))
     else:
         pool = _Pool(call, workers, max_tasks_per_child)
-    scene_units = _scene_units(plan.scenes, index, count, plan.chunk_size)
+    scene_units = _scene_units(plan, index, count)
     ready: deque[WorkUnit] = deque()  # later chunks of scenes whose first chunk is known
     pending: dict[Future, WorkUnit] = {}
     window = 2 * workers
@@ -293,7 +301,7 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
 
     def expand(unit: WorkUnit, total: int) -> None:
         chunks = range(1, chunk_count(total, plan.chunk_size))
-        ready.extend(WorkUnit(unit.scene, chunk, plan.chunk_size) for chunk in chunks)
+        ready.extend(plan.unit(unit.scene, chunk) for chunk in chunks)
 
     def refill() -> None:
         nonlocal skipped
@@ -327,7 +335,12 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
         pool.shutdown(interrupted)
     outputs = []
     shards = complete_shards(plan)
-    if shards is not None:
+    if shards is not None and plan.staged:
+        from .staged_output import consolidate, remove_staging
+
+        outputs.append(consolidate(plan.output_dir / plan.file_name, shards))
+        remove_staging(plan.output_dir / plan.folder)
+    elif shards is not None:
         from .shard_index import build_index
 
         outputs.append(build_index(plan.output_dir / plan.file_name, shards, policy.fingerprint_text))
@@ -342,11 +355,11 @@ def complete_shards(plan: ShardingPlan) -> list[Path] | None:
     """Every unit file of every scene in (scene, chunk) order, or None while some are missing."""
     shards = []
     for scene in range(plan.scenes):
-        first = WorkUnit(scene, 0, plan.chunk_size).shard_path(plan.output_dir)
+        first = plan.unit(scene).shard_path(plan.output_dir)
         if not first.is_file():
             return None
         for chunk in range(chunk_count(_scene_keypoints(first), plan.chunk_size)):
-            path = WorkUnit(scene, chunk, plan.chunk_size).shard_path(plan.output_dir)
+            path = plan.unit(scene, chunk).shard_path(plan.output_dir)
             if not path.is_file():
                 return None
             shards.append(path)

@@ -17,19 +17,22 @@ SHARD_FOLDER = "shards"
 
 @dataclass(frozen=True, order=True)
 class WorkUnit:
-    """Scene ``scene``, keypoints ``[chunk * chunk_size, (chunk + 1) * chunk_size)`` (all when chunk_size is 0)."""
+    """Scene ``scene``, keypoints ``[chunk * chunk_size, (chunk + 1) * chunk_size)`` (all when chunk_size is 0);
+    its file goes to ``<output_dir>/<folder>`` (``shards``, or the hidden staging folder of a resumable
+    non-sharded run, :mod:`hybridgen.run.staged_output`)."""
 
     scene: int
     chunk: int = 0
     chunk_size: int = 0
+    folder: str = SHARD_FOLDER
 
     @property
     def name(self) -> str:
         return f"scene_{self.scene:06d}_chunk_{self.chunk:05d}"
 
     def shard_path(self, output_dir: str | Path, suffix: str = ".hdf5") -> Path:
-        """Where this unit's output goes: ``<output_dir>/shards/<name><suffix>``."""
-        return Path(output_dir) / SHARD_FOLDER / f"{self.name}{suffix}"
+        """Where this unit's output goes: ``<output_dir>/<folder>/<name><suffix>``."""
+        return Path(output_dir) / self.folder / f"{self.name}{suffix}"
 
     def keypoints(self, total: int) -> range:
         """The keypoint indices of the scene this unit renders."""

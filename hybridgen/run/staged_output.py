@@ -1,0 +1,160 @@
+"""Resumable non-sharded runs: keypoint chunks rendered as verified part files, merged into one ordinary file.
+
+A run of a config whose only writer is ``writer.Hdf5Writer`` (``layout: single``, one scene, no
+``keypoints_per_chunk``) renders its keypoints in parts of ``resume_chunk_keypoints`` into the hidden folder
+``<output_dir>/.<file_name>.parts/``: each part is a work unit of the sharded machinery
+(:mod:`hybridgen.run.runner`) - fingerprinted, sealed, renamed into place only when complete - so a killed
+run, rerun, reuses every part that verifies and renders only the rest.
+
+Each part records a *journal* (:data:`JOURNAL_ATTR`): the writer's options and the order of the calls the
+writer received (datasets, records and attributes of each renderer, then the scene records and run
+attributes). :func:`consolidate` replays those calls through the same
+:class:`~hybridgen.io.hdf5_single.Hdf5SingleFileWriter` over all keypoints, with each chunk's stored
+(compressed) bytes copied verbatim from its part (``read_direct_chunk`` / ``write_direct_chunk``: nothing
+is decompressed or encoded again). The result is the file an uninterrupted direct run writes, byte for
+byte, whether or not the run was interrupted; the staging folder is removed afterwards.
+"""
+from __future__ import annotations
+
+import json
+import shutil
+from concurrent.futures import Future
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+
+from ..errors import InputError
+from ..io.frame_sink import PassLayout
+from ..io.hdf5_single import Hdf5SingleFileWriter
+
+JOURNAL_ATTR = "staged_journal"
+UNIT_ATTRIBUTES = ("scene_index", "chunk_index", "scene_keypoints")
+DEFAULT_CHUNK_KEYPOINTS = 50
+
+
+def canonical(value: Any) -> str:
+    """An attribute value as text that is the same before it is stored and after h5py reads it back."""
+    return repr(np.asarray(value).tolist())
+
+
+def staging_folder_name(file_name: str) -> str:
+    """The hidden folder (inside ``output_dir``) holding the parts of ``file_name``."""
+    return f".{file_name}.parts"
+
+
+class JournalingWriter(Hdf5SingleFileWriter):
+    """An :class:`Hdf5SingleFileWriter` for one part that also stores how it was called (the journal)."""
+
+    def __init__(self, path: str | Path, **options: Any) -> None:
+        super().__init__(path, **options)
+        self._journal: dict[str, Any] = {"compression": self.compression, "compression_level": self.level,
+                                         "encoding": self.encoding, "begins": []}
+
+    def begin(self, n_keypoints: int, layouts: list[PassLayout], camera_records: dict[str, np.ndarray],
+              attributes: dict[str, Any]) -> None:
+        self._journal["begins"].append({
+            "layouts": [[lay.key, lay.dtype, list(lay.shape), list(lay.value_range) if lay.value_range else None]
+                        for lay in layouts],
+            "records": list(camera_records),
+            "attributes": {key: canonical(value) for key, value in attributes.items()}})
+        super().begin(n_keypoints, layouts, camera_records, attributes)
+
+    def finalize(self, records: dict[str, Any] | None = None, attributes: dict[str, Any] | None = None) -> Path:
+        self._journal["records"] = list(records or {})
+        self._journal["attributes"] = [key for key in (attributes or {}) if key not in UNIT_ATTRIBUTES]
+        return super().finalize(records, {**(attributes or {}), JOURNAL_ATTR: json.dumps(self._journal)})
+
+
+class _ReplayWriter(Hdf5SingleFileWriter):
+    """Stores chunks that are already encoded and compressed (copied from parts) in keypoint order."""
+
+    def write_stored(self, index: int, jobs: dict[str, Any]) -> None:
+        """Queue keypoint ``index``: per key the stored chunk bytes (None: no chunk) or a JSON value."""
+        self._raise_worker_error()
+        queued: dict[str, Any] = {}
+        for key, value in jobs.items():
+            if self._layouts[key].dtype == "json":
+                queued[key] = value
+            else:
+                done: Future = Future()
+                done.set_result(value)
+                queued[key] = done
+        self._queue.put((index, queued))
+
+
+def _layout(entry: list[Any]) -> PassLayout:
+    key, dtype, shape, value_range = entry
+    return PassLayout(key, dtype, tuple(shape), tuple(value_range) if value_range is not None else None)
+
+
+def _stored_chunk(dset: h5py.Dataset, local: int) -> bytes | None:
+    offset = (local,) + (0,) * (dset.ndim - 1)
+    if dset.id.get_chunk_info_by_coord(offset).byte_offset is None:
+        return None  # never written (a pass derived on read)
+    mask, data = dset.id.read_direct_chunk(offset)
+    if mask != 0:
+        raise InputError(f"'{dset.file.filename}': chunk {local} of '{dset.name}' has filter mask {mask}")
+    return data
+
+
+def _read_journal(part: h5py.File) -> dict[str, Any]:
+    text = part.attrs.get(JOURNAL_ATTR)
+    if text is None:
+        raise InputError(f"'{part.filename}' is not a part of a resumable run (no {JOURNAL_ATTR})")
+    return json.loads(text.decode() if isinstance(text, bytes) else str(text))
+
+
+def _text_value(value: Any) -> Any:
+    return json.loads(value.decode() if isinstance(value, bytes) else str(value))
+
+
+def consolidate(target: Path, parts: list[Path]) -> Path:
+    """Merge ``parts`` (one scene's chunks in keypoint order, verified) into ``target`` by replaying their
+    journal; returns ``target``. The file is written under a temporary name and renamed when complete."""
+    files = [h5py.File(path, "r") for path in parts]
+    writer: _ReplayWriter | None = None
+    try:
+        journal = _read_journal(files[0])
+        counts = [len(f["keypoint_index"]) for f in files]
+        keypoints = np.concatenate([f["keypoint_index"][()] for f in files])
+        if not np.array_equal(keypoints, np.arange(len(keypoints))):
+            raise InputError(f"the parts in '{parts[0].parent}' do not cover the keypoints in order; "
+                             "rerun with --restart")
+        writer = _ReplayWriter(target, compression=journal["compression"],
+                               compression_level=journal["compression_level"], encoding=journal["encoding"])
+        for begin in journal["begins"]:
+            layouts = [_layout(entry) for entry in begin["layouts"]]
+            records = {key: np.concatenate([f[key][()] for f in files]) for key in begin["records"]}
+            attributes = {key: files[0].attrs[key] for key in begin["attributes"]}
+            changed = [key for key, text in begin["attributes"].items() if canonical(attributes[key]) != text]
+            if changed:  # set twice with different values: the replay cannot know the first value
+                raise InputError(f"cannot merge the parts in '{parts[0].parent}': attribute(s) {changed} "
+                                 "were changed by a later renderer; use resume_chunk_keypoints: 0")
+            writer.begin(len(keypoints), layouts, records, attributes)
+            first = 0
+            for part, count in zip(files, counts):
+                dsets = {lay.key: part[lay.key] for lay in layouts}
+                for local in range(count):
+                    writer.write_stored(first + local, {
+                        key: _text_value(dset[local]) if lay.dtype == "json" else _stored_chunk(dset, local)
+                        for (key, dset), lay in zip(dsets.items(), layouts)})
+                first += count
+            writer.end()
+        records = {key: _text_value(files[0][key][()]) for key in journal["records"]}
+        attributes = {key: files[0].attrs[key] for key in journal["attributes"]}
+        path = writer.finalize(records, attributes)
+        writer = None
+        return path
+    finally:
+        if writer is not None:
+            writer.abort()
+        for f in files:
+            f.close()
+
+
+def remove_staging(folder: Path) -> None:
+    """Delete the staging folder once its parts are merged (also temporary files of killed attempts)."""
+    if folder.is_dir() and not folder.is_symlink():
+        shutil.rmtree(folder)
