@@ -48,11 +48,14 @@ class Hdf5Writer(Module):
               "dtypes as they are); the blenderproc layout always stores BlenderProc's encodings"),
         Param("compression_level", "int", 1, doc="gzip level 0..9 (1: twice as fast as 4, files ~10 % larger)",
               check=lambda v: None if 0 <= v <= 9 else f"must be in 0..9, got {v}"),
-        Param("resume_chunk_keypoints", "int", DEFAULT_CHUNK_KEYPOINTS,
+        Param("resume_chunk_keypoints", "int", -1,
               doc="single layout, run without sharding as the only writer: render this many keypoints per "
               "verified part in the hidden folder .<file_name>.parts, merged at the end into the same bytes a "
-              "direct write gives, so a killed run resumes (0: write directly, a killed run starts over)",
-              check=lambda v: None if v >= 0 else f"must be >= 0, got {v}"),
+              "direct write gives, so a killed run resumes; every part rebuilds the scene. 0: write directly "
+              f"(a killed run starts over); -1: {DEFAULT_CHUNK_KEYPOINTS} when the config path-traces color "
+              "(renderer.RgbRenderer), else 0 (label-only runs are fast and camera sampling would be redone "
+              "per part)",
+              check=lambda v: None if v >= -1 else f"must be >= -1, got {v}"),
     )
 
     def prepare(self, context: RunContext) -> None:

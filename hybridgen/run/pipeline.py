@@ -138,15 +138,20 @@ def single_file_output(modules: list[Module]) -> Path | None:
 
 def staged_plan(modules: list[Module]) -> ShardingPlan | None:
     """The plan of a non-sharded run that renders in resumable parts (:mod:`hybridgen.run.staged_output`):
-    its only writer is ``writer.Hdf5Writer`` (``layout: single``) with ``resume_chunk_keypoints`` > 0."""
-    from .staged_output import staging_folder_name
+    its only writer is ``writer.Hdf5Writer`` (``layout: single``) with ``resume_chunk_keypoints`` > 0 (-1:
+    :data:`~hybridgen.run.staged_output.DEFAULT_CHUNK_KEYPOINTS` when it path-traces color)."""
+    from .staged_output import DEFAULT_CHUNK_KEYPOINTS, staging_folder_name
 
     single = single_file_output(modules)
     writer = next((m for m in modules if m.module_name == "writer.Hdf5Writer"), None)
-    if single is None or writer is None or writer.config["resume_chunk_keypoints"] <= 0:
+    if single is None or writer is None:
         return None
-    return ShardingPlan(1, writer.config["resume_chunk_keypoints"], single.parent, single.name,
-                        folder=staging_folder_name(single.name), staged=True)
+    chunk = writer.config["resume_chunk_keypoints"]
+    if chunk < 0:
+        chunk = DEFAULT_CHUNK_KEYPOINTS if any(m.module_name == "renderer.RgbRenderer" for m in modules) else 0
+    if chunk == 0:
+        return None
+    return ShardingPlan(1, chunk, single.parent, single.name, folder=staging_folder_name(single.name), staged=True)
 
 
 def run_config(path: str | Path, args: Sequence[str] = (), *, env: Mapping[str, str] | None = None,

@@ -4,7 +4,10 @@ A run of a config whose only writer is ``writer.Hdf5Writer`` (``layout: single``
 ``keypoints_per_chunk``) renders its keypoints in parts of ``resume_chunk_keypoints`` into the hidden folder
 ``<output_dir>/.<file_name>.parts/``: each part is a work unit of the sharded machinery
 (:mod:`hybridgen.run.runner`) - fingerprinted, sealed, renamed into place only when complete - so a killed
-run, rerun, reuses every part that verifies and renders only the rest.
+run, rerun, reuses every part that verifies and renders only the rest. Every part rebuilds the scene (camera
+sampling included), which costs little beside path tracing but a lot beside fast label rasterizing: the
+default (``-1``) stages runs that path-trace color (parts of :data:`DEFAULT_CHUNK_KEYPOINTS`) and writes
+label-only runs directly.
 
 Each part records a *journal* (:data:`JOURNAL_ATTR`): the writer's options and the order of the calls the
 writer received (datasets, records and attributes of each renderer, then the scene records and run
@@ -110,48 +113,58 @@ def _text_value(value: Any) -> Any:
     return json.loads(value.decode() if isinstance(value, bytes) else str(value))
 
 
+def _read_all(parts: list[Path], key: str) -> np.ndarray:
+    arrays = []
+    for path in parts:
+        with h5py.File(path, "r") as part:
+            arrays.append(part[key][()])
+    return np.concatenate(arrays)
+
+
+def _replay_keypoints(writer: _ReplayWriter, part: h5py.File, first: int, layouts: list[PassLayout]) -> int:
+    """Queue every keypoint of ``part`` (stored chunks, JSON values) as keypoints ``first...``; their count."""
+    dsets = [(layout, part[layout.key]) for layout in layouts]
+    count = len(part["keypoint_index"])
+    for local in range(count):
+        writer.write_stored(first + local, {
+            layout.key: _text_value(dset[local]) if layout.dtype == "json" else _stored_chunk(dset, local)
+            for layout, dset in dsets})
+    return count
+
+
 def consolidate(target: Path, parts: list[Path]) -> Path:
     """Merge ``parts`` (one scene's chunks in keypoint order, verified) into ``target`` by replaying their
-    journal; returns ``target``. The file is written under a temporary name and renamed when complete."""
-    files = [h5py.File(path, "r") for path in parts]
-    writer: _ReplayWriter | None = None
+    journal; returns ``target``. One part is open at a time; the file is written under a temporary name and
+    renamed when complete."""
+    keypoints = _read_all(parts, "keypoint_index")
+    if not np.array_equal(keypoints, np.arange(len(keypoints))):
+        raise InputError(f"the parts in '{parts[0].parent}' do not cover the keypoints in order; "
+                         "rerun with --restart")
+    with h5py.File(parts[0], "r") as first_part:
+        journal = _read_journal(first_part)
+        run_attributes = dict(first_part.attrs)
+        scene_records = {key: _text_value(first_part[key][()]) for key in journal["records"]}
+    writer = _ReplayWriter(target, compression=journal["compression"],
+                           compression_level=journal["compression_level"], encoding=journal["encoding"])
     try:
-        journal = _read_journal(files[0])
-        counts = [len(f["keypoint_index"]) for f in files]
-        keypoints = np.concatenate([f["keypoint_index"][()] for f in files])
-        if not np.array_equal(keypoints, np.arange(len(keypoints))):
-            raise InputError(f"the parts in '{parts[0].parent}' do not cover the keypoints in order; "
-                             "rerun with --restart")
-        writer = _ReplayWriter(target, compression=journal["compression"],
-                               compression_level=journal["compression_level"], encoding=journal["encoding"])
         for begin in journal["begins"]:
             layouts = [_layout(entry) for entry in begin["layouts"]]
-            records = {key: np.concatenate([f[key][()] for f in files]) for key in begin["records"]}
-            attributes = {key: files[0].attrs[key] for key in begin["attributes"]}
+            attributes = {key: run_attributes[key] for key in begin["attributes"]}
             changed = [key for key, text in begin["attributes"].items() if canonical(attributes[key]) != text]
             if changed:  # set twice with different values: the replay cannot know the first value
                 raise InputError(f"cannot merge the parts in '{parts[0].parent}': attribute(s) {changed} "
                                  "were changed by a later renderer; use resume_chunk_keypoints: 0")
-            writer.begin(len(keypoints), layouts, records, attributes)
+            writer.begin(len(keypoints), layouts, {key: _read_all(parts, key) for key in begin["records"]},
+                         attributes)
             first = 0
-            for part, count in zip(files, counts):
-                dsets = {lay.key: part[lay.key] for lay in layouts}
-                for local in range(count):
-                    writer.write_stored(first + local, {
-                        key: _text_value(dset[local]) if lay.dtype == "json" else _stored_chunk(dset, local)
-                        for (key, dset), lay in zip(dsets.items(), layouts)})
-                first += count
+            for path in parts:
+                with h5py.File(path, "r") as part:
+                    first += _replay_keypoints(writer, part, first, layouts)
             writer.end()
-        records = {key: _text_value(files[0][key][()]) for key in journal["records"]}
-        attributes = {key: files[0].attrs[key] for key in journal["attributes"]}
-        path = writer.finalize(records, attributes)
-        writer = None
-        return path
-    finally:
-        if writer is not None:
-            writer.abort()
-        for f in files:
-            f.close()
+        return writer.finalize(scene_records, {key: run_attributes[key] for key in journal["attributes"]})
+    except BaseException:
+        writer.abort()
+        raise
 
 
 def remove_staging(folder: Path) -> None:

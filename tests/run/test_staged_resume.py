@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from hybridgen.io.integrity import verify
-from hybridgen.run.staged_output import JOURNAL_ATTR, staging_folder_name
+from hybridgen.run.staged_output import DEFAULT_CHUNK_KEYPOINTS, JOURNAL_ATTR, staging_folder_name
 from tests.conftest import REPO
 from tests.run.test_resume_integrity import SINGLE
 
@@ -159,3 +159,18 @@ def test_parts_of_another_config_are_refused(reference, write_config, run_cli):
     assert (out / "data.hdf5").read_bytes() != data
     code, _, err = run_cli("run", "-q", str(config), str(out), "--restart")
     assert code == 0 and (out / "data.hdf5").read_bytes() == data
+
+
+@pytest.mark.parametrize(("renderers", "setting", "expected"), [
+    ("labels", "", None), ("color", "", DEFAULT_CHUNK_KEYPOINTS), ("color", "0", None), ("labels", "7", 7)])
+def test_which_runs_are_staged_by_default(tmp_path, write_config, renderers, setting, expected):
+    from hybridgen.config.config_file import load_config
+    from hybridgen.run.pipeline import build_modules, staged_plan
+
+    text = (COLOR if renderers == "color" else CONFIG).replace("SEED", "1")
+    text = text.replace("{resume_chunk_keypoints: 2}", f"{{resume_chunk_keypoints: {setting}}}" if setting else "{}")
+    config = load_config(str(write_config(text)), [str(tmp_path / "out")])
+    plan = staged_plan(build_modules(config))
+    assert (plan.chunk_size if plan else None) == expected
+    if plan is not None:
+        assert plan.staged and plan.folder == ".data.hdf5.parts" and plan.scenes == 1
