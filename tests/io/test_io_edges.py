@@ -66,3 +66,21 @@ def test_box_of_an_empty_mask_is_the_toolkits_no_box():
     mask = np.zeros((4, 5), bool)
     mask[1:3, 2:5] = True
     assert bbox_of(mask) == [2, 1, 3, 2]
+
+
+def test_contact_sheet_legend_bar_ends_and_id_swatches():
+    """The scale bar runs from the colormap's first entry (left) to its last (right), matplotlib's viridis
+    ends written out; each id swatch is a 10 px square on its 12 px row, with the gap below it left dark."""
+    from hybridgen.io.preview import Legend
+    from hybridgen.io.visualize import _id_rows, _scale_bar
+
+    bar = np.asarray(_scale_bar(Legend("depth", 0.0, 5.0, "m"), 100))
+    np.testing.assert_array_equal(bar[2, 0], [68, 1, 84])      # viridis(0.0)
+    np.testing.assert_array_equal(bar[2, -1], [253, 231, 36])  # viridis(1.0)
+    colors = [(255, 0, 0), (0, 255, 0), (0, 0, 255)]
+    rows = np.asarray(_id_rows(Legend("ids", entries=[(i + 1, c, f"o{i}") for i, c in enumerate(colors)]), 120))
+    assert rows.shape[0] == 12 * 3 + 2
+    for i, color in enumerate(colors):
+        top = 1 + 12 * i
+        np.testing.assert_array_equal(rows[top + 5, 6], color)          # inside the swatch
+        np.testing.assert_array_equal(rows[top + 11:top + 13, 6], 0)  # the gap under it
