@@ -199,7 +199,8 @@ def run_config(path: str | Path, args: Sequence[str] = (), *, env: Mapping[str, 
         staged = staged_plan(modules)
         if staged is not None:  # rendered in verified parts, merged into the same bytes: a killed run resumes
             return run_sharded(staged, path, args, env, workers=1, shard=None, executor="pool", address=None,
-                               log=say, start=start, policy=policy, max_tasks_per_child=max_tasks_per_child)
+                               log=say, start=start, policy=policy, max_tasks_per_child=max_tasks_per_child,
+                               progress=progress)
         context = execute(config, modules, progress=progress, log=log,
                           attributes={FINGERPRINT_ATTR: policy.fingerprint_text})
     return RunSummary(context.frames_rendered, time.perf_counter() - start, context.outputs)

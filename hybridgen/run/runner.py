@@ -111,15 +111,16 @@ def _apply_thread_limit() -> None:
 
 
 def run_unit(path: str, args: Sequence[str], env: Mapping[str, str] | None, unit: WorkUnit,
-             fingerprint: str | None = None) -> tuple[int, int]:
+             fingerprint: str | None = None, progress: Callable[[int, str], Any] | None = None) -> tuple[int, int]:
     """Run one unit (in whatever process this is); returns (keypoints rendered, keypoints of its scene).
-    ``fingerprint`` (the parent's, JSON) is recorded in the unit's file."""
+    ``fingerprint`` (the parent's, JSON) is recorded in the unit's file; ``progress`` makes progress bars
+    (units run in this process)."""
     from .pipeline import build_modules, execute
 
     _apply_thread_limit()
     config = load_config(path, args, env)
     attributes = {FINGERPRINT_ATTR: fingerprint} if fingerprint is not None else None
-    context = execute(config, build_modules(config), unit=unit, attributes=attributes)
+    context = execute(config, build_modules(config), unit=unit, attributes=attributes, progress=progress)
     return context.frames_rendered, len(context.scene.camera)
 
 
@@ -268,8 +269,10 @@ def _scene_units(plan: ShardingPlan, index: int, count: int) -> Iterator[WorkUni
 def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: Mapping[str, str] | None, *,
                 workers: int, shard: tuple[int, int] | None, executor: str, address: str | None,
                 log: Callable[[str], None], start: float, policy: ResumePolicy,
-                max_tasks_per_child: int = DEFAULT_MAX_TASKS_PER_CHILD) -> Any:
-    """Execute the plan's missing units, then build the index when all exist. Returns a RunSummary."""
+                max_tasks_per_child: int = DEFAULT_MAX_TASKS_PER_CHILD,
+                progress: Callable[[int, str], Any] | None = None) -> Any:
+    """Execute the plan's missing units, then build the index (or merge a staged plan's parts) when all
+    exist. ``progress`` makes progress bars of units run in this process. Returns a RunSummary."""
     from .pipeline import RunSummary
 
     if executor not in EXECUTORS:
@@ -290,7 +293,7 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
     if executor == "ray":
         pool: Any = _Ray(call, address, workers)
     elif workers == 1:
-        pool = _Local(lambda unit: run_unit(*call[:3], unit, call[3]))
+        pool = _Local(lambda unit: run_unit(*call[:3], unit, call[3], progress))
     else:
         pool = _Pool(call, workers, max_tasks_per_child)
     scene_units = _scene_units(plan, index, count)

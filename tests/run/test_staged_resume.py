@@ -39,10 +39,10 @@ KILLER = textwrap.dedent("""
     from hybridgen.run import runner
     chunk, at = int(sys.argv[1]), int(sys.argv[2])
     run_unit, write = runner.run_unit, hdf5_single.Hdf5SingleFileWriter.write
-    def unit(path, args, env, u, fingerprint=None):
-        if u.chunk == chunk and at < 0:
+    def unit(*call):
+        if call[3].chunk == chunk and at < 0:
             os.kill(os.getpid(), signal.SIGKILL)
-        return run_unit(path, args, env, u, fingerprint)
+        return run_unit(*call)
     def killing_write(self, index, values):
         if f"chunk_{chunk:05d}" in self.path.name and index == at:
             os.kill(os.getpid(), signal.SIGKILL)
