@@ -3,9 +3,9 @@
 :func:`seal` stores the digest as the ``content_sha256`` attribute just before a file is committed;
 :func:`verify` recomputes it. The digest covers each dataset's name, dtype, shape and stored bytes - the
 *compressed* chunks as they lie on disk for chunked datasets (read with ``read_direct_chunk``, nothing is
-decompressed, so checking costs one read of the file), the values for contiguous ones - and every
-attribute except the digest itself. A flipped bit in any chunk, a truncated file or a changed attribute
-fails the check; a damaged file header fails to open. Virtual datasets are skipped (an index checks its
+decompressed, so checking costs one read of the file), the values for contiguous ones - each dataset's
+attributes (they say how a pass is encoded) and every file attribute except the digest itself. A flipped
+bit in any chunk, a truncated file or a changed attribute fails the check; a damaged file header fails to open. Virtual datasets are skipped (an index checks its
 sources with :func:`hybridgen.run.shard_index.check_index_sources`).
 """
 from __future__ import annotations
@@ -30,8 +30,16 @@ def _update_value(digest: "hashlib._Hash", value: Any) -> None:
         digest.update(np.ascontiguousarray(array).tobytes())
 
 
+def _update_attributes(digest: "hashlib._Hash", attrs: h5py.AttributeManager, prefix: str) -> None:
+    for key in sorted(attrs):
+        if key != DIGEST_ATTR:
+            digest.update(f"\0{prefix}@{key}\0".encode())
+            _update_value(digest, attrs[key])
+
+
 def _update_dataset(digest: "hashlib._Hash", name: str, dset: h5py.Dataset) -> None:
     digest.update(f"\0{name}\0{dset.dtype}\0{dset.shape}\0".encode())
+    _update_attributes(digest, dset.attrs, name)
     if dset.chunks is None:
         _update_value(digest, dset[()])
         return
@@ -56,10 +64,7 @@ def content_digest(h5: h5py.File) -> str:
         if dset.is_virtual:
             continue
         _update_dataset(digest, name, dset)
-    for key in sorted(h5.attrs):
-        if key != DIGEST_ATTR:
-            digest.update(f"\0@{key}\0".encode())
-            _update_value(digest, h5.attrs[key])
+    _update_attributes(digest, h5.attrs, "")
     return digest.hexdigest()
 
 

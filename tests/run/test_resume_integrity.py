@@ -107,7 +107,17 @@ def _flip_bit_in_cam2world(path: Path) -> None:
     path.write_bytes(bytes(data))
 
 
-@pytest.mark.parametrize("damage", ["depth_bit", "cam2world_bit", "truncate", "empty", "delete", "garbage"])
+def _edit_dataset_attribute(path: Path) -> None:
+    """Change one attribute of a stored pass (an encoding attribute says how its bytes decode)."""
+    with h5py.File(path, "r+") as h5:
+        key = next(k for k in sorted(h5) if isinstance(h5[k], h5py.Dataset) and len(h5[k].attrs))
+        name = sorted(h5[key].attrs)[0]
+        value = h5[key].attrs[name]
+        h5[key].attrs[name] = value + 1 if isinstance(value, (int, float, np.number)) else f"{value}x"
+
+
+@pytest.mark.parametrize("damage", ["depth_bit", "cam2world_bit", "dataset_attribute", "truncate", "empty", "delete",
+                                    "garbage"])
 def test_damaged_or_missing_shard_is_detected_and_rendered_again(reference, run_cli, damage):
     config, out, digests = reference
     shard = out / "shards/scene_000001_chunk_00000.hdf5"
@@ -115,6 +125,8 @@ def test_damaged_or_missing_shard_is_detected_and_rendered_again(reference, run_
         _flip_bit_in_depth(shard)
     elif damage == "cam2world_bit":
         _flip_bit_in_cam2world(shard)
+    elif damage == "dataset_attribute":
+        _edit_dataset_attribute(shard)
     elif damage == "truncate":
         shard.write_bytes(shard.read_bytes()[: shard.stat().st_size // 2])
     elif damage == "empty":
