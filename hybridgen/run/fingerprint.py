@@ -7,10 +7,11 @@ writes. Its keys are
 - ``config:<module>#<index>.<key path>`` for every leaf of the resolved config (after ``<args:N>`` and
   environment substitution). Keys named ``output_dir`` are left out: where a run writes does not change
   what it writes, so a moved output folder still resumes;
-- ``input:<path>`` -> SHA-256 of each file the config names (a string value that is an existing file, or
-  a glob that matches files, or the files directly in a named folder; relative to the working directory,
+- ``input:<path>`` -> SHA-256 of each file the config names: a string value that is an existing file, a
+  glob that matches files, or the files directly in a named folder (relative to the working directory,
   else to the config's folder, as modules read them), plus the MTL files an OBJ names and the texture
-  files an MTL names.
+  files an MTL names. ``<path>`` is relative to the config's folder when the file lies below it, so a
+  moved checkout gives the same fingerprint.
 
 :func:`differing_keys` names what changed between two fingerprints, so a refused resume says which
 config keys or input files differ.
@@ -76,6 +77,15 @@ def _candidate_files(text: str, folder: Path) -> list[Path]:
     return []
 
 
+def _input_key(path: Path, folder: Path) -> str:
+    """``path`` relative to the config's folder when it lies below it (so a moved checkout or dataset
+    folder gives the same fingerprint, and the same bytes), else as the config names it."""
+    try:
+        return str(path.resolve().relative_to(folder))
+    except (OSError, ValueError):
+        return str(path)
+
+
 def input_files(config: ConfigFile) -> list[Path]:
     """Every input file the config names (and the MTL / texture files those name), each once, in order."""
     seen: dict[str, Path] = {}
@@ -111,9 +121,10 @@ def run_fingerprint(config: ConfigFile) -> dict[str, str]:
     fingerprint = {"hybridgen_version": __version__}
     for key, value in _config_leaves(config):
         fingerprint[f"config:{key}"] = _leaf_text(value)
+    folder = Path(config.path).resolve().parent
     for path in input_files(config):
         try:
-            fingerprint[f"input:{path}"] = file_sha256(path)
+            fingerprint[f"input:{_input_key(path, folder)}"] = file_sha256(path)
         except OSError:
             continue  # the module that reads it reports the problem
     return fingerprint
