@@ -29,7 +29,7 @@ from ..errors import ConfigError, InputError
 from ..io.bounded_read import MAX_POSE_FILE_BYTES, read_bounded_text
 from ..scene.camera import Intrinsics
 from ..scene.frames import BLENDER_TO_OPENCV, euler_xyz_to_matrix, forward_to_rotation_blender, look_at_blender, \
-    make_pose
+    make_pose, source_frame_matrix
 from .schema import closest
 
 ROTATION_FORMATS = ("euler", "look_at", "forward_vec")
@@ -39,7 +39,6 @@ BLENDER_FRAME = ("X", "Y", "Z")
 """BlenderProc's default ``source_frame``: the numbers are Blender's own axes."""
 OPENCV_FRAME = ("X", "-Y", "-Z")
 """``source_frame`` of an OpenCV camera (x right, y down, z forward) in Blender camera axes."""
-_AXES = {"X": 0, "Y": 1, "Z": 2}
 
 
 def source_frame_axes(frame: Any, key: str = "source_frame") -> np.ndarray:
@@ -51,16 +50,10 @@ def source_frame_axes(frame: Any, key: str = "source_frame") -> np.ndarray:
     """
     if not isinstance(frame, (list, tuple)) or len(frame) != 3:
         raise ConfigError(f"needs 3 axes like [X, -Y, -Z], got {frame!r}", key=key)
-    rows = np.zeros((3, 3))
-    for i, axis in enumerate(frame):
-        text = str(axis).strip().upper()
-        name = text.lstrip("+-")
-        if name not in _AXES:
-            raise ConfigError(f"axis {axis!r} is not one of X, Y, Z, -X, -Y, -Z", key=key)
-        rows[i, _AXES[name]] = -1.0 if text.startswith("-") else 1.0
-    if abs(abs(np.linalg.det(rows)) - 1.0) > 1e-9:
-        raise ConfigError(f"axes {list(frame)} repeat an axis", key=key)
-    return rows
+    try:
+        return source_frame_matrix(frame)[:3, :3]
+    except ValueError as exc:
+        raise ConfigError(str(exc), key=key) from None
 
 
 def _numbers(value: Any, count: int, key: str) -> np.ndarray:

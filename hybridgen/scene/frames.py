@@ -34,7 +34,8 @@ def source_frame_matrix(axes: Sequence[str]) -> np.ndarray:
     orthonormal). For the two frames configs use the matrix is its own inverse:
     ``source_frame_matrix(["X", "-Y", "-Z"]) == BLENDER_TO_OPENCV``, so
     ``cam2world_opencv = cam2world_blender @ source_frame_matrix(["X", "-Y", "-Z"])``. What a config's
-    ``source_frame`` means (BlenderProc's meaning) is applied by :mod:`hybridgen.config.camera_poses`.
+    ``source_frame`` means (BlenderProc's meaning) is applied by :mod:`hybridgen.config.camera_poses`,
+    which reads a config's axes through this function.
     """
     if len(axes) != 3:
         raise ValueError(f"source_frame needs 3 axes like [X, -Y, -Z], got {list(axes)}")
@@ -48,7 +49,7 @@ def source_frame_matrix(axes: Sequence[str]) -> np.ndarray:
         rows.append(sign * _AXIS_VECTORS[name])
     # source axis i expressed in OpenCV camera coordinates = rows[i]; the matrix S maps cv -> source
     # coordinates, i.e. p_src = S p_cv with S[i] = rows[i] (rows are orthonormal).
-    rot = np.array(rows)
+    rot = np.array(rows) + 0.0  # no -0.0 entries: products with the matrix keep the bytes of plain zeros
     if abs(abs(np.linalg.det(rot)) - 1.0) > 1e-9:
         raise ValueError(f"source_frame axes {list(axes)} repeat an axis")
     out = np.eye(4)
