@@ -6,10 +6,9 @@ by a rotation of pi about the camera x axis: ``cam2world_cv = cam2world_blender 
 """
 from __future__ import annotations
 
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 BLENDER_TO_OPENCV = np.diag([1.0, -1.0, -1.0, 1.0])
 """Right-multiplying a Blender-axes cam2world by this gives the OpenCV-axes cam2world (it is its own inverse)."""
@@ -57,6 +56,14 @@ def source_frame_matrix(axes: Sequence[str]) -> np.ndarray:
     return out
 
 
+def _rotation() -> Any:
+    """SciPy's ``Rotation``, imported on first use (``scipy.spatial`` costs ~0.17 s of start-up that a
+    labels-only run with no Euler angles need not pay)."""
+    from scipy.spatial.transform import Rotation
+
+    return Rotation
+
+
 def euler_xyz_to_matrix(angles: Sequence[float]) -> np.ndarray:
     """3x3 rotation from Blender ``XYZ`` Euler angles in radians: ``R = Rz(c) @ Ry(b) @ Rx(a)``.
 
@@ -66,18 +73,18 @@ def euler_xyz_to_matrix(angles: Sequence[float]) -> np.ndarray:
     values = np.asarray(angles, dtype=np.float64).ravel()
     if values.size != 3:
         raise ValueError(f"Euler XYZ rotation needs 3 angles, got {list(values)}")
-    return Rotation.from_euler("xyz", values).as_matrix()
+    return _rotation().from_euler("xyz", values).as_matrix()
 
 
 def matrix_to_euler_xyz(rotation: np.ndarray) -> np.ndarray:
     """Blender ``XYZ`` Euler angles (radians) of a 3x3 rotation; the inverse of :func:`euler_xyz_to_matrix`."""
-    return Rotation.from_matrix(np.asarray(rotation, dtype=np.float64)).as_euler("xyz")
+    return _rotation().from_matrix(np.asarray(rotation, dtype=np.float64)).as_euler("xyz")
 
 
 def rotation_about_axis(axis: np.ndarray, angle: float) -> np.ndarray:
     """3x3 rotation of ``angle`` radians about ``axis`` (right-hand rule; any non-zero length)."""
     axis = np.asarray(axis, dtype=np.float64)
-    return Rotation.from_rotvec(axis / np.linalg.norm(axis) * float(angle)).as_matrix()
+    return _rotation().from_rotvec(axis / np.linalg.norm(axis) * float(angle)).as_matrix()
 
 
 def forward_to_rotation_blender(forward: Sequence[float], inplane_rot: float = 0.0) -> np.ndarray:
