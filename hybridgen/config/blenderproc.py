@@ -325,20 +325,28 @@ def _shading(cfg: dict[str, Any], note: Note) -> None:
     _pop(cfg, "cf_shading_auto_smooth_angle_in_deg", note, "Blender's auto-smooth angle")
 
 
-_OUTPUT_KEYS = {"output_key": None, "distance_output_key": "distance", "depth_output_key": "depth",
-                "normals_output_key": "normals", "diffuse_color_output_key": "albedo",
+_OUTPUT_KEYS = {"output_key": None, "segmap_output_key": None, "distance_output_key": "distance",
+                "depth_output_key": "depth", "normals_output_key": "normals", "diffuse_color_output_key": "albedo",
                 "segcolormap_output_key": "instance_attribute_maps",
                 "forward_flow_output_key": "forward_flow", "backward_flow_output_key": "backward_flow"}
 
 
 def _output_keys(cfg: dict[str, Any], note: Note, default: str | None) -> None:
+    """BlenderProc's ``output_key`` (the renderer's main pass, ``default``) and ``*_output_key`` become
+    hybridgen's ``output_keys`` {pass: stored name}: the dataset is stored under BlenderProc's name."""
+    names = dict(cfg.get("output_keys") or {})
     for key, own in _OUTPUT_KEYS.items():
         if key not in cfg:
             continue
         value = cfg.pop(key)
         name = default if key == "output_key" else own
-        if name is not None and value != name:
-            note(f"hybridgen writes this pass as '{name}', not '{value}' (datasets keep hybridgen's names)", key)
+        if name is None:
+            note(f"BlenderProc's '{value}' has no single hybridgen dataset (segmentation is stored per "
+                 "attribute as '<attr>_segmaps'); those keep hybridgen's names", key)
+        elif value != name:
+            names[name] = str(value)
+    if names:
+        cfg["output_keys"] = names
 
 
 def _renderer_common(cfg: dict[str, Any], note: Note) -> None:
@@ -459,10 +467,13 @@ def _writer(kind: str) -> Callable[[dict[str, Any], Note, dict[str, Any]], list[
                 cfg["annotation_unit"] = "mm" if cfg.pop("m2mm") else "m"
             if state.get("blenderproc") and "output_dir" not in cfg:
                 state.setdefault("subdirs", {})[id(cfg)] = "bop_data"
-        if kind == "writer.CocoAnnotationsWriter" and state.get("blenderproc") and "output_dir" not in cfg:
-            state.setdefault("subdirs", {})[id(cfg)] = "coco_data"
-            note("COCO images are written as images/<id>.png next to coco_annotations.json (BlenderProc: "
-                 "rgb_<id>.png)", "output_dir")
+        if kind == "writer.CocoAnnotationsWriter" and state.get("blenderproc"):
+            if "output_dir" not in cfg:
+                state.setdefault("subdirs", {})[id(cfg)] = "coco_data"
+            cfg.setdefault("image_names", "blenderproc")  # rgb_%04d.png next to the JSON, as BlenderProc
+            if cfg.pop("segmap_output_key", "segmap") != "segmap":
+                note("hybridgen's COCO writer reads the renderer's instance_segmaps (segmentation is stored per "
+                     "attribute, not as one BlenderProc segmap)", "segmap_output_key")
         return [(kind, cfg)]
 
     return translate
@@ -676,6 +687,16 @@ def _as_list(value: Any) -> list[Any]:
     return [] if value is None else [value] if isinstance(value, str) else list(value)
 
 
+def _coco_reads_renamed(coco: dict[str, Any], renderers: list[dict[str, Any]]) -> None:
+    """A COCO writer whose keys are not given (or BlenderProc's defaults) reads the passes under the names the
+    renderers before it store them (their ``output_keys``)."""
+    stored = {own: name for r in renderers for own, name in (r.get("output_keys") or {}).items()}
+    for key, own, blenderproc_default in (("rgb_output_key", "colors", "colors"),
+                                          ("segcolormap_output_key", "instance_attribute_maps", "segcolormap")):
+        if coco.get(key, blenderproc_default) == blenderproc_default:
+            coco[key] = stored.get(own, own)
+
+
 def finish(entries: list[Any], state: dict[str, Any], output_dir: Any) -> None:
     """Cross-module effects: Dist2Depth renders depth where distance was rendered; writers' BlenderProc folders."""
     if not state.get("blenderproc"):
@@ -694,6 +715,8 @@ def finish(entries: list[Any], state: dict[str, Any], output_dir: Any) -> None:
         if not renderers:
             continue
         last = renderers[-1].config
+        if entry.name == "writer.CocoAnnotationsWriter":
+            _coco_reads_renamed(entry.config, [e.config for e in renderers])
         if not any("instance" in _as_list(e.config.get("map_by")) for e in renderers):
             last["map_by"] = [*_as_list(last.get("map_by")), "instance"]
         if entry.name == "writer.BopWriter" and not any(e.config.get("render_depth") for e in renderers):

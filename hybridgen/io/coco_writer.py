@@ -1,6 +1,8 @@
 """COCO instance annotations (BlenderProc's ``CocoAnnotationsWriter``): ``images/`` plus ``coco_annotations.json``.
 
-Per keypoint one image ``images/<prefix><image id, 6 digits>.png`` (or ``.jpg``) of the chosen key
+Per keypoint one image ``images/<prefix><image id, 6 digits>.png`` (or ``.jpg``; with ``image_names=
+"blenderproc"`` BlenderProc's ``rgb_<image id, 4 digits>.png`` next to the JSON, whose ``file_name`` is
+``<folder name>/rgb_0000.png`` as BlenderProc writes it) of the chosen key
 (``colors`` by default) and one annotation per visible instance with a non-zero ``category_id``:
 ``segmentation`` (compressed RLE via pycocotools, or exact pixel-outline polygons), ``bbox`` ``[x, y, w, h]``
 (pixel indices, w/h in pixels), ``area`` (pixels), ``iscrowd`` 0. Masks are the exact instance map
@@ -34,6 +36,8 @@ from .mask_encoding import bbox_of, mask_to_polygons, require_pycocotools, rle_c
 ANNOTATIONS_FILE = "coco_annotations.json"
 MASK_ENCODINGS = ("rle", "polygon")
 COLOR_FORMATS = ("PNG", "JPEG")
+IMAGE_NAMES = ("hybridgen", "blenderproc")
+"""hybridgen: images/<prefix><id:06d>; blenderproc: rgb_<id:04d> next to coco_annotations.json."""
 DEFAULT_SUPERCATEGORY = "coco_annotations"
 
 NEEDED_KEYS = {
@@ -111,7 +115,9 @@ class CocoWriter:
     def __init__(self, output_dir: str | Path, *, image_key: str = "colors", mask_encoding: str = "rle",
                  color_file_format: str = "PNG", jpg_quality: int = 95,
                  supercategory: str = DEFAULT_SUPERCATEGORY, label_mapping: Mapping[int, str] | None = None,
-                 append: bool = False, file_prefix: str = "") -> None:
+                 append: bool = False, file_prefix: str = "", image_names: str = "hybridgen") -> None:
+        if image_names not in IMAGE_NAMES:
+            raise InputError(f"image_names must be one of {IMAGE_NAMES}, got {image_names!r}")
         if mask_encoding not in MASK_ENCODINGS:
             raise InputError(f"mask encoding must be one of {MASK_ENCODINGS}, got {mask_encoding!r}")
         if color_file_format not in COLOR_FORMATS:
@@ -142,7 +148,8 @@ class CocoWriter:
         self.categories: dict[int, dict[str, Any]] = {}
         self._pending: dict[int, dict[str, Any]] = {}
         self._staged = StagedFiles()
-        self._image_dir = self.output_dir / "images"
+        self.blenderproc_names = image_names == "blenderproc"
+        self._image_dir = self.output_dir if self.blenderproc_names else self.output_dir / "images"
 
     # ------------------------------------------------------------------ FrameSink
     def begin(self, n_keypoints: int, layouts: list[PassLayout], camera_records: dict[str, np.ndarray],
@@ -208,11 +215,16 @@ class CocoWriter:
 
     def _write_image(self, index: int, image: np.ndarray) -> None:
         self._staged.make_dir(self._image_dir)
-        name = f"{self.file_prefix}{self.image_id(index):06d}{self.extension}"
+        if self.blenderproc_names:  # BlenderProc: rgb_%04d, file_name relative to the folder above the JSON's
+            name = f"{self.file_prefix}rgb_{self.image_id(index):04d}{self.extension}"
+            file_name = f"{self.output_dir.name}/{name}"
+        else:
+            name = f"{self.file_prefix}{self.image_id(index):06d}{self.extension}"
+            file_name = f"images/{name}"
         rgb = image if image.ndim == 3 else np.repeat(image[..., None], 3, axis=2)
         data = png_bytes(image) if self.extension == ".png" else jpeg_bytes(rgb[..., :3], self.jpg_quality)
         self._staged.add(self._image_dir / name, data)
-        self.images[index] = {"id": self.image_id(index), "file_name": f"images/{name}",
+        self.images[index] = {"id": self.image_id(index), "file_name": file_name,
                               "width": int(image.shape[1]), "height": int(image.shape[0])}
 
     def _included(self, record: dict[str, Any]) -> bool:

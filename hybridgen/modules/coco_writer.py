@@ -3,8 +3,9 @@ from __future__ import annotations
 
 from ..config.registry import register_module
 from ..config.schema import Param
-from ..io.coco_writer import (COLOR_FORMATS, DEFAULT_SUPERCATEGORY, MASK_ENCODINGS, NEEDED_KEYS, CocoWriter,
-                              image_key_hint, load_label_mapping)
+from ..io.coco_writer import (COLOR_FORMATS, DEFAULT_SUPERCATEGORY, IMAGE_NAMES, MASK_ENCODINGS, NEEDED_KEYS,
+                              CocoWriter, image_key_hint, load_label_mapping)
+from ..io.renamed_sink import renamed_sinks
 from ..run.context import RunContext
 from .base import Module
 from .writer_support import refuse_work_units, require_planned
@@ -33,19 +34,31 @@ class CocoAnnotationsWriter(Module):
         Param("append_to_existing_output", "bool", False, doc="extend an existing coco_annotations.json: image and "
               "annotation ids continue after its highest ones"),
         Param("file_prefix", "str", "", doc="prefix of the image file names", check=_prefix_check),
+        Param("image_names", "str", "hybridgen", choices=IMAGE_NAMES, doc="hybridgen: images/<prefix><id:06d>.png; "
+              "blenderproc: BlenderProc's <prefix>rgb_<id:04d>.png next to coco_annotations.json, file_name "
+              "'<folder>/rgb_0000.png' (the default for configs in BlenderProc's form)"),
+        Param("segcolormap_output_key", "str", "instance_attribute_maps", doc="the key the renderer stores "
+              "instance_attribute_maps under (its output_keys; BlenderProc's segcolormap_output_key)"),
+        Param("segmap_output_key", "str", "instance_segmaps", doc="the key the renderer stores instance_segmaps "
+              "under (its output_keys)"),
     )
 
     def prepare(self, context: RunContext) -> None:
         cfg = self.config
         refuse_work_units(context, self.module_name)
-        needed = {cfg["rgb_output_key"]: image_key_hint(cfg["rgb_output_key"]), **NEEDED_KEYS}
+        stored = {cfg["segcolormap_output_key"]: "instance_attribute_maps",
+                  cfg["segmap_output_key"]: "instance_segmaps"}
+        renamed = {key: own for key, own in stored.items() if key != own}
+        needed = {cfg["rgb_output_key"]: image_key_hint(cfg["rgb_output_key"]),
+                  **{key: NEEDED_KEYS[own] for key, own in stored.items()}}
         require_planned(context, self.index, needed)
         self.writer = CocoWriter(cfg["output_dir"], image_key=cfg["rgb_output_key"],
                                  mask_encoding=cfg["mask_encoding_format"], color_file_format=cfg["color_file_format"],
                                  jpg_quality=cfg["jpg_quality"], supercategory=cfg["supercategory"],
                                  label_mapping=load_label_mapping(cfg["label_mapping"]),
-                                 append=cfg["append_to_existing_output"], file_prefix=cfg["file_prefix"])
-        context.sinks.append(self.writer)
+                                 append=cfg["append_to_existing_output"], file_prefix=cfg["file_prefix"],
+                                 image_names=cfg["image_names"])
+        context.sinks += renamed_sinks([self.writer], renamed)  # reads the renamed passes by their roles
         context.cleanups.append(self.writer.abort)
 
     def run(self, context: RunContext) -> None:

@@ -5,6 +5,7 @@ import math
 from typing import Any
 
 from ..config.schema import Param
+from ..io.renamed_sink import check_output_keys
 from ..render.label_request import LabelRequest, parse_map_by
 from ..render.raster import NORMAL_SPACES
 
@@ -40,6 +41,9 @@ def label_params(*, depth: bool, normals: bool, map_by: Any) -> tuple[Param, ...
         Param("render_nocs", "bool", False, doc="write 'nocs': normalized object coordinates in [0, 1]"),
         Param("render_object_records", "bool", False, doc="write 'object_records' per keypoint: object-to-camera "
               "poses, 3D boxes, visible and amodal 2D boxes, pixel counts, visible fractions"),
+        Param("output_keys", "dict|null", None, check=check_output_keys, doc="store passes under other names, "
+              "{pass: name} (e.g. {colors: rgb, depth: depth_m}); every writer sees the new name "
+              "(BlenderProc's output_key / *_output_key)"),
     )
 
 

@@ -5,6 +5,7 @@ from typing import Any
 
 from ..config.registry import register_module
 from ..config.schema import Param, positive
+from ..io.renamed_sink import renamed_sinks
 from ..render.mitsuba_variant import choose_variant
 from ..render.path_trace import PathTraceSettings
 from ..render.render_color import render_color
@@ -90,8 +91,9 @@ class RgbRenderer(Module):
         context.log(f"color: Mitsuba {variant}, {sampling}, max_bounces {settings.max_bounces}"
                     + (f", indirect clamp {settings.clamp_indirect}" if settings.clamp_indirect else "")
                     + (", denoised" if cfg["denoise"] else ""))
+        sinks = renamed_sinks(context.sinks, cfg["output_keys"])
         context.frames_rendered += render_color(
-            scene, context.sinks, settings, labels=request if wants_labels else None, seed=context.scene_seed,
+            scene, sinks, settings, labels=request if wants_labels else None, seed=context.scene_seed,
             variant=variant, hdr=cfg["output_hdr"], denoise=cfg["denoise"], keep_raw=cfg["output_raw"],
             sample_counts=cfg["output_sample_counts"],
             stereo_baseline=cfg["interocular_distance"] if cfg["stereo"] else None,

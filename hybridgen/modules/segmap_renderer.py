@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from ..config.registry import register_module
+from ..io.renamed_sink import renamed_sinks
 from ..render.render_labels import render_labels
 from ..run.context import RunContext
 from .base import Module
@@ -15,7 +16,8 @@ class SegMapRenderer(Module):
     params = label_params(depth=True, normals=True, map_by=["class", "instance"])
 
     def run(self, context: RunContext) -> None:
-        context.frames_rendered += render_labels(context.scene, context.sinks, label_request(self.config),
+        sinks = renamed_sinks(context.sinks, self.config["output_keys"])
+        context.frames_rendered += render_labels(context.scene, sinks, label_request(self.config),
                                                  default_category_id=context.default_category_id,
                                                  progress=context.progress,
                                                  indices=context.keypoint_indices())

@@ -28,12 +28,14 @@ def planned_keys(context: RunContext, writer_index: int) -> set[str] | None:
             return None
         try:
             values = validate_config(get_module(entry.name).param_table(), entry.config, config.global_all)
-            keys.update(layout.key for layout in label_request(values).layouts(1, 1))
+            written = {layout.key for layout in label_request(values).layouts(1, 1)}
         except HybridgenError:
             return None  # the renderer reports its own config error when it runs
-        keys.update(_COLOR_KEYS[entry.name])
+        written.update(_COLOR_KEYS[entry.name])
         if values.get("output_hdr"):
-            keys.add("colors_hdr")
+            written.add("colors_hdr")
+        names = values.get("output_keys") or {}  # stored under the names the renderer gives them
+        keys.update(names.get(key, key) for key in written)
     return keys
 
 

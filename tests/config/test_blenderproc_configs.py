@@ -426,8 +426,87 @@ def test_coco_annotations_at_blenderprocs_place(tmp_path, notices):
     for ann in coco.dataset["annotations"]:
         mask = coco.annToMask(ann)
         assert mask.sum() == pytest.approx(ann["area"], abs=1)
-    image = coco.dataset["images"][0]
-    assert (out / "coco_data" / image["file_name"]).is_file()
+    # BlenderProc's names: coco_data/rgb_0000.png, file_name relative to output_dir ("coco_data/rgb_0000.png")
+    assert [i["file_name"] for i in coco.dataset["images"]] == ["coco_data/rgb_0000.png"]
+    assert coco.dataset["images"][0]["id"] == 0
+    first = out / "coco_data" / "rgb_0000.png"
+    assert first.is_file() and not (out / "coco_data" / "images").exists()
+    first_bytes = first.read_bytes()
+    n_annotations = len(coco.dataset["annotations"])
+    # append_to_existing_output: the numbering continues after the highest image id, as BlenderProc's
+    run_config(config, [str(obj), str(out)])
+    appended = json.loads(annotations.read_text())
+    assert [(i["id"], i["file_name"]) for i in appended["images"]] == [(0, "coco_data/rgb_0000.png"),
+                                                                        (1, "coco_data/rgb_0001.png")]
+    assert first.read_bytes() == first_bytes and (out / "coco_data" / "rgb_0001.png").is_file()
+    assert len(appended["annotations"]) == 2 * n_annotations
+    assert {a["image_id"] for a in appended["annotations"][n_annotations:]} == {1}
+
+
+RENAMED_KEYS_V3 = """\
+    {
+      "version": 3,
+      "setup": {"blender_install_path": "/opt/blender/"},
+      "modules": [
+        {"module": "main.Initializer", "config": {"global": {"output_dir": "<args:1>"}}},
+        {"module": "loader.ObjectLoader", "config": {"path": "<args:0>",
+                                                     "add_properties": {"cp_category_id": "1"}}},
+        {"module": "manipulators.EntityManipulator", "config": {
+            "selector": {"provider": "getter.Entity", "conditions": {"name": "Cube.*"}}, "cp_category_id": 3}},
+        {"module": "lighting.LightLoader", "config": {"lights": [{"type": "POINT", "location": [0, -3, 6],
+                                                                  "energy": 800}]}},
+        {"module": "camera.CameraLoader", "config": {"intrinsics": {"fov": 1.2, "resolution_x": 40,
+                                                                    "resolution_y": 30},
+            "cam_poses": [{"location": [0, -5, 5], "rotation": {"format": "look_at", "value": [0, 0, 0.3]}},
+                          {"location": [3, -4, 4], "rotation": {"format": "look_at", "value": [0, 0, 0.3]}}]}},
+        {"module": "renderer.RgbRenderer", "config": {"samples": 1, "render_depth": True,
+                                                      "render_normals": True, RGB_KEYS}},
+        {"module": "renderer.SegMapRenderer", "config": {"map_by": ["instance", "class"], SEG_KEYS}},
+        {"module": "writer.CocoAnnotationsWriter", "config": {}},
+        {"module": "writer.Hdf5Writer", "config": {}}
+      ]
+    }
+"""
+
+
+def test_output_keys_rename_the_stored_datasets(tmp_path, notices):
+    from hybridgen.data import KeypointDataset
+    from hybridgen.io.label_encoding import decode_dataset
+
+    obj = write_scene(tmp_path)
+    runs = {}
+    for name, rgb_keys, seg_keys in (
+            ("default", '"output_key": "colors"', '"segcolormap_output_key": "instance_attribute_maps"'),
+            ("renamed", '"output_key": "rgb", "depth_output_key": "depth_m", "normals_output_key": "nrm", '
+                        '"distance_output_key": "never_rendered"', '"segcolormap_output_key": "segcolormap"')):
+        text = RENAMED_KEYS_V3.replace("RGB_KEYS", rgb_keys).replace("SEG_KEYS", seg_keys)
+        out = tmp_path / name
+        run_config(write(tmp_path, f"{name}.yaml", text), [str(obj), str(out)])
+        with h5py.File(out / "data.hdf5") as f:
+            runs[name] = {k: decode_dataset(f[k]) for k in f if isinstance(f[k], h5py.Dataset)}
+        runs[name + "_coco"] = json.loads((out / "coco_data" / "coco_annotations.json").read_text())
+    default, renamed = runs["default"], runs["renamed"]
+    pairs = {"colors": "rgb", "depth": "depth_m", "normals": "nrm", "instance_attribute_maps": "segcolormap"}
+    for own, stored in pairs.items():
+        assert own in default and own not in renamed and stored in renamed and stored not in default
+    assert "never_rendered" not in renamed  # a name for a pass not rendered is no error, as in BlenderProc
+    np.testing.assert_array_equal(renamed["rgb"], default["colors"])  # same seed: the same image
+    np.testing.assert_array_equal(renamed["depth_m"], default["depth"])
+    # default normals are stored octahedral (within 1e-4 rad); the renamed ones plain float32
+    np.testing.assert_allclose(renamed["nrm"], default["normals"], atol=2e-4)
+    assert renamed["nrm"].dtype == np.float32
+    assert [json.loads(v) if isinstance(v, (bytes, str)) else v for v in renamed["segcolormap"]] == \
+        [json.loads(v) if isinstance(v, (bytes, str)) else v for v in default["instance_attribute_maps"]]
+    for key in set(default) - set(pairs):
+        np.testing.assert_array_equal(renamed[key], default[key], err_msg=key)
+    # the COCO writer found the renamed passes (finish() points it at segcolormap): the same annotations
+    assert runs["renamed_coco"]["annotations"] == runs["default_coco"]["annotations"]
+    assert runs["renamed_coco"]["annotations"]
+    # the reader returns renamed passes under their stored name
+    samples = list(KeypointDataset(tmp_path / "renamed", keys=["rgb", "depth_m", "nrm"]))
+    assert len(samples) == 2
+    np.testing.assert_array_equal(samples[1]["rgb"], default["colors"][1])
+    np.testing.assert_array_equal(samples[1]["depth_m"], default["depth"][1])
 
 
 BOP_REPLICATION_V3 = """\
@@ -508,3 +587,16 @@ def test_source_frame_as_blenderprocs_point_and_matrix_conversion():
     expected[:3, :3] = given[:3, :3] @ T.T
     np.testing.assert_allclose(pose_from_entry({"cam2world_matrix": given.tolist()}, source_frame=frame),
                                expected @ np.diag([1.0, -1.0, -1.0, 1.0]), atol=1e-12)
+
+
+def test_output_keys_that_would_store_two_passes_under_one_name_are_refused():
+    from hybridgen.io.frame_sink import PassLayout
+    from hybridgen.io.renamed_sink import check_output_keys, renamed_layouts
+
+    layouts = [PassLayout("depth", "float32", (2, 2)), PassLayout("normals", "float32", (2, 2, 3))]
+    assert [layout.key for layout in renamed_layouts(layouts, {"depth": "d", "albedo": "a"})] == ["d", "normals"]
+    with pytest.raises(ConfigError, match="two passes"):
+        renamed_layouts(layouts, {"depth": "normals"})
+    assert check_output_keys({"depth": "x", "normals": "x"}) is not None
+    assert check_output_keys({"depth": "a/b"}) is not None
+    assert check_output_keys({"depth": "d"}) is None and check_output_keys(None) is None
