@@ -717,6 +717,11 @@ def finish(entries: list[Any], state: dict[str, Any], output_dir: Any) -> None:
         last = renderers[-1].config
         if entry.name == "writer.CocoAnnotationsWriter":
             _coco_reads_renamed(entry.config, [e.config for e in renderers])
+        else:  # BlenderProc's BOP writer renders its own: hybridgen's reads the passes under their stored names
+            stored = {own: name for e in renderers for own, name in (e.config.get("output_keys") or {}).items()
+                      if own in ("colors", "depth", "instance_segmaps")}
+            if stored and entry.config.get("input_keys") is None:
+                entry.config["input_keys"] = stored
         if not any("instance" in _as_list(e.config.get("map_by")) for e in renderers):
             last["map_by"] = [*_as_list(last.get("map_by")), "instance"]
         if entry.name == "writer.BopWriter" and not any(e.config.get("render_depth") for e in renderers):

@@ -4,6 +4,7 @@ from __future__ import annotations
 from ..config.registry import register_module
 from ..config.schema import Param, positive
 from ..io.bop_writer import ANNOTATION_UNITS, COLOR_FORMATS, BopWriter as BopSink
+from ..io.renamed_sink import check_output_keys, renamed_sinks
 from ..run.context import RunContext
 from ..sampling.getters import parse_selector
 from ..scene.mesh_object import MeshObject
@@ -32,6 +33,9 @@ class BopWriter(Module):
         Param("save_world2cam", "bool", True, doc="write cam_R_w2c, cam_t_w2c in scene_camera.json"),
         Param("calc_mask_info_coco", "bool", True, doc="write mask/, mask_visib/, scene_gt_info.json and "
               "scene_gt_coco.json (needs instance maps)"),
+        Param("input_keys", "dict|null", None, check=check_output_keys, doc="{pass: name} when the renderers "
+              "store colors, depth or instance_segmaps under other names (their output_keys; configs in "
+              "BlenderProc's form set it from them)"),
         Param("ignore_dist_thres", "float", 100.0, "m", "objects farther from the camera are left out",
               check=positive),
     )
@@ -47,8 +51,9 @@ class BopWriter(Module):
                               annotation_unit=cfg["annotation_unit"], save_world2cam=cfg["save_world2cam"],
                               calc_mask_info_coco=cfg["calc_mask_info_coco"],
                               ignore_dist_thres=cfg["ignore_dist_thres"], log=context.log)
-        require_planned(context, self.index, self.writer.needed_keys())
-        context.sinks.append(self.writer)
+        stored = cfg["input_keys"] or {}
+        require_planned(context, self.index, {stored.get(k, k): v for k, v in self.writer.needed_keys().items()})
+        context.sinks += renamed_sinks([self.writer], {name: own for own, name in stored.items()})
         context.cleanups.append(self.writer.abort)
 
     def _selected(self, context: RunContext) -> list[MeshObject]:

@@ -463,6 +463,7 @@ RENAMED_KEYS_V3 = """\
                                                       "render_normals": True, RGB_KEYS}},
         {"module": "renderer.SegMapRenderer", "config": {"map_by": ["instance", "class"], SEG_KEYS}},
         {"module": "writer.CocoAnnotationsWriter", "config": {}},
+        {"module": "writer.BopWriter", "config": {}},
         {"module": "writer.Hdf5Writer", "config": {}}
       ]
     }
@@ -502,6 +503,14 @@ def test_output_keys_rename_the_stored_datasets(tmp_path, notices):
     # the COCO writer found the renamed passes (finish() points it at segcolormap): the same annotations
     assert runs["renamed_coco"]["annotations"] == runs["default_coco"]["annotations"]
     assert runs["renamed_coco"]["annotations"]
+    # the BOP writer found them too (finish() gives it input_keys): the same files, byte for byte
+    bop = {name: sorted(p.relative_to(tmp_path / name / "bop_data") for p in (tmp_path / name / "bop_data").rglob("*")
+                        if p.is_file()) for name in ("default", "renamed")}
+    assert bop["default"] == bop["renamed"] and any(p.parent.name == "depth" for p in bop["default"])
+    for path in bop["default"]:
+        if path.suffix == ".png":
+            assert (tmp_path / "default/bop_data" / path).read_bytes() == \
+                (tmp_path / "renamed/bop_data" / path).read_bytes(), path
     # the reader returns renamed passes under their stored name
     samples = list(KeypointDataset(tmp_path / "renamed", keys=["rgb", "depth_m", "nrm"]))
     assert len(samples) == 2
