@@ -51,10 +51,10 @@ class Hdf5Writer(Module):
         Param("resume_chunk_keypoints", "int", -1,
               doc="single layout, run without sharding as the only writer: render this many keypoints per "
               "verified part in the hidden folder .<file_name>.parts, merged at the end into the same bytes a "
-              "direct write gives, so a killed run resumes; every part rebuilds the scene. 0: write directly "
-              f"(a killed run starts over); -1: {DEFAULT_CHUNK_KEYPOINTS} when the config path-traces color "
-              "(renderer.RgbRenderer), else 0 (label-only runs are fast and camera sampling would be redone "
-              "per part)",
+              "direct write gives, so a killed run resumes; the scene is built once and each part renders its "
+              "keypoints. 0: write directly (a killed run starts over); -1: "
+              f"{DEFAULT_CHUNK_KEYPOINTS} when the config path-traces color (renderer.RgbRenderer), else 0 "
+              "(merging the parts copies every chunk once more: ~40 % on top of fast label rasterizing)",
               check=lambda v: None if v >= -1 else f"must be >= -1, got {v}"),
     )
 

@@ -81,21 +81,41 @@ def execute(config: ConfigFile, modules: list[Module], *, unit: WorkUnit | None 
     if log is not None:
         context.log = log
     try:
-        with config_folder(config.path):  # relative input paths fall back to the config's folder
-            for phase in ("prepare", "run"):
-                for module in modules:
-                    try:
-                        getattr(module, phase)(context)
-                    except ConfigError as exc:
-                        raise exc.located(file=config.path, module=module.module_name, index=module.index) \
-                            from None
-                    except HybridgenError as exc:
-                        raise type(exc)(f"{config.path}: module '{module.module_name}' (#{module.index}): {exc}") \
-                            from None
+        run_modules(config, modules, context)
     finally:
-        for cleanup in reversed(context.cleanups):
-            cleanup()
+        run_cleanups(context)
     return context
+
+
+def run_modules(config: ConfigFile, modules: list[Module], context: RunContext) -> None:
+    """Prepare, then run ``modules`` in order on ``context``; errors name file, module and key."""
+    with config_folder(config.path):  # relative input paths fall back to the config's folder
+        for phase in ("prepare", "run"):
+            for module in modules:
+                try:
+                    getattr(module, phase)(context)
+                except ConfigError as exc:
+                    raise exc.located(file=config.path, module=module.module_name, index=module.index) from None
+                except HybridgenError as exc:
+                    raise type(exc)(f"{config.path}: module '{module.module_name}' (#{module.index}): {exc}") \
+                        from None
+
+
+def run_cleanups(context: RunContext) -> None:
+    """Run the cleanups the modules registered on ``context`` (last first) and forget them."""
+    for cleanup in reversed(context.cleanups):
+        cleanup()
+    context.cleanups.clear()
+
+
+def scene_stage(modules: list[Module]) -> int | None:
+    """Where the modules that depend on a work unit's keypoints begin: the index of the first renderer, when
+    every module from there on is a renderer or a writer (the modules before it build the scene, the same
+    for every unit of a scene); None when there is no renderer or a later module changes the scene."""
+    first = next((i for i, m in enumerate(modules) if m.module_name.startswith("renderer.")), None)
+    if first is None or not all(m.module_name.startswith(("renderer.", "writer.")) for m in modules[first:]):
+        return None
+    return first
 
 
 def writer_folders(modules: list[Module], file: str) -> list[Path]:

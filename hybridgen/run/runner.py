@@ -38,6 +38,7 @@ from ..io.atomic import prepare_output_dir
 from ..io.integrity import verify
 from ..modules.base import Module
 from .fingerprint import FINGERPRINT_ATTR, describe_difference, differing_keys, parse_fingerprint
+from .scene_reuse import SceneReuse
 from .signals import die_with_parent, reclaim_sigterm
 from .units import SHARD_FOLDER, WorkUnit, chunk_count
 
@@ -111,16 +112,21 @@ def _apply_thread_limit() -> None:
 
 
 def run_unit(path: str, args: Sequence[str], env: Mapping[str, str] | None, unit: WorkUnit,
-             fingerprint: str | None = None, progress: Callable[[int, str], Any] | None = None) -> tuple[int, int]:
+             fingerprint: str | None = None, progress: Callable[[int, str], Any] | None = None,
+             scenes: "SceneReuse | None" = None) -> tuple[int, int]:
     """Run one unit (in whatever process this is); returns (keypoints rendered, keypoints of its scene).
     ``fingerprint`` (the parent's, JSON) is recorded in the unit's file; ``progress`` makes progress bars
-    (units run in this process)."""
+    (units run in this process); with ``scenes`` consecutive units of one scene build it once
+    (:mod:`hybridgen.run.scene_reuse`)."""
     from .pipeline import build_modules, execute
 
     _apply_thread_limit()
-    config = load_config(path, args, env)
     attributes = {FINGERPRINT_ATTR: fingerprint} if fingerprint is not None else None
-    context = execute(config, build_modules(config), unit=unit, attributes=attributes, progress=progress)
+    if scenes is not None:
+        context = scenes.execute(path, args, env, unit, attributes=attributes, progress=progress)
+    else:
+        config = load_config(path, args, env)
+        context = execute(config, build_modules(config), unit=unit, attributes=attributes, progress=progress)
     return context.frames_rendered, len(context.scene.camera)
 
 
@@ -167,8 +173,9 @@ def discard_outputs(plan: ShardingPlan, shard: tuple[int, int] | None = None) ->
 class _Local:
     """Runs units one after another in this process."""
 
-    def __init__(self, task: Callable[[WorkUnit], tuple[int, int]]) -> None:
+    def __init__(self, task: Callable[[WorkUnit], tuple[int, int]], scenes: SceneReuse | None = None) -> None:
         self.task = task
+        self.scenes = scenes
 
     def submit(self, unit: WorkUnit) -> Future:
         future: Future = Future()
@@ -181,7 +188,8 @@ class _Local:
         return future
 
     def shutdown(self, interrupted: bool = False) -> None:
-        pass
+        if self.scenes is not None:
+            self.scenes.close()
 
 
 class _Pool:
@@ -293,7 +301,8 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
     if executor == "ray":
         pool: Any = _Ray(call, address, workers)
     elif workers == 1:
-        pool = _Local(lambda unit: run_unit(*call[:3], unit, call[3], progress))
+        scenes = SceneReuse() if plan.staged else None  # a staged run's parts share one scene
+        pool = _Local(lambda unit: run_unit(*call[:3], unit, call[3], progress, scenes), scenes)
     else:
         pool = _Pool(call, workers, max_tasks_per_child)
     scene_units = _scene_units(plan, index, count)

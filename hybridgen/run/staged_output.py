@@ -4,10 +4,10 @@ A run of a config whose only writer is ``writer.Hdf5Writer`` (``layout: single``
 ``keypoints_per_chunk``) renders its keypoints in parts of ``resume_chunk_keypoints`` into the hidden folder
 ``<output_dir>/.<file_name>.parts/``: each part is a work unit of the sharded machinery
 (:mod:`hybridgen.run.runner`) - fingerprinted, sealed, renamed into place only when complete - so a killed
-run, rerun, reuses every part that verifies and renders only the rest. Every part rebuilds the scene (camera
-sampling included), which costs little beside path tracing but a lot beside fast label rasterizing: the
-default (``-1``) stages runs that path-trace color (parts of :data:`DEFAULT_CHUNK_KEYPOINTS`) and writes
-label-only runs directly.
+run, rerun, reuses every part that verifies and renders only the rest. The parts share one scene, built
+once per process (:mod:`hybridgen.run.scene_reuse`); merging copies every stored chunk once more, which
+costs little beside path tracing but ~40 % of a fast label-only run: the default (``-1``) stages runs that
+path-trace color (parts of :data:`DEFAULT_CHUNK_KEYPOINTS`) and writes label-only runs directly.
 
 Each part records a *journal* (:data:`JOURNAL_ATTR`): the writer's options and the order of the calls the
 writer received (datasets, records and attributes of each renderer, then the scene records and run

@@ -3,7 +3,8 @@
 Scene ``s`` draws everything (object poses, camera samples, ...) from
 ``numpy.random.SeedSequence(root_seed, spawn_key=(s,))`` - exactly ``SeedSequence(root_seed).spawn(n)[s]`` -
 so its content does not depend on how units are spread over workers, nor on how many scenes there are.
-Every unit of a scene rebuilds the same scene and renders its own slice of the keypoints.
+Every unit of a scene rebuilds the same scene (or, run one after another in one process, reuses it:
+:mod:`hybridgen.run.scene_reuse`) and renders its own slice of the keypoints.
 """
 from __future__ import annotations
 

@@ -174,3 +174,33 @@ def test_which_runs_are_staged_by_default(tmp_path, write_config, renderers, set
     assert (plan.chunk_size if plan else None) == expected
     if plan is not None:
         assert plan.staged and plan.folder == ".data.hdf5.parts" and plan.scenes == 1
+
+
+def test_resumed_parts_build_the_scene_once_and_give_the_direct_bytes(reference, run_cli, monkeypatch):
+    """A killed label-only staged run, rerun in this process: the scene-building modules (loaders, camera
+    sampling) run once for both missing parts, and the merged file is the file a direct write gives."""
+    from hybridgen.config.config_file import load_config
+    from hybridgen.modules.camera_sampler import CameraSampler
+    from hybridgen.modules.primitive_loader import PrimitiveLoader
+    from hybridgen.run.fingerprint import FINGERPRINT_ATTR, fingerprint_text, run_fingerprint
+    from hybridgen.run.pipeline import build_modules, execute
+
+    config, out, data = reference
+    _killed_run(config, out, chunk=2, at=1)
+    calls: list[str] = []
+    for cls in (CameraSampler, PrimitiveLoader):
+        original = cls.run
+        monkeypatch.setattr(cls, "run", lambda self, context, run=original: (calls.append(self.module_name),
+                                                                             run(self, context))[1])
+    code, _, err = run_cli("run", str(config), str(out))
+    assert code == 0, err
+    assert _units_rendered(err) == ["scene_000000_chunk_00002", "scene_000000_chunk_00003"]
+    assert sorted(calls) == ["camera.CameraSampler", "loader.PrimitiveLoader", "loader.PrimitiveLoader"]
+    assert (out / "data.hdf5").read_bytes() == data
+    (out / "data.hdf5").unlink()
+    loaded = load_config(str(config), [str(out)])
+    context = execute(loaded, build_modules(loaded),
+                      attributes={FINGERPRINT_ATTR: fingerprint_text(run_fingerprint(loaded))})
+    assert context.outputs[0].read_bytes() == data
+    with h5py.File(out / "data.hdf5", "r") as h5:  # every keypoint rendered, each from its own camera
+        assert h5["depth"].shape[0] == 7 and len({h5["depth"][i].tobytes() for i in range(7)}) == 7

@@ -1,0 +1,89 @@
+"""Consecutive work units of one scene in one process build that scene once.
+
+The parts of a resumable non-sharded run (:mod:`hybridgen.run.staged_output`) are units of the same scene
+run one after another in this process. The modules before the first renderer (loaders, placement, camera
+sampling, ...) build the scene and draw from the run's generator; the renderers and writers after them only
+render and write the unit's keypoints (per-keypoint seeds derive from the scene seed and the keypoint
+index, never from the generator). So the scene-building modules run once, and every unit runs the
+renderers and writers on a deep copy of the built state (scene, generator, attributes): the bytes are those
+of rebuilding the scene per unit. Configs with a scene-changing module after a renderer rebuild per unit.
+"""
+from __future__ import annotations
+
+import copy
+import dataclasses
+from typing import Any, Callable, Mapping, Sequence
+
+from ..config.config_file import ConfigFile, load_config
+from ..modules.base import Module
+from .context import RunContext
+from .units import WorkUnit
+
+
+@dataclasses.dataclass
+class _Built:
+    key: tuple[Any, ...]
+    config: ConfigFile
+    modules: list[Module]
+    stage: int
+    context: RunContext
+
+
+class SceneReuse:
+    """Builds each scene once for the units that follow; :meth:`close` runs the builders' cleanups.
+    ``builds`` counts how often scene-building modules ran in this process."""
+
+    def __init__(self) -> None:
+        self._built: _Built | None = None
+        self.builds = 0
+
+    def execute(self, path: str, args: Sequence[str], env: Mapping[str, str] | None, unit: WorkUnit, *,
+                attributes: Mapping[str, Any] | None = None,
+                progress: Callable[[int, str], Any] | None = None) -> RunContext:
+        """Run ``unit`` like :func:`hybridgen.run.pipeline.execute`, reusing the scene built for the
+        previous unit when it is the same config, arguments and scene index."""
+        from .pipeline import build_modules, execute, run_cleanups, run_modules, scene_stage
+
+        key = (str(path), tuple(args), tuple(sorted((env or {}).items())), unit.scene,
+               tuple(sorted((attributes or {}).items())))
+        if self._built is None or self._built.key != key:
+            self.close()
+            config = load_config(path, args, env)
+            modules = build_modules(config)
+            stage = scene_stage(modules)
+            if stage is None:
+                return execute(config, modules, unit=unit, attributes=attributes, progress=progress)
+            base = RunContext(config=config, progress=progress, unit=unit)
+            base.attributes.update(attributes or {})
+            try:
+                run_modules(config, modules[:stage], base)
+            except BaseException:
+                run_cleanups(base)
+                raise
+            self.builds += 1
+            self._built = _Built(key, config, modules, stage, base)
+        built = self._built
+        context = _copy_for(built.context, unit)
+        try:
+            run_modules(built.config, built.modules[built.stage:], context)
+        finally:
+            run_cleanups(context)
+        return context
+
+    def close(self) -> None:
+        """Forget the built scene and run the cleanups its modules registered."""
+        if self._built is not None:
+            from .pipeline import run_cleanups
+
+            built, self._built = self._built, None
+            run_cleanups(built.context)
+
+
+def _copy_for(base: RunContext, unit: WorkUnit) -> RunContext:
+    """A context for ``unit`` holding a deep copy of what the scene-building modules made."""
+    context = dataclasses.replace(base, unit=unit, scene=copy.deepcopy(base.scene), sinks=list(base.sinks),
+                                  outputs=list(base.outputs), attributes=copy.deepcopy(base.attributes),
+                                  cleanups=[])
+    context.rng = copy.deepcopy(base.rng)
+    context.log = base.log
+    return context
