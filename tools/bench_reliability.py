@@ -20,29 +20,15 @@ import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "tools"))
+from bench_workers import CONFIG, KINDS  # noqa: E402  (one scene template for the run benchmarks)
 
-CONFIG = """
-global: {{all: {{output_dir: "<args:0>"}}}}
-modules:
-  - name: main.Initializer
-    config: {{seed: 1, number_of_scenes: {scenes}}}
-  - name: loader.ObjLoader
-    config: {{path: {repo}/configs/assets/knot.obj, name: knot, category_id: 2, scale: 0.3,
-             location: {{provider: sampler.Uniform3d, min: [-0.5, -0.5, 0.6], max: [0.5, 0.5, 0.9]}}}}
-  - name: loader.PrimitiveLoader
-    config: {{shape: plane, size: 8, name: floor, category_id: 1}}
-  - name: camera.CameraSampler
-    config:
-      intrinsics: {{resolution_x: {width}, resolution_y: {height}}}
-      cam_poses:
-        - number_of_samples: {keypoints}
-          location: {{provider: sampler.Shell, center: [0, 0, 0.7], radius_min: 2, radius_max: 3,
-                     elevation_min: 15, elevation_max: 60}}
-          rotation: {{format: look_at, value: [0, 0, 0.7]}}
-  - name: renderer.SegMapRenderer
-    config: {{render_distance: true}}
-  - name: writer.Hdf5Writer
-"""
+
+def config_text(scenes: int, width: int, height: int, keypoints: int) -> str:
+    """bench_workers.py's labels-only scene (knot over a floor, sampled cameras, depth/distance/normals/ids)."""
+    labels = KINDS["labels"]
+    return CONFIG.format(scenes=scenes, repo=REPO, width=width, height=height, keypoints=keypoints,
+                         renderer=labels["renderer"], renderer_config=labels["renderer_config"])
 
 
 def _run(config: Path, out: Path) -> tuple[float, int]:
@@ -64,7 +50,7 @@ def overhead(keypoints: int, rounds: int, tmp: Path) -> None:
     import h5py
 
     config = tmp / "overhead.yaml"
-    config.write_text(CONFIG.format(scenes=1, repo=REPO, width=64, height=48, keypoints=keypoints))
+    config.write_text(config_text(1, 64, 48, keypoints))
     runs, fingerprints, seals, verifies = [], [], [], []
     for round_index in range(rounds):
         out = tmp / f"overhead{round_index}"
@@ -94,7 +80,7 @@ def memory(scene_counts: list[int], tmp: Path) -> None:
     print("labels-only, 16x12, 2 keypoints per scene, one process (workers 1):")
     for scenes in scene_counts:
         config = tmp / f"memory{scenes}.yaml"
-        config.write_text(CONFIG.format(scenes=scenes, repo=REPO, width=16, height=12, keypoints=2))
+        config.write_text(config_text(scenes, 16, 12, 2))
         seconds, rss = _run(config, tmp / f"memory{scenes}")
         print(f"  {scenes:5d} scenes: peak RSS {rss} MiB ({seconds:.1f} s)")
 
