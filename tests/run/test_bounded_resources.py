@@ -11,29 +11,10 @@ from pathlib import Path
 import pytest
 
 from tests.conftest import REPO
+from tests.run.scene_configs import LABELS_WITHOUT_NORMALS, floor_and_object
 
-SCENES = """
-global: {all: {output_dir: "<args:0>"}}
-modules:
-  - name: main.Initializer
-    config: {seed: 3, number_of_scenes: SCENES}
-  - name: loader.PrimitiveLoader
-    config: {shape: plane, size: 6, name: floor, category_id: 1}
-  - name: loader.PrimitiveLoader
-    config: {shape: sphere, size: 0.6, name: ball, category_id: 2,
-             location: {provider: sampler.Uniform3d, min: [-1, -1, 0.3], max: [1, 1, 0.3]}}
-  - name: camera.CameraSampler
-    config:
-      intrinsics: {resolution_x: 8, resolution_y: 6}
-      cam_poses:
-        - number_of_samples: 1
-          location: {provider: sampler.Shell, center: [0, 0, 0], radius_min: 2, radius_max: 4,
-                     elevation_min: 20, elevation_max: 60}
-          rotation: {format: look_at, value: [0, 0, 0]}
-  - name: renderer.SegMapRenderer
-    config: {render_normals: false}
-  - name: writer.Hdf5Writer
-"""
+SCENES = floor_and_object(initializer="seed: 3, number_of_scenes: SCENES", width=8, height=6, keypoints=1,
+                          renderer=LABELS_WITHOUT_NORMALS)
 PEAK_RSS = ("import resource, sys; from hybridgen.cli import main; rc = main(sys.argv[1:]); "
             "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss); sys.exit(rc)")
 

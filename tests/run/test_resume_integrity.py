@@ -12,29 +12,10 @@ import pytest
 from hybridgen.errors import InputError
 from hybridgen.io.integrity import DIGEST_ATTR, verify
 from hybridgen.run.shard_index import check_index_sources
+from tests.run.scene_configs import LABELS_WITHOUT_NORMALS, floor_and_object
 
-CONFIG = """
-global: {all: {output_dir: "<args:0>"}}
-modules:
-  - name: main.Initializer
-    config: {seed: SEED, number_of_scenes: 2, keypoints_per_chunk: 2}
-  - name: loader.PrimitiveLoader
-    config: {shape: plane, size: 6, name: floor, category_id: 1}
-  - name: loader.PrimitiveLoader
-    config: {shape: cube, size: 0.6, name: box, category_id: 2,
-             location: {provider: sampler.Uniform3d, min: [-1, -1, 0.3], max: [1, 1, 0.3]}}
-  - name: camera.CameraSampler
-    config:
-      intrinsics: {resolution_x: 16, resolution_y: 12}
-      cam_poses:
-        - number_of_samples: 3
-          location: {provider: sampler.Shell, center: [0, 0, 0], radius_min: 2, radius_max: 4,
-                     elevation_min: 20, elevation_max: 60}
-          rotation: {format: look_at, value: [0, 0, 0]}
-  - name: renderer.SegMapRenderer
-    config: {render_normals: false}
-  - name: writer.Hdf5Writer
-"""
+CONFIG = floor_and_object(initializer="seed: SEED, number_of_scenes: 2, keypoints_per_chunk: 2", shape="cube",
+                          name="box", width=16, height=12, keypoints=3, renderer=LABELS_WITHOUT_NORMALS)
 SINGLE = CONFIG.replace("number_of_scenes: 2, keypoints_per_chunk: 2", "number_of_scenes: 1")
 
 

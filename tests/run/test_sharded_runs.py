@@ -14,29 +14,12 @@ import h5py
 import numpy as np
 
 from tests.conftest import REPO
+from tests.run.scene_configs import floor_and_object
 
-CONFIG = """
-global: {all: {output_dir: "<args:0>"}}
-modules:
-  - name: main.Initializer
-    config: {seed: 5, number_of_scenes: 3, keypoints_per_chunk: 2}
-  - name: loader.PrimitiveLoader
-    config: {shape: plane, size: 6, name: floor, category_id: 1}
-  - name: loader.PrimitiveLoader
-    config: {shape: sphere, size: 0.6, name: ball, category_id: 2,
-             location: {provider: sampler.Uniform3d, min: [-1, -1, 0.3], max: [1, 1, 0.3]}}
-  - name: camera.CameraSampler
-    config:
-      intrinsics: {resolution_x: 40, resolution_y: 30}
-      cam_poses:
-        - number_of_samples: 5
-          location: {provider: sampler.Shell, center: [0, 0, 0], radius_min: 2, radius_max: 4,
-                     elevation_min: 20, elevation_max: 60}
-          rotation: {format: look_at, value: {provider: getter.POI, selector: {name: ball}}}
-  - name: renderer.RgbRenderer
-    config: {samples: 2, render_depth: true, map_by: [class, instance]}
-  - name: writer.Hdf5Writer
-"""
+CONFIG = floor_and_object(
+    initializer="seed: 5, number_of_scenes: 3, keypoints_per_chunk: 2", width=40, height=30, keypoints=5,
+    look_at="{provider: getter.POI, selector: {name: ball}}",
+    renderer="  - name: renderer.RgbRenderer\n    config: {samples: 2, render_depth: true, map_by: [class, instance]}")
 
 
 def _digests(folder: Path) -> dict[str, str]:
