@@ -1,8 +1,8 @@
 """Translation of the renderer-agnostic scene into a Mitsuba 3 scene dictionary (done once per run).
 
 Geometry is handed over as in-memory meshes in world coordinates (flat-shaded meshes without vertex
-normals stay flat). Materials become Mitsuba's ``principled`` BSDF; lights map as follows (Blender's
-units, as BlenderProc configs give them):
+normals stay flat). Materials become Mitsuba BSDFs (:mod:`hybridgen.render.mitsuba_materials`); lights
+map as follows (Blender's units, as BlenderProc configs give them):
 
 - POINT of power P [W]: ``point`` with intensity P / (4 pi) [W/sr], uniform in all directions.
 - SPOT: ``spot`` with the same intensity, cutoff = spot_size / 2, falloff from spot_blend.
@@ -26,67 +26,16 @@ from ..config.paths import not_found
 from ..errors import InputError
 from ..io.image_check import check_image_file
 from ..scene.light import Light
-from ..scene.material import Material
 from ..scene.mesh_object import MeshObject
 from ..scene.scene import Scene, World
 from . import light_selection
+from .mitsuba_materials import bsdf_dict
+from .mitsuba_materials import rgb as _rgb
 
 ENVMAP_TO_WORLD = np.array([[0.0, 0, 1, 0], [1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 0, 1]])
 """Lays Mitsuba's lat-long map (local +Y up, u = atan2(x, -z) / 2 pi mod 1) out as Blender's equirectangular
 mapping (world +Z up, u = 1/2 - atan2(y, x) / 2 pi): image centre column = world +X, a quarter from the left
 = +Y, top row = +Z, so an HDRI lights a scene from the same side as in BlenderProc."""
-
-
-def _rgb(value: Any) -> dict[str, Any]:
-    return {"type": "rgb", "value": [float(v) for v in list(value)[:3]]}
-
-
-def _texture(material: Material, owner: str) -> dict[str, Any]:
-    import mitsuba as mi
-
-    texture = material.base_color_texture
-    if isinstance(texture, (str, Path)):
-        path = Path(texture)
-        if not path.is_file():
-            raise InputError(f"object '{owner}': {not_found('texture file', path)}")
-        check_image_file(path, f"object '{owner}': texture file")  # header pixel budget, truncation
-        return {"type": "bitmap", "filename": str(path)}
-    array = np.ascontiguousarray(np.asarray(texture)[..., :3])
-    if array.dtype != np.uint8 or array.ndim != 3:
-        raise InputError(f"object '{owner}': base_color_texture must be an HxWx3/4 uint8 image")
-    return {"type": "bitmap", "bitmap": mi.Bitmap(array, pixel_format=mi.Bitmap.PixelFormat.RGB),
-            "raw": False}
-
-
-def bsdf_dict(material: Material, owner: str) -> dict[str, Any]:
-    """Mitsuba ``principled`` BSDF of ``material`` (wrapped in ``mask`` when alpha < 1)."""
-    for name in ("roughness", "metallic", "specular", "transmission", "alpha"):
-        value = getattr(material, name)
-        if not (isinstance(value, (int, float)) and 0.0 <= value <= 1.0):
-            raise InputError(f"object '{owner}': material '{material.name}' {name} must be in 0..1, got {value!r}")
-    if material.extra:
-        raise InputError(f"object '{owner}': material '{material.name}' has unsupported parameter(s) "
-                         f"{sorted(material.extra)}")
-    base = _texture(material, owner) if material.base_color_texture is not None else _rgb(material.base_color)
-    bsdf: dict[str, Any]
-    if material.specular == 0 and material.metallic == 0 and material.transmission == 0:
-        # A principled material without specular, metal or transmission is Lambertian (as Blender 4's).
-        bsdf = {"type": "diffuse", "reflectance": base}
-    else:
-        bsdf = {"type": "principled", "base_color": base, "roughness": float(material.roughness),
-                "metallic": float(material.metallic), "spec_trans": float(material.transmission)}
-        # Mitsuba's principled BSDF takes either the specular amount or the IOR: transmissive materials are
-        # defined by their IOR, opaque ones by their specular amount (as in Blender's UI).
-        if material.transmission > 0:
-            bsdf["eta"] = float(material.ior)
-        else:
-            bsdf["specular"] = float(material.specular)
-    if material.transmission == 0:
-        # Mitsuba's opaque BSDFs are one-sided; Blender (and real meshes with mixed windings) need both sides.
-        bsdf = {"type": "twosided", "material": bsdf}
-    if material.alpha < 1.0:
-        bsdf = {"type": "mask", "opacity": float(material.alpha), "material": bsdf}
-    return bsdf
 
 
 def emitted_radiance(obj: MeshObject) -> np.ndarray:

@@ -7,6 +7,12 @@ from typing import Any
 import numpy as np
 
 
+TEXTURE_SLOTS = ("base_color_texture", "roughness_texture", "metallic_texture", "alpha_texture",
+                 "normal_texture", "displacement_texture")
+"""The material's image inputs, all sampled with the mesh UVs."""
+ALPHA_MODES = ("BLEND", "CLIP")
+
+
 @dataclass
 class Material:
     """A principled material. Colors are linear RGB(A) in [0, 1]; textures are file paths or arrays.
@@ -14,6 +20,20 @@ class Material:
     ``base_color_texture`` (when set) replaces ``base_color``'s RGB and is sampled with the mesh UVs. A
     config override of ``base_color`` alone removes the texture (see
     :func:`hybridgen.config.material_config.apply_material_config`).
+
+    PBR maps (file path or HxW[xC] uint8 array, read as data, not sRGB; the first channel of a gray map):
+
+    - ``roughness_texture`` / ``metallic_texture`` / ``alpha_texture`` replace their value.
+    - ``normal_texture``: tangent-space normal map, RGB = (x, y, z) * 0.5 + 0.5 with x along the mesh's +u
+      and y along +v (OpenGL convention, ambientCG's ``_NormalGL``); ``normal_y_down`` reads DirectX maps
+      (green along -v, ambientCG's ``_NormalDX`` and cc0textures' older ``_Normal``) by inverting green.
+    - ``displacement_texture``: height h in 0..1; the surface is displaced by (h - 0.5) x
+      ``displacement_scale`` metres along its normal. Rendered as a bump (shading normals only, the geometry
+      and so the labels stay undisplaced) - what Blender's default material displacement method "Bump
+      Only" does with BlenderProc's displacement node.
+    - ``alpha_mode``: "BLEND" - alpha is a fractional opacity in color, labels see the surface (BlenderProc's
+      default, segmentation without ``use_alpha``); "CLIP" - alpha >= 0.5 is opaque, below it the surface is
+      cut out of color, albedo and every label (Blender's alpha clip, BlenderProc's ``use_alpha``).
     """
 
     name: str = "default"
@@ -27,7 +47,25 @@ class Material:
     transmission: float = 0.0
     ior: float = 1.45
     alpha: float = 1.0
+    roughness_texture: Any = None
+    metallic_texture: Any = None
+    alpha_texture: Any = None
+    alpha_mode: str = "BLEND"
+    normal_texture: Any = None
+    normal_y_down: bool = False
+    displacement_texture: Any = None
+    displacement_scale: float = 0.15  # metres per unit of height (Blender's Displacement node default in BlenderProc)
     extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def cuts_out(self) -> bool:
+        """True where alpha clips surfaces out of the labels too (``alpha_mode`` CLIP with alpha below 1)."""
+        return self.alpha_mode == "CLIP" and (self.alpha_texture is not None or self.alpha < 0.5)
+
+    @property
+    def uses_uvs(self) -> bool:
+        """True if any texture is set (they are all sampled with the mesh UVs)."""
+        return any(getattr(self, name) is not None for name in TEXTURE_SLOTS)
 
     @staticmethod
     def from_trimesh_visual(visual: Any, fallback_name: str) -> "Material":

@@ -1,0 +1,139 @@
+"""Material -> Mitsuba 3 BSDF dictionary (the principled model with its PBR maps).
+
+The BSDF is built inside out:
+
+- ``diffuse`` when the material has no specular, metal or transmission (Blender 4's principled is Lambertian
+  then), else ``principled`` with base color, roughness and metallic each a value or a texture;
+- ``normalmap`` around it for a tangent-space normal map (Mitsuba's tangent frame: x = dP/du projected
+  into the surface, y = n x x, i.e. +v for a right-handed UV layout, the OpenGL convention; DirectX maps
+  get their green channel inverted first);
+- ``bumpmap`` for a displacement map: shading normals of the surface displaced by h x scale metres (the
+  texture's gradient with respect to UV times ``displacement_scale``; the 0.5 mid level of Blender's node
+  does not change a gradient);
+- ``twosided`` for opaque materials (Mitsuba's BSDFs are one-sided; Blender's are not);
+- ``mask`` for alpha < 1 or an alpha texture (fractional opacity; CLIP materials get their alpha
+  thresholded at 0.5 per texel).
+
+Color textures are sRGB encoded (``raw`` false), data maps are linear (``raw`` true), as Blender's
+"Non-Color" image nodes in BlenderProc's material loaders.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..config.paths import not_found
+from ..errors import InputError
+from ..io.image_check import check_image_file
+from ..scene.material import ALPHA_MODES, Material
+from .material_textures import data_image
+
+
+def rgb(value: Any) -> dict[str, Any]:
+    """Mitsuba constant RGB of the first three channels of ``value``."""
+    return {"type": "rgb", "value": [float(v) for v in list(value)[:3]]}
+
+
+def _checked_path(texture: Any, owner: str, slot: str) -> Path:
+    path = Path(texture)
+    if not path.is_file():
+        raise InputError(f"object '{owner}': {slot}: {not_found('texture file', path)}")
+    check_image_file(path, f"object '{owner}': {slot} file")  # header pixel budget, truncation
+    return path
+
+
+def color_texture(texture: Any, owner: str, slot: str = "base_color_texture") -> dict[str, Any]:
+    """sRGB-encoded color bitmap of a path or an HxWx{3,4} uint8 array."""
+    import mitsuba as mi
+
+    if isinstance(texture, (str, Path)):
+        return {"type": "bitmap", "filename": str(_checked_path(texture, owner, slot))}
+    array = np.ascontiguousarray(np.asarray(texture)[..., :3])
+    if array.dtype != np.uint8 or array.ndim != 3:
+        raise InputError(f"object '{owner}': {slot} must be an HxWx3/4 uint8 image")
+    return {"type": "bitmap", "bitmap": mi.Bitmap(array, pixel_format=mi.Bitmap.PixelFormat.RGB), "raw": False}
+
+
+def data_texture(texture: Any, owner: str, slot: str, *, channels: int = 1,
+                 invert_green: bool = False, threshold: float | None = None) -> dict[str, Any]:
+    """Linear (raw) bitmap of a data map: ``channels`` 1 (gray: the first channel) or 3 (a normal map).
+
+    ``invert_green`` reads a DirectX normal map; ``threshold`` turns values into 0/1 (alpha clip).
+    """
+    import mitsuba as mi
+
+    if isinstance(texture, (str, Path)) and not invert_green and threshold is None and channels == 3:
+        return {"type": "bitmap", "filename": str(_checked_path(texture, owner, slot)), "raw": True}
+    if isinstance(texture, (str, Path)):
+        _checked_path(texture, owner, slot)
+    values = data_image(texture, owner, slot, channels)  # float32 0..1, rows top-down
+    if invert_green:
+        values[..., 1] = 1.0 - values[..., 1]
+    if threshold is not None:
+        values = (values >= threshold).astype(np.float32)
+    return {"type": "bitmap", "bitmap": mi.Bitmap(np.ascontiguousarray(values)), "raw": True}
+
+
+def _scalar_or_map(material: Material, name: str, owner: str) -> Any:
+    texture = getattr(material, f"{name}_texture")
+    if texture is None:
+        return float(getattr(material, name))
+    return data_texture(texture, owner, f"{name}_texture")
+
+
+def check_material(material: Material, owner: str) -> None:
+    """One-line errors for values no renderer can use."""
+    for name in ("roughness", "metallic", "specular", "transmission", "alpha"):
+        value = getattr(material, name)
+        if not (isinstance(value, (int, float)) and 0.0 <= value <= 1.0):
+            raise InputError(f"object '{owner}': material '{material.name}' {name} must be in 0..1, got {value!r}")
+    if material.alpha_mode not in ALPHA_MODES:
+        raise InputError(f"object '{owner}': material '{material.name}' alpha_mode must be one of {ALPHA_MODES}, "
+                         f"got {material.alpha_mode!r}")
+    if not np.isfinite(material.displacement_scale):
+        raise InputError(f"object '{owner}': material '{material.name}' displacement_scale must be finite")
+    if material.extra:
+        raise InputError(f"object '{owner}': material '{material.name}' has unsupported parameter(s) "
+                         f"{sorted(material.extra)}")
+
+
+def bsdf_dict(material: Material, owner: str) -> dict[str, Any]:
+    """Mitsuba BSDF of ``material`` (see the module docstring for the nesting)."""
+    check_material(material, owner)
+    base = color_texture(material.base_color_texture, owner) if material.base_color_texture is not None \
+        else rgb(material.base_color)
+    bsdf: dict[str, Any]
+    plain = material.specular == 0 and material.metallic == 0 and material.metallic_texture is None
+    if plain and material.transmission == 0:
+        # A principled material without specular, metal or transmission is Lambertian (as Blender 4's).
+        bsdf = {"type": "diffuse", "reflectance": base}
+    else:
+        bsdf = {"type": "principled", "base_color": base, "roughness": _scalar_or_map(material, "roughness", owner),
+                "metallic": _scalar_or_map(material, "metallic", owner), "spec_trans": float(material.transmission)}
+        # Mitsuba's principled BSDF takes either the specular amount or the IOR: transmissive materials are
+        # defined by their IOR, opaque ones by their specular amount (as in Blender's UI).
+        if material.transmission > 0:
+            bsdf["eta"] = float(material.ior)
+        else:
+            bsdf["specular"] = float(material.specular)
+    if material.normal_texture is not None:
+        bsdf = {"type": "normalmap", "bsdf": bsdf,
+                "normalmap": data_texture(material.normal_texture, owner, "normal_texture", channels=3,
+                                          invert_green=material.normal_y_down)}
+    if material.displacement_texture is not None and material.displacement_scale != 0:
+        bsdf = {"type": "bumpmap", "bsdf": bsdf, "scale": float(material.displacement_scale),
+                "arbitrary": data_texture(material.displacement_texture, owner, "displacement_texture")}
+    if material.transmission == 0:
+        # Mitsuba's opaque BSDFs are one-sided; Blender (and real meshes with mixed windings) need both sides.
+        bsdf = {"type": "twosided", "material": bsdf}
+    clip = 0.5 if material.alpha_mode == "CLIP" else None
+    if material.alpha_texture is not None:
+        opacity: Any = data_texture(material.alpha_texture, owner, "alpha_texture", threshold=clip)
+        bsdf = {"type": "mask", "opacity": opacity, "material": bsdf}
+    elif material.alpha < 1.0:
+        alpha = float(material.alpha) if clip is None else float(material.alpha >= clip)
+        if alpha < 1.0:
+            bsdf = {"type": "mask", "opacity": alpha, "material": bsdf}
+    return bsdf
