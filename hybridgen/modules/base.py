@@ -1,7 +1,17 @@
-"""Base class of config modules: a declared schema and a thin call into the Python API."""
+"""Base class of config modules: a declared schema, a declared role and outputs, and a thin call into the
+Python API.
+
+run/ plans a run from these declarations alone (never from module names): which modules build the scene
+(run once per scene, before the first renderer), which render keypoints and which write them; the keys
+renderers produce and writers consume (checked before anything renders); how many scenes and keypoint
+chunks a run has; and which writer's single file sharded and resumable runs write unit by unit.
+"""
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, ClassVar
+import enum
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, ClassVar, Mapping
 
 from ..config.schema import Param
 
@@ -9,17 +19,61 @@ if TYPE_CHECKING:
     from ..run.context import RunContext
 
 
+class Role(enum.Enum):
+    """What a module does to a run. Setup, loaders and manipulators build the scene; renderers render the
+    scene's keypoints into the sinks; writers collect what the renderers before them made and commit files."""
+
+    SETUP = "setup"  # run-wide settings: seed, defaults, number of scenes
+    LOADER = "loader"  # adds objects, lights, cameras or materials
+    MANIPULATOR = "manipulator"  # samples or changes what is there (poses, materials, cameras, visibility)
+    RENDERER = "renderer"
+    WRITER = "writer"
+
+    @property
+    def builds_scene(self) -> bool:
+        """Whether modules of this role build the scene: the same for every work unit of a scene, so they run
+        once per scene (and, run before the first renderer, once per process for consecutive units)."""
+        return self not in (Role.RENDERER, Role.WRITER)
+
+
+@dataclass(frozen=True)
+class SceneUnits:
+    """How a run splits into work units: ``scenes`` variations, each in chunks of ``keypoints_per_chunk``
+    keypoints (0: one unit per scene)."""
+
+    scenes: int
+    keypoints_per_chunk: int
+
+
+@dataclass(frozen=True)
+class SingleFile:
+    """A writer's one output file: sharded runs write it as one file per work unit (then an index), resumable
+    runs as verified parts merged into it. ``resume_chunk_keypoints``: keypoints per part of a non-sharded
+    run (0: direct write; -1: the default, parts only when a renderer path-traces)."""
+
+    path: Path
+    resume_chunk_keypoints: int
+
+
 class Module:
     """A step of a config's ``modules`` list.
 
-    Subclasses declare ``params`` once (type, default, unit, doc) and implement :meth:`run`. ``config`` holds
-    validated values with defaults filled in. :meth:`prepare` runs for every module, in order, before any
-    module runs (writers use it to accept frames from renderers that come earlier in the list).
+    Subclasses declare ``params`` once (type, default, unit, doc), their ``role`` (and, where it applies, the
+    declarations below) and implement :meth:`run`. ``config`` holds validated values with defaults filled
+    in. :meth:`prepare` runs for every module, in order, before any module runs (writers use it to accept
+    frames from renderers that come earlier in the list). A module that declares no role (a plugin) is taken
+    to change the scene.
     """
 
     module_name: ClassVar[str] = ""
     doc: ClassVar[str] = ""
     params: ClassVar[tuple[Param, ...]] = ()
+    role: ClassVar[Role] = Role.MANIPULATOR
+    path_traces: ClassVar[bool] = False
+    """Renderers: seconds per keypoint (path tracing), so non-sharded runs render in resumable parts."""
+    writes_unit_files: ClassVar[bool] = False
+    """Writers: in a sharded run every work unit writes its own file through this writer (see
+    :meth:`single_file`); a sharded run needs exactly one such writer."""
 
     def __init__(self, config: dict[str, Any], index: int) -> None:
         self.config = config
@@ -29,6 +83,24 @@ class Module:
     def param_table(cls) -> dict[str, Param]:
         """The declared parameters by name."""
         return {p.name: p for p in cls.params}
+
+    def produces(self) -> frozenset[str] | None:
+        """Renderers: the keys this module stores (under the names its config gives them); None when that is
+        not known before it runs (then writers after it are not checked before rendering)."""
+        return None
+
+    def consumes(self) -> Mapping[str, str]:
+        """Writers: the keys this module needs from the renderers before it, each with how to make it."""
+        return {}
+
+    def scene_units(self) -> SceneUnits | None:
+        """Setup modules: the run's scenes and keypoint chunks, when this module sets them."""
+        return None
+
+    def single_file(self) -> SingleFile | None:
+        """Writers with ``writes_unit_files``: the one file they write with this config, or None when their
+        config writes something else (e.g. one file per keypoint)."""
+        return None
 
     def value(self, context: "RunContext", key: str) -> Any:
         """The config value ``key`` with its samplers drawn afresh, checked against its declared type."""

@@ -40,7 +40,7 @@ from ..io.mesh_loader import load_objects
 from ..run.context import RunContext
 from ..scene.camera import Intrinsics
 from ..scene.frames import BLENDER_TO_OPENCV
-from .base import Module
+from .base import Module, Role
 from .obj_loader import add_with_blender_names
 
 
@@ -81,6 +81,8 @@ def _pose(rotation: Any, translation: Any, scale: float) -> np.ndarray:
 @register_module("loader.BopLoader")
 class BopLoader(Module):
     """Loads BOP models (sampled, listed or all) or replicates a BOP scene with its cameras."""
+
+    role = Role.LOADER
 
     params = (
         Param("bop_dataset_path", "path", doc="the dataset's folder, e.g. <bop>/lm"),

@@ -8,13 +8,15 @@ from ..io.renamed_sink import check_output_keys, renamed_sinks
 from ..run.context import RunContext
 from ..sampling.getters import parse_selector
 from ..scene.mesh_object import MeshObject
-from .base import Module
+from .base import Module, Role
 from .writer_support import refuse_work_units, require_planned
 
 
 @register_module("writer.BopWriter")
 class BopWriter(Module):
     """Writes train_pbr chunks (rgb, depth, exact full/visible masks, scene_gt*, camera.json); obj_id = category_id."""
+
+    role = Role.WRITER
 
     params = (
         Param("output_dir", "path", doc="folder of the dataset (usually from global.all)"),
@@ -65,4 +67,4 @@ class BopWriter(Module):
         return objects
 
     def run(self, context: RunContext) -> None:
-        context.outputs.append(self.writer.finalize())
+        context.outputs += self.writer.finalize()

@@ -6,12 +6,14 @@ from ..config.registry import register_module
 from ..config.schema import Param
 from ..errors import ConfigError
 from ..run.context import RunContext
-from .base import Module
+from .base import Module, Role
 
 
 @register_module("camera.CameraLoader")
 class CameraLoader(Module):
     """Sets the camera intrinsics and appends one keypoint per pose (OpenCV axes internally)."""
+
+    role = Role.LOADER
 
     params = (
         Param("intrinsics", "dict", {}, doc="resolution_x/y [px], cam_K (9 numbers) or fov [rad] + fov_axis, "

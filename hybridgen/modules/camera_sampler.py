@@ -13,7 +13,7 @@ from ..sampling.camera_checks import NoveltyCheck, ProximityChecks
 from ..sampling.camera_sampling import PoseChecks, SamplingReport, sample_camera_poses
 from ..sampling.getters import parse_selector
 from ..sampling.registry import DrawContext, draw
-from .base import Module
+from .base import Module, Role
 
 ENTRY_KEYS = ("number_of_samples", "location", "rotation", "cam2world_matrix", "source_frame",
               "proximity_checks", "excluded_objs_in_proximity_check", "check_if_objects_visible",
@@ -25,6 +25,8 @@ POSE_ONLY = ("location", "rotation", "cam2world_matrix", "source_frame")
 @register_module("camera.CameraSampler")
 class CameraSampler(Module):
     """Samples camera poses (BlenderProc's CameraSampler); each entry's samplers are drawn per try."""
+
+    role = Role.MANIPULATOR
 
     params = (
         Param("intrinsics", "dict", {}, doc="as camera.CameraLoader; omitted: keep the camera's"),

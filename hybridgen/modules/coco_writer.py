@@ -7,7 +7,7 @@ from ..io.coco_writer import (COLOR_FORMATS, DEFAULT_SUPERCATEGORY, IMAGE_NAMES,
                               CocoWriter, image_key_hint, load_label_mapping)
 from ..io.renamed_sink import renamed_sinks
 from ..run.context import RunContext
-from .base import Module
+from .base import Module, Role
 from .writer_support import refuse_work_units, require_planned
 
 
@@ -18,6 +18,8 @@ def _prefix_check(value: str) -> str | None:
 @register_module("writer.CocoAnnotationsWriter")
 class CocoAnnotationsWriter(Module):
     """Writes images/ and coco_annotations.json (RLE or polygon masks from the exact instance map)."""
+
+    role = Role.WRITER
 
     params = (
         Param("output_dir", "path", doc="dataset folder (usually from global.all)"),
@@ -62,4 +64,4 @@ class CocoAnnotationsWriter(Module):
         context.cleanups.append(self.writer.abort)
 
     def run(self, context: RunContext) -> None:
-        context.outputs.append(self.writer.finalize())
+        context.outputs += self.writer.finalize()

@@ -17,6 +17,7 @@ from ..config.registry import register_module
 from ..config.schema import Param, positive
 from ..run.context import RunContext
 from ..scene.mesh_object import MeshObject
+from .base import Role
 from .selecting import SelectingModule
 
 
@@ -49,6 +50,8 @@ def floor_faces(obj: MeshObject, angle_deg: float, height: float, upwards: bool)
 @register_module("object.FloorExtractor")
 class FloorExtractor(SelectingModule):
     """Splits the floor faces of the selected objects into a new object (BlenderProc's FloorExtractor)."""
+
+    role = Role.MANIPULATOR
 
     params = (
         Param("selector", "dict|list", doc="objects to split the floor from (getter.Entity conditions)"),

@@ -12,7 +12,7 @@ from ..run.context import RunContext
 from ..run.staged_output import DEFAULT_CHUNK_KEYPOINTS, JournalingWriter
 from ..run.units import SHARD_FOLDER
 from ..scene.scene import Scene
-from .base import Module
+from .base import Module, Role
 
 
 def _file_name_check(value: str) -> str | None:
@@ -32,6 +32,9 @@ def scene_records(scene: Scene) -> dict[str, list[dict[str, Any]]]:
 @register_module("writer.Hdf5Writer")
 class Hdf5Writer(Module):
     """Collects every renderer's keypoints (streamed while they render) and commits the file at this step."""
+
+    role = Role.WRITER
+    writes_unit_files = True
 
     params = (
         Param("output_dir", "path", doc="folder of the output file (usually from global.all)"),
@@ -78,8 +81,4 @@ class Hdf5Writer(Module):
         context.cleanups.append(self.writer.abort)
 
     def run(self, context: RunContext) -> None:
-        records = scene_records(context.scene)
-        if isinstance(self.writer, BlenderProcHdf5Writer):
-            context.outputs += self.writer.finalize(records, context.run_attributes())
-        else:
-            context.outputs.append(self.writer.finalize(records, context.run_attributes()))
+        context.outputs += self.writer.finalize(scene_records(context.scene), context.run_attributes())

@@ -4,6 +4,7 @@ from __future__ import annotations
 from ..config.registry import register_module
 from ..config.schema import Param
 from ..run.context import RunContext
+from .base import Role
 from .selecting import SelectingModule
 
 
@@ -11,6 +12,8 @@ from .selecting import SelectingModule
 class Hide(SelectingModule):
     """Removes the selected objects from the scene: no color, depth or segmentation sees them. Their instance
     ids are not given to other objects, so the remaining objects keep theirs."""
+
+    role = Role.MANIPULATOR
 
     params = (
         Param("selector", "dict|list", doc="objects to hide (getter.Entity conditions, random_samples)"),

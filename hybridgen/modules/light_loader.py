@@ -9,7 +9,7 @@ from ..errors import ConfigError
 from ..io.mesh_loader import object_pose
 from ..run.context import RunContext
 from ..scene.light import LIGHT_TYPES, Light
-from .base import Module
+from .base import Module, Role
 
 LIGHT_KEYS = {"type": str, "name": str, "location": list, "rotation": list, "color": list, "energy": float,
               "radius": float, "spot_size": float, "spot_blend": float, "size": float}
@@ -50,6 +50,8 @@ def light_from_entry(entry: Any, where: str, default_name: str = "light") -> Lig
 class LightLoader(Module):
     """Adds point, spot, sun and area lights; SUN/SPOT/AREA shine along their local -z axis."""
 
+    role = Role.LOADER
+
     params = (
         Param("lights", "list", sampleable=True,
               doc="entries {type: POINT|SUN|SPOT|AREA, name, location [m], rotation [rad], color [0..], energy [W; "
@@ -67,6 +69,8 @@ class LightLoader(Module):
 class LightSampler(LightLoader):
     """LightLoader whose entries are drawn ``number_of_samples`` times each (samplers give every light its
     own location, color, energy, ...)."""
+
+    role = Role.LOADER
 
     params = (
         *LightLoader.params,

@@ -4,7 +4,7 @@ from __future__ import annotations
 from ..config.registry import register_module
 from ..config.schema import Param
 from ..run.context import DEFAULT_SEED, RunContext
-from .base import Module
+from .base import Module, Role
 
 
 def _color_check(value: list) -> str | None:
@@ -15,6 +15,8 @@ def _color_check(value: list) -> str | None:
 @register_module("main.Initializer")
 class Initializer(Module):
     """Sets the root seed every random draw of the run derives from, and run-wide defaults."""
+
+    role = Role.SETUP
 
     params = (
         Param("seed", "int", DEFAULT_SEED, doc="root seed; same config + seed = same bytes",

@@ -11,12 +11,15 @@ from ..errors import InputError
 from ..io.mesh_loader import object_pose
 from ..run.context import RunContext
 from ..scene.frames import matrix_to_euler_xyz
+from .base import Role
 from .selecting import SelectingModule
 
 
 @register_module("manipulators.MaterialManipulator")
 class MaterialManipulator(SelectingModule):
     """Sets principled values (and textures, e.g. from sampler.Path over a folder) on selected objects."""
+
+    role = Role.MANIPULATOR
 
     params = (
         Param("selector", "dict|list", doc="which objects (getter.Entity conditions, random_samples)"),
@@ -38,6 +41,8 @@ class MaterialManipulator(SelectingModule):
 @register_module("manipulators.EntityManipulator")
 class EntityManipulator(SelectingModule):
     """Sets the pose (location, rotation, scale) and custom attributes of selected objects."""
+
+    role = Role.MANIPULATOR
 
     params = (
         Param("selector", "dict|list", doc="which objects (getter.Entity conditions, random_samples)"),

@@ -20,7 +20,7 @@ from ..config.schema import Param
 from ..errors import InputError
 from ..run.context import RunContext
 from ..scene.material import Material
-from .base import Module
+from .base import Module, Role
 
 _COLOR_FILE = re.compile(r".*_(2K_)?(Color|col|diffuse|albedo)\.(jpg|jpeg|png)$", re.IGNORECASE)
 
@@ -78,6 +78,8 @@ def cc_materials(folder: Path, used_assets: list[str]) -> list[LibraryMaterial]:
 @register_module("loader.CCMaterialLoader")
 class CCMaterialLoader(Module):
     """Loads cc0textures assets as materials into the run's material library (see the module doc)."""
+
+    role = Role.LOADER
 
     params = (
         Param("folder_path", "path", doc="folder with one sub-folder per texture asset"),

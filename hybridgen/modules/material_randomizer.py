@@ -20,6 +20,7 @@ from ..errors import InputError
 from ..run.context import RunContext
 from ..scene.material import Material
 from .material_library import LibraryMaterial, material_library, material_matches
+from .base import Role
 from .selecting import SelectingModule
 
 
@@ -42,6 +43,8 @@ def planar_uvs(vertices: np.ndarray) -> np.ndarray:
 @register_module("manipulators.MaterialRandomizer")
 class MaterialRandomizer(SelectingModule):
     """Replaces the materials of selected objects by random candidates (see the module doc)."""
+
+    role = Role.MANIPULATOR
 
     params = (
         Param("selector", "dict|list", doc="objects whose materials are replaced (getter.Entity)"),

@@ -7,7 +7,7 @@ from ..config.schema import Param
 from ..io.mesh_cache import load_objects_cached
 from ..io.mesh_loader import LOADERS, unique_blender_name
 from ..run.context import RunContext
-from .base import Module
+from .base import Module, Role
 from .placement import PLACEMENT_PARAMS, apply_placement, drawn_placement, placement_pose
 
 
@@ -17,6 +17,8 @@ class ObjLoader(Module):
 
     Without ``name``, objects get Blender's names; a name already in the scene gets Blender's ``.001`` suffix.
     """
+
+    role = Role.LOADER
 
     params = (
         Param("path", "path", doc=f"mesh file ({', '.join(LOADERS)}); relative to the working directory, else to "

@@ -14,6 +14,7 @@ from ..sampling.getters import parse_selector
 from ..io.mesh_loader import object_pose
 from ..sampling.placement import (PlacementResult, SurfaceProbe, check_spacing, rest_on_surface, sample_poses,
                                   scale_of)
+from .base import Role
 from .selecting import SelectingModule
 
 _COMMON = (
@@ -26,6 +27,7 @@ _COMMON = (
 
 
 class _Placer(SelectingModule):
+    role = Role.MANIPULATOR
     selector_key = "objects_to_sample"
 
     def _report(self, context: RunContext, result: PlacementResult) -> None:

@@ -15,6 +15,7 @@ from ..sampling.getters import parse_selector
 from ..sampling.swapping import ALIGN_MODES, SCALE_MODES, swap_objects
 from ..scene.frames import euler_xyz_to_matrix
 from ..scene.mesh_object import MeshObject
+from .base import Role
 from .selecting import SelectingModule
 
 POOL_KEYS = ("path", "category_id", "name", "up_axis", "attributes")
@@ -49,6 +50,8 @@ class ObjectSwapper(SelectingModule):
     mesh is used, their pose ignored; removed from the scene afterwards unless remove_pool_objects is
     false - their ids are then unused, never reassigned). A replacement's attributes: the candidate's
     (without those pool_objects selects by), the original's (copy_attributes) and swapped_from."""
+
+    role = Role.MANIPULATOR
 
     selector_key = "objects_to_swap"
     params = (

@@ -9,6 +9,7 @@ from ..physics.shapes import SHAPES, DecompositionSettings
 from ..physics.simulate import PhysicsSettings, simulate_physics
 from ..run.context import RunContext
 from ..sampling.getters import parse_selector
+from .base import Role
 from .selecting import SelectingModule
 
 
@@ -35,6 +36,8 @@ class PhysicsPositioning(SelectingModule):
     moved less than the thresholds during one check interval, or max_simulation_time. Logs
     'simulated X s, N objects at rest'. An object attribute collision_shape overrides the shape kind for
     that object (e.g. convex_decomposition for one concave mesh)."""
+
+    role = Role.MANIPULATOR
 
     selector_key = "active_objects"
     params = (

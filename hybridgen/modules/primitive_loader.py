@@ -5,7 +5,7 @@ from ..config.registry import register_module
 from ..config.schema import Param, positive
 from ..run.context import RunContext
 from ..scene.primitives import PRIMITIVES, make_primitive
-from .base import Module
+from .base import Module, Role
 from .placement import PLACEMENT_PARAMS, apply_placement, drawn_placement, placement_pose
 
 
@@ -20,6 +20,8 @@ def _color_check(value: object) -> str | None:
 @register_module("loader.PrimitiveLoader")
 class PrimitiveLoader(Module):
     """Adds one analytic shape; handy for quick scenes and tests without mesh files."""
+
+    role = Role.LOADER
 
     params = (
         Param("shape", "str", choices=tuple(PRIMITIVES), doc="which shape"),

@@ -10,7 +10,7 @@ from ..render.mitsuba_variant import choose_variant
 from ..render.path_trace import PathTraceSettings
 from ..render.render_color import render_color
 from ..run.context import RunContext
-from .base import Module
+from .base import Module, Role
 from .label_params import label_params, label_request
 
 
@@ -29,6 +29,9 @@ def _optional_positive(value: Any) -> str | None:
 @register_module("renderer.RgbRenderer")
 class RgbRenderer(Module):
     """Renders color for every keypoint; render_depth / render_normals / map_by add labels in the same pass."""
+
+    role = Role.RENDERER
+    path_traces = True
 
     params = (
         Param("samples", "int|null", None, "spp", "null: adaptive sampling up to 1024 spp (BlenderProc 2.8's "

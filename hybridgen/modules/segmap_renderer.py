@@ -5,13 +5,15 @@ from ..config.registry import register_module
 from ..io.renamed_sink import renamed_sinks
 from ..render.render_labels import render_labels
 from ..run.context import RunContext
-from .base import Module
+from .base import Module, Role
 from .label_params import label_params, label_request
 
 
 @register_module("renderer.SegMapRenderer")
 class SegMapRenderer(Module):
     """Rasterizes the selected label passes of every keypoint and streams them to the writers."""
+
+    role = Role.RENDERER
 
     params = label_params(depth=True, normals=True, map_by=["class", "instance"])
 

@@ -15,11 +15,13 @@ from ..config.registry import register_module
 from ..config.schema import Param
 from ..errors import ConfigError
 from ..run.context import RunContext
-from .base import Module
+from .base import Module, Role
 
 
 class StateWriter(Module):
     """Checks for a following writer.Hdf5Writer, which writes ``written_as``."""
+
+    role = Role.WRITER
 
     written_as: ClassVar[str] = ""
     params = (

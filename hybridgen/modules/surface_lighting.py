@@ -6,6 +6,7 @@ import dataclasses
 from ..config.registry import register_module
 from ..config.schema import Param
 from ..run.context import RunContext
+from .base import Role
 from .selecting import SelectingModule
 
 
@@ -17,6 +18,8 @@ def _color(value: list) -> str | None:
 @register_module("lighting.SurfaceLighting")
 class SurfaceLighting(SelectingModule):
     """Selected objects emit ``emission_color`` x ``emission_strength`` (radiance, both sides)."""
+
+    role = Role.MANIPULATOR
 
     params = (
         Param("selector", "dict|list", doc="which objects emit (getter.Entity conditions)"),

@@ -5,13 +5,15 @@ from ..config.notices import notice
 from ..config.registry import register_module
 from ..config.schema import Param
 from ..run.context import RunContext
-from .base import Module
+from .base import Module, Role
 
 
 @register_module("manipulators.WorldManipulator")
 class WorldManipulator(Module):
     """Sets the world background color and strength; ``cf_set_world_category_id`` is accepted with a notice
     (hybridgen's segmentation background is always 0)."""
+
+    role = Role.MANIPULATOR
 
     params = (
         Param("color", "list|null", None, sampleable=True, doc="background radiance, linear RGB(A)"),
