@@ -110,6 +110,8 @@ def load_objects_cached(path: str | Path, *, name: str | None = None, category_i
     for obj in objects:
         obj.local2world = base @ obj.local2world  # exact: a signed permutation (see _exact_under_any_pose)
         obj.category_id = category_id
+        if "source_path" in obj.attributes:  # the entry is keyed by content: it may come from another path
+            obj.attributes["source_path"] = str(file)
         obj.attributes.update(attributes or {})
     return objects
 
