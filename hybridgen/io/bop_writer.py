@@ -306,7 +306,7 @@ class BopWriter:
     def begin(self, n_keypoints: int, layouts: list[PassLayout], camera_records: dict[str, np.ndarray],
               attributes: dict[str, Any]) -> None:
         """Check the renderer's output and pick the annotated objects (once)."""
-        if "stereo_baseline" in attributes:
+        if any(layout.stereo for layout in layouts):
             raise InputError("writer.BopWriter does not support stereo renders; render the eyes as keypoints")
         if self.count and n_keypoints != self.count:
             raise InputError(f"renderers disagree on the keypoint count ({self.count} vs {n_keypoints})")
@@ -314,8 +314,9 @@ class BopWriter:
         for key in ("cam_K", "cam2world"):
             if key in camera_records:
                 self.camera[key] = np.asarray(camera_records[key], dtype=np.float64)
-        if "depth_background" in attributes:
-            self.depth_background = float(attributes["depth_background"])
+        for layout in layouts:
+            if layout.key == "depth" and layout.background is not None:
+                self.depth_background = layout.background
         self.intrinsics = self.scene.camera.intrinsics
         if self.objects is None:
             objects = self.select() if self.select is not None else list(self.scene.objects)
@@ -423,8 +424,9 @@ class BopWriter:
                     "instance_segmaps": all(f.masks_done for f in frames)}
         return [key for key in self.needed_keys() if not received[key]]
 
-    def finalize(self) -> Path:
-        """Rename every staged file and write the JSON files; returns the dataset folder."""
+    def finalize(self, records: dict[str, Any] | None = None,
+                 attributes: dict[str, Any] | None = None) -> list[Path]:
+        """Rename every staged file and write the JSON files; returns ``[the dataset folder]``."""
         if self.count == 0:
             raise InputError("no keypoint was rendered before the BOP writer")
         missing = self.missing_keys()
@@ -440,7 +442,7 @@ class BopWriter:
             write_file(path, text.encode("utf-8"), durable=True)
         self._amodal.release()
         self._unlock()
-        return self.dataset_dir
+        return [self.dataset_dir]
 
     def abort(self) -> None:
         """Delete everything staged (and the folders made for it); existing chunks stay as they were."""

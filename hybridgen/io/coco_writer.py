@@ -155,7 +155,7 @@ class CocoWriter:
     def begin(self, n_keypoints: int, layouts: list[PassLayout], camera_records: dict[str, np.ndarray],
               attributes: dict[str, Any]) -> None:
         """Check one renderer's keys (no stereo; the image key must be a uint8 image)."""
-        if "stereo_baseline" in attributes:
+        if any(layout.stereo for layout in layouts):
             raise InputError("writer.CocoAnnotationsWriter does not support stereo renders (as in BlenderProc); "
                              "render left and right as separate keypoints instead")
         self.count = max(self.count, n_keypoints)
@@ -190,8 +190,10 @@ class CocoWriter:
                 missing.append(key)
         return missing
 
-    def finalize(self) -> Path:
-        """Rename the staged images and write ``coco_annotations.json`` (merged with the existing one)."""
+    def finalize(self, records: dict[str, Any] | None = None,
+                 attributes: dict[str, Any] | None = None) -> list[Path]:
+        """Rename the staged images and write ``coco_annotations.json`` (merged with the existing one);
+        returns ``[the JSON file]``. Scene ``records`` and run ``attributes`` are not part of COCO."""
         if self.count == 0:
             raise InputError("no keypoint was rendered before the COCO writer")
         missing = self.missing_keys()
@@ -202,7 +204,7 @@ class CocoWriter:
         self._staged.commit()
         write_file(self.path, json.dumps(content).encode("utf-8"), durable=True)
         self._unlock()
-        return self.path
+        return [self.path]
 
     def abort(self) -> None:
         """Delete every staged image; the annotations file is untouched."""

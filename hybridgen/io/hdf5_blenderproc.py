@@ -97,7 +97,8 @@ class BlenderProcHdf5Writer:
         array = np.asarray(value)
         if key == "normals":
             cam2world = self._records["cam2world"][index]
-            array = encode_normals(array, cam2world, str(self._attributes.get("normals_space", "camera")))
+            frame = layout.frame if layout is not None and layout.frame else "camera"
+            array = encode_normals(array, cam2world, frame)
         h5.create_dataset(key, data=array, compression=self.compression, compression_opts=self.level)
 
     def end(self) -> None:
@@ -112,9 +113,8 @@ class BlenderProcHdf5Writer:
         for index in sorted(self._touched):
             with h5py.File(self._temp(index), "a") as h5:
                 if K is not None and cam2world is not None:
-                    height, width = next((layout.shape[-3:-1] if layout.key.startswith(("colors", "normals"))
-                                          else layout.shape[-2:] for layout in self._layouts.values()
-                                          if len(layout.shape) >= 2), (0, 0))
+                    height, width = next((layout.image_size for layout in self._layouts.values()
+                                          if layout.image_size is not None), (0, 0))
                     state = cam_state(K[index], cam2world[index], width, height)
                     h5.create_dataset("cam_states", data=np.bytes_(json.dumps(state)))
                 for key, value in (records or {}).items():

@@ -86,6 +86,7 @@ class Hdf5SingleFileWriter:
         self._file: h5py.File | None = None
         self._layouts: dict[str, PassLayout] = {}
         self._stored: dict[str, StoredPass] = {}
+        self._datasets: dict[str, h5py.Dataset] = {}  # looked up once: h5[key] costs ~70 us per call
         self._pool: ThreadPoolExecutor | None = None
         self._queue: queue.Queue[Any] = queue.Queue(maxsize=queue_size)
         self._thread: threading.Thread | None = None
@@ -98,13 +99,12 @@ class Hdf5SingleFileWriter:
         """Create the datasets of one renderer's passes and store the camera records (checked if present)."""
         self._drain()
         h5 = self._open()
-        keys = {layout.key for layout in layouts} | set(self._layouts)
-        background = float(attributes.get("depth_background", h5.attrs.get("depth_background", np.inf)))
         for layout in layouts:
             if layout.key in h5:
                 raise InputError(f"output key '{layout.key}' is produced twice (two renderers write it)")
-            self._create(h5, layout, n_keypoints, keys, background)
-            self._layouts[layout.key] = layout
+        self._layouts.update({layout.key: layout for layout in layouts})
+        for layout in layouts:
+            self._create(h5, layout, n_keypoints)
         for key, value in camera_records.items():
             if key in h5:
                 if not np.array_equal(h5[key][()], value):
@@ -136,8 +136,10 @@ class Hdf5SingleFileWriter:
         self._drain()
 
     # ------------------------------------------------------------------ commit
-    def finalize(self, records: dict[str, Any] | None = None, attributes: dict[str, Any] | None = None) -> Path:
-        """Add JSON records (e.g. ``object_states``) and attributes, close, and rename to the final name."""
+    def finalize(self, records: dict[str, Any] | None = None,
+                 attributes: dict[str, Any] | None = None) -> list[Path]:
+        """Add JSON records (e.g. ``object_states``) and attributes, close, and rename to the final name;
+        returns ``[path]``."""
         self._drain()
         h5 = self._open()
         for key, value in (records or {}).items():
@@ -149,7 +151,7 @@ class Hdf5SingleFileWriter:
         self._file = None
         self._shutdown_pool()
         commit(self._temp, self.path)
-        return self.path
+        return [self.path]
 
     def abort(self) -> None:
         """Stop writing and delete the temporary file; nothing appears under the final name."""
@@ -180,12 +182,15 @@ class Hdf5SingleFileWriter:
             self._pool.shutdown(wait=True)
             self._pool = None
 
-    def _create(self, h5: h5py.File, layout: PassLayout, n: int, keys: set[str], depth_background: float) -> None:
+    def _create(self, h5: h5py.File, layout: PassLayout, n: int) -> None:
         if layout.dtype == "json":
-            h5.create_dataset(layout.key, shape=(n,), dtype=h5py.string_dtype(), track_times=False)
+            self._datasets[layout.key] = h5.create_dataset(layout.key, shape=(n,), dtype=h5py.string_dtype(),
+                                                           track_times=False)
             return
-        stored = plan_storage(layout, compact=self.encoding == "compact", keys=keys,
-                              depth_background=depth_background)
+        depth = self._layouts.get("depth")  # distance is derived from depth when its background allows
+        background = depth.background if depth is not None and depth.background is not None else np.inf
+        stored = plan_storage(layout, compact=self.encoding == "compact", keys=set(self._layouts),
+                              depth_background=background)
         self._stored[layout.key] = stored
         options: dict[str, Any] = {}
         if stored.encode is None:  # derived on read: no chunk is ever written; a plain read gives NaN
@@ -198,6 +203,7 @@ class Hdf5SingleFileWriter:
                                  chunks=(1, *stored.shape), track_times=False, **options)
         for name, value in stored.attrs.items():
             dset.attrs[name] = value
+        self._datasets[layout.key] = dset
 
     def _chunk(self, key: str, index: int, value: Any) -> np.ndarray | bytes | None:
         """Keypoint ``index``'s stored chunk of ``key`` (runs on the pool): the encoded array, or for gzip
@@ -222,24 +228,28 @@ class Hdf5SingleFileWriter:
                 return
             if self._error is not None:
                 continue  # keep draining so producers never block
-            index, jobs = item
             try:
-                for key, job in jobs.items():
-                    dset = h5[key]
-                    if not isinstance(job, Future):
-                        dset[index] = json.dumps(job)
-                        continue
-                    chunk = job.result()
-                    if chunk is None:
-                        continue
-                    if isinstance(chunk, bytes) or self.compression == "none":
-                        # gzip: deflated bytes; none: the array's bytes are the chunk as HDF5 stores it
-                        dset.id.write_direct_chunk((index,) + (0,) * (dset.ndim - 1), chunk)
-                    else:
-                        dset[index] = chunk
-                self.frames_written += 1
+                self._store(h5, *item)
             except BaseException as exc:  # surfaced to the producer thread
                 self._error = exc
+
+    def _store(self, h5: h5py.File, index: int, jobs: dict[str, Any]) -> None:
+        """Store keypoint ``index``: per key a JSON value, or its chunk (a Future of it, or the chunk itself:
+        bytes, an array, None for a pass derived on read)."""
+        for key, job in jobs.items():
+            dset = self._datasets[key]
+            if self._layouts[key].dtype == "json":
+                dset[index] = json.dumps(job)
+                continue
+            chunk = job.result() if isinstance(job, Future) else job
+            if chunk is None:
+                continue
+            if isinstance(chunk, bytes) or self.compression == "none":
+                # gzip: deflated bytes; none: the array's bytes are the chunk as HDF5 stores it
+                dset.id.write_direct_chunk((index,) + (0,) * len(self._stored[key].shape), chunk)
+            else:
+                dset[index] = chunk
+        self.frames_written += 1
 
     def _drain(self) -> None:
         if self._thread is not None:

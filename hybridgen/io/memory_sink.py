@@ -1,6 +1,7 @@
 """A frame sink that keeps every keypoint's values in memory (for notebooks, tests, custom pipelines)."""
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -30,6 +31,16 @@ class MemorySink:
 
     def end(self) -> None:
         """Nothing to flush."""
+
+    def finalize(self, records: dict[str, Any] | None = None,
+                 attributes: dict[str, Any] | None = None) -> list[Path]:
+        """Keeps ``records`` (e.g. ``object_states``) and ``attributes``; writes no file."""
+        self.records.update(records or {})
+        self.attributes.update(attributes or {})
+        return []
+
+    def abort(self) -> None:
+        """Nothing to delete."""
 
     def stacked(self, key: str) -> np.ndarray:
         """All keypoints' ``key`` as one array with a leading keypoint axis."""

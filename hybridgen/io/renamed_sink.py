@@ -4,6 +4,7 @@ writer of the run sees the pass under the new name, as BlenderProc's writers do.
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
@@ -54,8 +55,12 @@ class RenamedSink:
     def end(self) -> None:
         self.sink.end()
 
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self.sink, name)
+    def finalize(self, records: dict[str, Any] | None = None,
+                 attributes: dict[str, Any] | None = None) -> list[Path]:
+        return self.sink.finalize(records, attributes)
+
+    def abort(self) -> None:
+        self.sink.abort()
 
 
 def renamed_sinks(sinks: list[FrameSink], names: Mapping[str, str] | None) -> list[FrameSink]:

@@ -122,7 +122,7 @@ class StereoProducer:
         self.producers, self.baseline, self.scene = producers, float(baseline), scene
 
     def layouts(self) -> list[PassLayout]:
-        return [layout if layout.dtype == "json" else replace(layout, shape=(2, *layout.shape))
+        return [layout if layout.dtype == "json" else replace(layout, shape=(2, *layout.shape), stereo=True)
                 for p in self.producers for layout in p.layouts()]
 
     def attributes(self) -> dict[str, Any]:

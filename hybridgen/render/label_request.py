@@ -55,8 +55,10 @@ class LabelRequest:
         for flag, key in ((self.depth, "depth"), (self.distance, "distance"), (self.normals, "normals")):
             if flag:
                 spec = PASSES[key]
+                meaning = ({"frame": self.normals_space} if key == "normals"
+                           else {"units": "m", "background": float(self.depth_background)})
                 out.append(PassLayout(key, spec.dtype, (height, width, spec.channels) if spec.channels
-                                      else (height, width)))
+                                      else (height, width), **meaning))
         for attribute in self.segmap_attributes():
             out.append(PassLayout(f"{attribute}_segmaps", "int32", (height, width)))
         if self.wants_instances:

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import json
 import shutil
-from concurrent.futures import Future
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -58,13 +58,13 @@ class JournalingWriter(Hdf5SingleFileWriter):
     def begin(self, n_keypoints: int, layouts: list[PassLayout], camera_records: dict[str, np.ndarray],
               attributes: dict[str, Any]) -> None:
         self._journal["begins"].append({
-            "layouts": [[lay.key, lay.dtype, list(lay.shape), list(lay.value_range) if lay.value_range else None]
-                        for lay in layouts],
+            "layouts": [asdict(layout) for layout in layouts],
             "records": list(camera_records),
             "attributes": {key: canonical(value) for key, value in attributes.items()}})
         super().begin(n_keypoints, layouts, camera_records, attributes)
 
-    def finalize(self, records: dict[str, Any] | None = None, attributes: dict[str, Any] | None = None) -> Path:
+    def finalize(self, records: dict[str, Any] | None = None,
+                 attributes: dict[str, Any] | None = None) -> list[Path]:
         self._journal["records"] = list(records or {})
         self._journal["attributes"] = [key for key in (attributes or {}) if key not in UNIT_ATTRIBUTES]
         return super().finalize(records, {**(attributes or {}), JOURNAL_ATTR: json.dumps(self._journal)})
@@ -74,32 +74,40 @@ class _ReplayWriter(Hdf5SingleFileWriter):
     """Stores chunks that are already encoded and compressed (copied from parts) in keypoint order."""
 
     def write_stored(self, index: int, jobs: dict[str, Any]) -> None:
-        """Queue keypoint ``index``: per key the stored chunk bytes (None: no chunk) or a JSON value."""
-        self._raise_worker_error()
-        queued: dict[str, Any] = {}
-        for key, value in jobs.items():
-            if self._layouts[key].dtype == "json":
-                queued[key] = value
-            else:
-                done: Future = Future()
-                done.set_result(value)
-                queued[key] = done
-        self._queue.put((index, queued))
+        """Store keypoint ``index`` now, in this thread: per key the stored chunk bytes (None: no chunk) or a
+        JSON value - the calls the writer thread makes for a direct write, in the same order (no encoding,
+        no compression, no hand-over between threads: a raw copy)."""
+        assert self._file is not None, "write_stored() before begin()"
+        self._store(self._file, index, jobs)
 
 
-def _layout(entry: list[Any]) -> PassLayout:
-    key, dtype, shape, value_range = entry
-    return PassLayout(key, dtype, tuple(shape), tuple(value_range) if value_range is not None else None)
+def _layout(entry: dict[str, Any]) -> PassLayout:
+    value_range = entry["value_range"]
+    return PassLayout(**{**entry, "shape": tuple(entry["shape"]),
+                         "value_range": tuple(value_range) if value_range is not None else None})
 
 
-def _stored_chunk(dset: h5py.Dataset, local: int) -> bytes | None:
-    offset = (local,) + (0,) * (dset.ndim - 1)
-    if dset.id.get_chunk_info_by_coord(offset).byte_offset is None:
-        return None  # never written (a pass derived on read)
-    mask, data = dset.id.read_direct_chunk(offset)
-    if mask != 0:
-        raise InputError(f"'{dset.file.filename}': chunk {local} of '{dset.name}' has filter mask {mask}")
-    return data
+class _StoredChunks:
+    """Reads one dataset's stored (compressed) chunks of a part as they lie on disk."""
+
+    def __init__(self, dset: h5py.Dataset) -> None:
+        self.dset = dset
+        self.dsid = dset.id
+        self.tail = (0,) * (dset.ndim - 1)
+        self.derived = self.dsid.get_num_chunks() == 0  # a pass derived on read: no chunk is ever written
+
+    def __getitem__(self, local: int) -> bytes | None:
+        if self.derived:
+            return None
+        try:
+            mask, data = self.dsid.read_direct_chunk((local, *self.tail))
+        except (KeyError, RuntimeError, OSError):
+            raise InputError(f"'{self.dset.file.filename}': chunk {local} of '{self.dset.name}' is missing; "
+                             "rerun with --restart") from None
+        if mask != 0:
+            raise InputError(f"'{self.dset.file.filename}': chunk {local} of '{self.dset.name}' has filter mask "
+                             f"{mask}")
+        return data
 
 
 def _read_journal(part: h5py.File) -> dict[str, Any]:
@@ -122,13 +130,13 @@ def _read_all(parts: list[Path], key: str) -> np.ndarray:
 
 
 def _replay_keypoints(writer: _ReplayWriter, part: h5py.File, first: int, layouts: list[PassLayout]) -> int:
-    """Queue every keypoint of ``part`` (stored chunks, JSON values) as keypoints ``first...``; their count."""
-    dsets = [(layout, part[layout.key]) for layout in layouts]
+    """Store every keypoint of ``part`` (stored chunks, JSON values) as keypoints ``first...``; their count."""
+    sources: list[tuple[str, Any]] = [
+        (layout.key, [_text_value(v) for v in part[layout.key][()]] if layout.dtype == "json"
+         else _StoredChunks(part[layout.key])) for layout in layouts]
     count = len(part["keypoint_index"])
     for local in range(count):
-        writer.write_stored(first + local, {
-            layout.key: _text_value(dset[local]) if layout.dtype == "json" else _stored_chunk(dset, local)
-            for layout, dset in dsets})
+        writer.write_stored(first + local, {key: source[local] for key, source in sources})
     return count
 
 
@@ -161,7 +169,8 @@ def consolidate(target: Path, parts: list[Path]) -> Path:
                 with h5py.File(path, "r") as part:
                     first += _replay_keypoints(writer, part, first, layouts)
             writer.end()
-        return writer.finalize(scene_records, {key: run_attributes[key] for key in journal["attributes"]})
+        (merged,) = writer.finalize(scene_records, {key: run_attributes[key] for key in journal["attributes"]})
+        return merged
     except BaseException:
         writer.abort()
         raise
