@@ -84,7 +84,6 @@ UNAVAILABLE = {
     "camera.ReplicaCameraSampler": "samples inside Replica scenes; use camera.CameraSampler with proximity_checks",
     "loader.AMASSLoader": "posing SMPL bodies needs the AMASS data and the SMPL body model (licensed, not "
                           "distributable); export posed bodies to OBJ and load them with loader.ObjLoader",
-    "loader.HavenEnvironmentLoader": "use main.Initializer's hdri_path with the .hdr/.exr file instead",
     "loader.RockEssentialsRockLoader": "reads Blender .blend rock packs; " + _EXPORT,
     "constructor.RockEssentialsGroundConstructor": "builds Blender node-displaced ground; use "
                                                    "loader.PrimitiveLoader (plane) with a texture",

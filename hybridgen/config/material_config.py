@@ -6,13 +6,15 @@ import math
 from typing import Any
 
 from ..errors import ConfigError
-from ..scene.material import Material
+from ..scene.material import ALPHA_MODES, TEXTURE_SLOTS, Material
 from .paths import locate_input
 from .schema import closest
 
 _UNIT_KEYS = ("roughness", "metallic", "specular", "transmission", "alpha")
 _COLOR_KEYS = {"base_color": (3, 4), "emission": (3, 3)}
-KNOWN_KEYS = (*_UNIT_KEYS, *_COLOR_KEYS, "emission_strength", "ior", "base_color_texture", "name")
+_TEXTURE_KEYS = TEXTURE_SLOTS
+KNOWN_KEYS = (*_UNIT_KEYS, *_COLOR_KEYS, "emission_strength", "ior", *_TEXTURE_KEYS, "name", "alpha_mode",
+              "normal_y_down", "displacement_scale")
 
 
 def _number(value: Any, key: str) -> float:
@@ -25,7 +27,8 @@ def apply_material_config(material: Material, config: dict[str, Any]) -> Materia
     """A copy of ``material`` with the config's values; errors name ``material.<key>``.
 
     Overrides replace what they name: a ``base_color`` without a ``base_color_texture`` also removes the
-    mesh's own base-color texture (as setting a value on a linked input in BlenderProc unlinks the texture).
+    mesh's own base-color texture (as setting a value on a linked input in BlenderProc unlinks the texture);
+    likewise ``roughness``, ``metallic`` and ``alpha`` remove their maps unless the map is given too.
     """
     values: dict[str, Any] = {}
     for key, value in config.items():
@@ -52,6 +55,16 @@ def apply_material_config(material: Material, config: dict[str, Any]) -> Materia
             if number < 0:
                 raise ConfigError(f"must be >= 0, got {value!r}", key=f"material.{key}")
             values[key] = number
+        elif key == "displacement_scale":
+            values[key] = _number(value, key)
+        elif key == "normal_y_down":
+            if not isinstance(value, bool):
+                raise ConfigError(f"must be true or false, got {value!r}", key=f"material.{key}")
+            values[key] = value
+        elif key == "alpha_mode":
+            if value not in ALPHA_MODES:
+                raise ConfigError(f"must be one of {', '.join(ALPHA_MODES)}, got {value!r}", key=f"material.{key}")
+            values[key] = value
         elif key == "ior":
             number = _number(value, key)
             if not 1.0 <= number <= 5.0:
@@ -60,7 +73,8 @@ def apply_material_config(material: Material, config: dict[str, Any]) -> Materia
         else:
             if not isinstance(value, str) or not value:
                 raise ConfigError(f"must be a non-empty string, got {value!r}", key=f"material.{key}")
-            values[key] = locate_input(value) if key == "base_color_texture" else value
-    if "base_color" in values and "base_color_texture" not in values:
-        values["base_color_texture"] = None
+            values[key] = locate_input(value) if key in _TEXTURE_KEYS else value
+    for key in ("base_color", "roughness", "metallic", "alpha"):
+        if key in values and f"{key}_texture" not in values:
+            values[f"{key}_texture"] = None
     return dataclasses.replace(material, **values)

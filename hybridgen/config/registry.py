@@ -39,6 +39,7 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.state_writers",
     "hybridgen.modules.bop_loader",
     "hybridgen.modules.material_library",
+    "hybridgen.modules.haven_loaders",
     "hybridgen.modules.material_randomizer",
     "hybridgen.modules.hide_objects",
 )

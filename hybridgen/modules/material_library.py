@@ -1,29 +1,27 @@
 """Materials a run keeps without an object: the library ``loader.CCMaterialLoader`` fills and
 ``manipulators.MaterialRandomizer`` draws from (BlenderProc's materials that exist before they are used).
 
-``loader.CCMaterialLoader`` reads a cc0textures-style folder: one sub-folder per asset holding
-``<asset>_2K_Color.jpg`` (or any ``*_Color.*`` / ``*_col.*`` image). Each asset becomes a principled material
-named after the folder, its color image as ``base_color_texture``, kept with the custom properties
-``is_cc_texture: true`` and ``asset_path`` that getter.Material conditions (``cp_is_cc_texture``) select by.
-Roughness, normal and displacement maps are not used by hybridgen's principled material (one notice).
+``loader.CCMaterialLoader`` reads an ambientCG (cc0textures) folder: one sub-folder per asset holding
+``<asset>_2K_Color.jpg`` and its PBR maps (roughness, metalness, opacity, normal, displacement - see
+:mod:`hybridgen.io.texture_sets` for the names). Each asset becomes a principled material named after the
+folder, kept with the custom properties ``is_cc_texture: true`` and ``asset_path`` that getter.Material
+conditions (``cp_is_cc_texture``) select by. ``loader.HavenMaterialLoader``
+(:mod:`hybridgen.modules.haven_loaders`) fills the same library from Poly Haven folders.
 """
 from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
-from ..config.notices import notice
 from ..config.registry import register_module
 from ..config.schema import Param
 from ..errors import InputError
+from ..io.texture_sets import cc_material
 from ..run.context import RunContext
 from ..scene.material import Material
 from .base import Module, Role
-
-_COLOR_FILE = re.compile(r".*_(2K_)?(Color|col|diffuse|albedo)\.(jpg|jpeg|png)$", re.IGNORECASE)
-
 
 @dataclass
 class LibraryMaterial:
@@ -59,20 +57,27 @@ def material_matches(entry: LibraryMaterial, conditions: Any) -> bool:
     return True
 
 
-def cc_materials(folder: Path, used_assets: list[str]) -> list[LibraryMaterial]:
-    """One material per asset folder of ``folder`` whose name starts with one of ``used_assets`` (all if empty)."""
+def asset_materials(folder: Path, used_assets: list[str], read: Callable[[Path], Material | None],
+                    properties: dict[str, Any]) -> list[LibraryMaterial]:
+    """One material per asset sub-folder of ``folder`` that ``read`` understands, keeping only assets whose
+    names start with one of ``used_assets`` (all if empty; compared as BlenderProc does: case and spaces
+    ignored)."""
     if not folder.is_dir():
-        raise InputError(f"cc texture folder not found: '{folder}'")
+        raise InputError(f"texture folder not found: '{folder}'")
+    wanted = [a.lower().replace(" ", "") for a in used_assets]
     materials = []
     for asset in sorted(p for p in folder.iterdir() if p.is_dir()):
-        if used_assets and not any(asset.name.startswith(prefix) for prefix in used_assets):
+        if wanted and not any(asset.name.lower().startswith(prefix) for prefix in wanted):
             continue
-        colors = sorted(p for p in asset.iterdir() if _COLOR_FILE.match(p.name))
-        if not colors:
-            continue
-        materials.append(LibraryMaterial(Material(name=asset.name, base_color_texture=str(colors[0])),
-                                         {"is_cc_texture": True, "asset_path": str(asset)}))
+        material = read(asset)
+        if material is not None:
+            materials.append(LibraryMaterial(material, {**properties, "asset_path": str(asset)}))
     return materials
+
+
+def cc_materials(folder: Path, used_assets: list[str]) -> list[LibraryMaterial]:
+    """One material per ambientCG asset folder of ``folder`` (see :func:`asset_materials`)."""
+    return asset_materials(folder, used_assets, cc_material, {"is_cc_texture": True})
 
 
 @register_module("loader.CCMaterialLoader")
@@ -98,6 +103,4 @@ class CCMaterialLoader(Module):
         for entry in materials:
             for key, value in self.config["add_custom_properties"].items():
                 entry.properties[key[3:] if key.startswith("cp_") else key] = value
-        notice("only the color image of each asset is used (hybridgen's principled material has no roughness, "
-               "normal or displacement maps)", module=self.module_name, index=self.index, key="folder_path")
         material_library(context).extend(materials)

@@ -84,7 +84,7 @@ class MaterialRandomizer(SelectingModule):
                 continue
             pick = shared if self.config["mode"] == "once_for_all" else \
                 candidates[int(context.rng.integers(len(candidates)))]
-            if pick.base_color_texture is not None and obj.uvs is None:
+            if pick.uses_uvs and obj.uvs is None:
                 obj.uvs = planar_uvs(obj.vertices)
                 notice(f"object '{obj.name}' has no UVs: the texture is projected along its local Z axis",
                        module=self.module_name, index=self.index, key="selector")

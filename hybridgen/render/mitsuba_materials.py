@@ -10,6 +10,9 @@ The BSDF is built inside out:
 - ``bumpmap`` for a displacement map: shading normals of the surface displaced by h x scale metres (the
   texture's gradient with respect to UV times ``displacement_scale``; the 0.5 mid level of Blender's node
   does not change a gradient);
+- both without Mitsuba's default bump-terminator shadowing (Estevez et al. 2019), so a mapped normal shades
+  exactly as the analytic tilted normal (Cycles softens diffuse closures with Chiang et al. 2019's term
+  instead: the two differ only where light grazes the geometric surface);
 - ``twosided`` for opaque materials (Mitsuba's BSDFs are one-sided; Blender's are not);
 - ``mask`` for alpha < 1 or an alpha texture (fractional opacity; CLIP materials get their alpha
   thresholded at 0.5 per texel).
@@ -119,11 +122,12 @@ def bsdf_dict(material: Material, owner: str) -> dict[str, Any]:
         else:
             bsdf["specular"] = float(material.specular)
     if material.normal_texture is not None:
-        bsdf = {"type": "normalmap", "bsdf": bsdf,
+        bsdf = {"type": "normalmap", "bsdf": bsdf, "use_shadowing_function": False,
                 "normalmap": data_texture(material.normal_texture, owner, "normal_texture", channels=3,
                                           invert_green=material.normal_y_down)}
     if material.displacement_texture is not None and material.displacement_scale != 0:
         bsdf = {"type": "bumpmap", "bsdf": bsdf, "scale": float(material.displacement_scale),
+                "use_shadowing_function": False,
                 "arbitrary": data_texture(material.displacement_texture, owner, "displacement_texture")}
     if material.transmission == 0:
         # Mitsuba's opaque BSDFs are one-sided; Blender (and real meshes with mixed windings) need both sides.

@@ -128,7 +128,10 @@ def test_cc_materials_and_randomize_materials_once_for_all(tmp_path):
     assert context.scene.by_name("other").material.name == "plane_material"
     for obj in ground:  # Blender's plane UVs: [0, 1] over the plane
         assert obj.uvs is not None and obj.uvs.min() == 0 and obj.uvs.max() == 1
-    assert any("only the color image" in line for line in lines)
+    assert not any("only the color image" in line for line in lines)  # every map is read now
+    picked = ground[0].material
+    assert picked.base_color_texture.endswith(f"{picked.name}_2K_Color.jpg") and picked.specular == 0.333
+    assert picked.roughness_texture is None and picked.normal_texture is None  # these assets have no maps
 
 
 def test_world_manipulator_state_writers_and_replacer(tmp_path):

@@ -1,0 +1,85 @@
+"""Poly Haven assets: ``loader.HavenEnvironmentLoader`` (an HDRI as the world) and ``loader.HavenMaterialLoader``
+(PBR texture sets into the material library).
+
+HDRIs are read from BlenderProc's download layout, ``<data_path>/hdris/<name>/<name>_<res>.hdr``: every
+``.hdr`` (and ``.exr``) one folder below ``hdris``, sorted by path, one drawn with the run's random generator
+(BlenderProc draws with Python's ``random`` from the same sorted list). The world then emits the HDRI
+times ``strength``, turned by ``rotation`` radians about world +Z (hybridgen keys; BlenderProc's loader
+has neither, its world strength is 1 and the map unturned).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..config.registry import register_module
+from ..config.schema import Param
+from ..errors import InputError
+from ..io.texture_sets import haven_material
+from ..run.context import RunContext
+from .base import Module, Role
+from .material_library import asset_materials, material_library
+
+HDRI_SUFFIXES = (".hdr", ".exr")
+
+
+def haven_hdris(data_path: Path) -> list[Path]:
+    """The HDRI files of a Poly Haven download folder, sorted; a one-line error for a wrong folder."""
+    if not data_path.is_dir():
+        raise InputError(f"Haven data folder not found: '{data_path}'")
+    hdris = data_path / "hdris"
+    if not hdris.is_dir():
+        raise InputError(f"'{data_path}' has no 'hdris' folder (expected <data_path>/hdris/<name>/<name>.hdr, "
+                         "BlenderProc's download layout)")
+    files = sorted(p for p in hdris.glob("*/*") if p.is_file() and p.suffix.lower() in HDRI_SUFFIXES)
+    if not files:
+        raise InputError(f"no .hdr/.exr file in the sub-folders of '{hdris}'")
+    return files
+
+
+@register_module("loader.HavenEnvironmentLoader")
+class HavenEnvironmentLoader(Module):
+    """Sets the world to a randomly drawn HDRI of a Poly Haven folder (see the module doc)."""
+
+    role = Role.LOADER
+
+    params = (
+        Param("data_path", "path", "resources/haven", doc="Poly Haven download folder holding 'hdris/'"),
+        Param("strength", "float", 1.0, doc="multiplies the HDRI's radiance", sampleable=True),
+        Param("rotation", "float", 0.0, "rad", "turn of the map about world +Z", sampleable=True),
+    )
+
+    def run(self, context: RunContext) -> None:
+        files = haven_hdris(Path(self.config["data_path"]))
+        strength = float(self.value(context, "strength"))
+        if strength < 0:
+            raise InputError(f"{self.module_name}: strength must be >= 0, got {strength}")
+        world = context.scene.world
+        world.hdri_path = str(files[int(context.rng.integers(len(files)))])
+        world.strength = strength
+        world.hdri_rotation = float(self.value(context, "rotation"))
+
+
+@register_module("loader.HavenMaterialLoader")
+class HavenMaterialLoader(Module):
+    """Loads Poly Haven texture sets (``<asset>/<asset>_diff_2k.jpg`` + maps, see
+    :mod:`hybridgen.io.texture_sets`) into the run's material library, with ``is_haven_texture: true``."""
+
+    role = Role.LOADER
+
+    params = (
+        Param("folder_path", "path", "resources/haven/textures", doc="folder with one sub-folder per texture asset"),
+        Param("used_assets", "list", [], doc="only assets whose names start with one of these"),
+        Param("preload", "bool", False, doc="BlenderProc's lazy loading switch; hybridgen reads images when "
+              "rendering either way"),
+        Param("fill_used_empty_materials", "bool", False, doc="BlenderProc's two-phase loading switch; hybridgen "
+              "loads everything at once"),
+        Param("add_custom_properties", "dict", {}, doc="extra properties of every loaded material (cp_* keys)"),
+    )
+
+    def run(self, context: RunContext) -> None:
+        extra = {k[3:] if k.startswith("cp_") else k: v for k, v in self.config["add_custom_properties"].items()}
+        materials = asset_materials(Path(self.config["folder_path"]), [str(a) for a in self.config["used_assets"]],
+                                    haven_material, {"is_haven_texture": True, **extra})
+        if not materials:
+            raise InputError(f"no texture asset (<asset>/<asset>_diff_2k.jpg) in '{self.config['folder_path']}'")
+        material_library(context).extend(materials)
