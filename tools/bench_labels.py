@@ -37,7 +37,7 @@ def _ours_worker(conn: Any) -> None:
 
     import hybridgen as hg
     from hybridgen.render.keypoint_loop import run_keypoints
-    from hybridgen.render.passes import PASSES
+    from hybridgen.render.raster_passes import depth as depth_pass
     from hybridgen.render.render_labels import LabelProducer
 
     request = hg.LabelRequest(depth=True, normals=True, map_by=["class", "instance"])
@@ -89,7 +89,7 @@ def _ours_worker(conn: Any) -> None:
                 conn.send((len(keypoints) / elapsed, path.stat().st_size / len(keypoints)))
         elif kind == "frame":
             raw = view.render_raw(keypoints[0])
-            conn.send((PASSES["depth"].compute(raw), raw.instance.astype(np.int32)))
+            conn.send((depth_pass(raw), raw.instance.astype(np.int32)))
         elif kind == "breakdown":  # serial, no pipelining: where one keypoint's time goes
             tables = request.tables(view)
             stages: dict[str, list[float]] = {"submit": [], "raster wait": [], "readback": [], "passes": []}

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from ..scene.camera import Intrinsics
 from ..scene.mesh_object import MeshObject
 from .projection import projection_from_K
 from .raster import RasterView
@@ -61,23 +62,24 @@ class AlbedoPass:
             vao = ctx.vertex_array(self.program, content, index_buffer=gpu.indices, index_element_size=4)
             self._resources.append(vao)
             self._draws.append((vao, texture, obj))
-        self._fbo: Any = None
+        self._fbos: dict[tuple[int, int], Any] = {}  # one per image size (labels, supersampled guides)
 
-    def render(self, cam2world: np.ndarray, background: tuple[float, float, float] | None = None) -> np.ndarray:
-        """(H, W, 3) float32 linear albedo of one keypoint (OpenCV-axes ``cam2world``)."""
+    def render(self, cam2world: np.ndarray, background: tuple[float, float, float] | None = None,
+               intrinsics: Intrinsics | None = None) -> np.ndarray:
+        """(H, W, 3) float32 linear albedo of one keypoint (OpenCV-axes ``cam2world``) with ``intrinsics``
+        (default: the scene camera's)."""
         import moderngl
 
-        intr = self.view.scene.camera.intrinsics
+        intr = intrinsics or self.view.scene.camera.intrinsics
         ctx = self.view.ctx
         size = (intr.width, intr.height)
-        if self._fbo is None or self._fbo.size != size:
-            if self._fbo is not None:
-                self._fbo.release()
-            self._fbo = ctx.framebuffer(color_attachments=[ctx.renderbuffer(size, 4, dtype="f4")],
-                                        depth_attachment=ctx.depth_renderbuffer(size))
+        if size not in self._fbos:
+            self._fbos[size] = ctx.framebuffer(color_attachments=[ctx.renderbuffer(size, 4, dtype="f4")],
+                                               depth_attachment=ctx.depth_renderbuffer(size))
+        fbo = self._fbos[size]
         bg = background if background is not None else self.view.scene.world.color
-        self._fbo.use()
-        self._fbo.clear(float(bg[0]), float(bg[1]), float(bg[2]), 1.0, depth=1.0)
+        fbo.use()
+        fbo.clear(float(bg[0]), float(bg[1]), float(bg[2]), 1.0, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.disable(moderngl.CULL_FACE)
         world2cam = np.linalg.inv(cam2world)
@@ -92,7 +94,7 @@ class AlbedoPass:
                 self.program["u_texture"].value = 0
             vao.render()
         out = np.empty((intr.height, intr.width, 4), dtype=np.float32)
-        self._fbo.read_into(out, components=4, dtype="f4")
+        fbo.read_into(out, components=4, dtype="f4")
         return np.ascontiguousarray(out[..., :3])
 
     def release(self) -> None:
@@ -102,5 +104,8 @@ class AlbedoPass:
         if self.program is not None:
             self.program.release()
             self.program = None
-        if self._fbo is not None:
-            self._fbo.release()
+        for fbo in self._fbos.values():
+            for attachment in (*fbo.color_attachments, fbo.depth_attachment):
+                attachment.release()
+            fbo.release()
+        self._fbos.clear()

@@ -11,28 +11,24 @@ are not renormalised: at a silhouette the shorter mixed vector is what the pixel
 """
 from __future__ import annotations
 
-import copy
-
 import numpy as np
 
 from ..scene.scene import Scene
-from .albedo_pass import AlbedoPass
-from .raster import RasterView
+from .keypoint_frame import SceneRaster
 
 DEFAULT_FACTOR = 3
 
 
 class DenoiseGuides:
-    """Box-filtered linear albedo and camera-space normals (float32 H x W x 3 each) of ``scene``'s camera."""
+    """Box-filtered linear albedo and camera-space normals (float32 H x W x 3 each) of ``scene``'s camera,
+    drawn with ``raster`` (the scene's shared raster view, left open) or a view built here."""
 
-    def __init__(self, scene: Scene, factor: int = DEFAULT_FACTOR) -> None:
+    def __init__(self, scene: Scene, factor: int = DEFAULT_FACTOR, raster: SceneRaster | None = None) -> None:
         intr = scene.camera.intrinsics
         self.factor, self.width, self.height = int(factor), intr.width, intr.height
-        fine = copy.copy(scene)  # shares objects and lights; only the camera differs
-        fine.camera = copy.copy(scene.camera)
-        fine.camera.intrinsics = intr.resized(intr.width * self.factor, intr.height * self.factor)
-        self.raster = RasterView(fine)
-        self.albedo = AlbedoPass(self.raster)
+        self.fine = intr.resized(intr.width * self.factor, intr.height * self.factor)
+        self._own = raster is None
+        self.raster = raster or SceneRaster(scene)
 
     def _box(self, image: np.ndarray) -> np.ndarray:
         f = self.factor
@@ -41,10 +37,11 @@ class DenoiseGuides:
 
     def render(self, cam2world: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(albedo, normals) of one keypoint (OpenCV-axes ``cam2world``)."""
-        albedo = self.albedo.render(cam2world)
-        normals = self.raster.render(cam2world, ["normals"])["normals"]
+        albedo = self.raster.albedo.render(cam2world, intrinsics=self.fine)
+        normals = self.raster.view.render(cam2world, ["normals"], intrinsics=self.fine,
+                                          normals_space="camera")["normals"]
         return self._box(albedo), self._box(normals)
 
     def release(self) -> None:
-        self.albedo.release()
-        self.raster.release()
+        if self._own:
+            self.raster.release()

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
-from .passes import RasterOutput
+from .readback import RasterOutput
 
 OCCLUSION_RELATIVE = 0.01
 OCCLUSION_ABSOLUTE = 1e-3  # m

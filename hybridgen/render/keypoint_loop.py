@@ -15,6 +15,7 @@ from .._version import __version__
 from ..errors import InputError
 from ..io.frame_sink import FrameSink, PassLayout
 from ..scene.scene import Scene
+from .passes import on_request
 
 ProgressFactory = Callable[[int, str], Any]
 
@@ -72,8 +73,9 @@ def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Prod
             records.update(producer.records())
         records = {k: v[chosen] if len(v) == total else v for k, v in records.items()}
         records["keypoint_index"] = np.asarray(chosen, dtype=np.int64)
-        for sink in sinks:
-            sink.begin(n, layouts, records, attributes)
+        routes = [_route(sink, keys) for sink in sinks]
+        for sink, route in zip(sinks, routes):
+            sink.begin(n, [layout for layout in layouts if layout.key in route], records, attributes)
         bar = progress(n, what) if progress else None
         prefetching = [p for p in producers if hasattr(p, "prefetch")]
         keypoints = scene.camera.keypoints
@@ -88,8 +90,9 @@ def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Prod
             values: dict[str, Any] = {}
             for producer in producers:
                 values.update(producer.produce(index, keypoints[index]))
-            for sink in sinks:
-                sink.write(local, values)
+            for sink, route in zip(sinks, routes):
+                sink.write(local, values if len(route) == len(keys) else
+                           {k: v for k, v in values.items() if k in route})
             if bar is not None:
                 bar.update(1)
         if bar is not None:
@@ -100,6 +103,13 @@ def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Prod
         for producer in producers:
             producer.close()
     return n
+
+
+def _route(sink: FrameSink, keys: list[str]) -> set[str]:
+    """The keys ``sink`` receives: every stored pass, and the on-request passes it asks for
+    (``wanted_passes()``, see :mod:`hybridgen.render.passes`)."""
+    wanted = set(getattr(sink, "wanted_passes", tuple)())
+    return {key for key in keys if not on_request(key) or key in wanted}
 
 
 def baseline_shift(cam2world: np.ndarray, baseline: float) -> np.ndarray:
@@ -122,7 +132,8 @@ class StereoProducer:
         self.producers, self.baseline, self.scene = producers, float(baseline), scene
 
     def layouts(self) -> list[PassLayout]:
-        return [layout if layout.dtype == "json" else replace(layout, shape=(2, *layout.shape), stereo=True)
+        return [layout if layout.dtype in ("json", "object") else replace(layout, shape=(2, *layout.shape),
+                                                                          stereo=True)
                 for p in self.producers for layout in p.layouts()]
 
     def attributes(self) -> dict[str, Any]:

@@ -1,15 +1,17 @@
-"""Which label passes a renderer produces, and how each keypoint's values are made from one raster draw."""
+"""Which label passes a renderer produces: renderer options -> output keys of the pass catalogue."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass, field, replace
+from typing import Any, Collection
 
 import numpy as np
 
 from ..errors import InputError
 from ..io.frame_sink import PassLayout
 from ..scene.scene import Scene
-from .passes import PASSES, RasterOutput
+from .keypoint_frame import KeypointFrame, LabelTables
+from .passes import PASSES, spec
+from .readback import RasterOutput
 
 MAP_BY_ALIASES = {"class": "category_id", "instance": "instance"}
 
@@ -20,9 +22,9 @@ class LabelRequest:
 
     ``map_by`` entries: ``class`` (``category_id_segmaps``), ``instance`` (``instance_segmaps`` plus the
     per-keypoint ``instance_attribute_maps``) or the name of a numeric object attribute ``a``
-    (``a_segmaps``). ``albedo``, ``flow``, ``nocs`` and ``object_records`` add the passes of
-    :mod:`hybridgen.render.albedo_pass`, :mod:`hybridgen.render.geometry_passes` and
-    :mod:`hybridgen.render.object_records`.
+    (``a_segmaps``). ``albedo``, ``flow``, ``nocs`` and ``object_records`` add those passes of
+    :mod:`hybridgen.render.passes`. ``extra`` names on-request passes sinks asked for; each is made when
+    this request makes its ``with_keys``.
     """
 
     depth: bool = True
@@ -35,6 +37,7 @@ class LabelRequest:
     flow: bool = False
     nocs: bool = False
     object_records: bool = False
+    extra: tuple[str, ...] = ()
 
     def segmap_attributes(self) -> list[str]:
         """Attributes (``category_id``, custom) that get an ``<attr>_segmaps`` pass, in order."""
@@ -44,70 +47,82 @@ class LabelRequest:
     def wants_instances(self) -> bool:
         return "instance" in self.map_by
 
+    @property
+    def wants_any(self) -> bool:
+        """Whether any label pass is asked for."""
+        return bool(self.keys())
+
+    def keys(self) -> list[str]:
+        """The output keys this request makes, in the order they are announced and written."""
+        flags = {"depth": self.depth, "distance": self.distance, "normals": self.normals}
+        keys = [key for key, wanted in flags.items() if wanted]
+        keys += [f"{attribute}_segmaps" for attribute in self.segmap_attributes()]
+        if self.wants_instances:
+            keys += ["instance_segmaps", "instance_attribute_maps"]
+        flags = {"albedo": self.albedo, "nocs": self.nocs, "object_records": self.object_records}
+        keys += [key for key, wanted in flags.items() if wanted]
+        if self.flow:
+            keys += ["forward_flow", "forward_flow_occluded", "backward_flow", "backward_flow_occluded"]
+        return keys + [key for key in self.on_request(self.extra, keys)]
+
+    @staticmethod
+    def on_request(wanted: Collection[str], keys: Collection[str]) -> list[str]:
+        """The on-request passes of ``wanted`` a renderer making ``keys`` makes too."""
+        return [key for key in dict.fromkeys(wanted) if key in PASSES and PASSES[key].on_request
+                and all(k in keys for k in PASSES[key].with_keys)]
+
+    def with_sinks(self, sinks: Collection[Any]) -> "LabelRequest":
+        """This request plus the on-request passes ``sinks`` ask for (``wanted_passes()``)."""
+        wanted = [key for sink in sinks for key in (getattr(sink, "wanted_passes", None) or tuple)()]
+        return replace(self, extra=tuple(dict.fromkeys((*self.extra, *wanted))))
+
     def check_scene(self, scene: Scene, default_category_id: int | None) -> None:
         """Fail early, naming objects, if a requested segmentation attribute is missing."""
         if "category_id" in self.segmap_attributes():
             scene.require_category_ids(default_category_id)
 
+    def layout(self, key: str, width: int, height: int) -> PassLayout:
+        """Per-keypoint shape, dtype and meaning of output ``key``."""
+        entry = spec(key)
+        meaning: dict[str, Any] = {}
+        if key in ("depth", "distance"):
+            meaning = {"units": entry.units, "background": float(self.depth_background)}
+        elif key == "normals":
+            meaning = {"frame": self.normals_space}
+        elif entry.units:
+            meaning = {"units": entry.units}
+        return PassLayout(key, entry.dtype, entry.shape(width, height), **meaning)
+
     def layouts(self, width: int, height: int) -> list[PassLayout]:
         """Per-keypoint shape and dtype of every output key."""
-        out: list[PassLayout] = []
-        for flag, key in ((self.depth, "depth"), (self.distance, "distance"), (self.normals, "normals")):
-            if flag:
-                spec = PASSES[key]
-                meaning = ({"frame": self.normals_space} if key == "normals"
-                           else {"units": "m", "background": float(self.depth_background)})
-                out.append(PassLayout(key, spec.dtype, (height, width, spec.channels) if spec.channels
-                                      else (height, width), **meaning))
-        for attribute in self.segmap_attributes():
-            out.append(PassLayout(f"{attribute}_segmaps", "int32", (height, width)))
-        if self.wants_instances:
-            out.append(PassLayout("instance_segmaps", "int32", (height, width)))
-            out.append(PassLayout("instance_attribute_maps", "json", ()))
-        if self.albedo:
-            out.append(PassLayout("albedo", "float32", (height, width, 3)))
-        if self.nocs:
-            out.append(PassLayout("nocs", "float32", (height, width, 3)))
-        if self.object_records:
-            out.append(PassLayout("object_records", "json", ()))
-        if self.flow:
-            for direction in ("forward", "backward"):
-                out.append(PassLayout(f"{direction}_flow", "float32", (height, width, 2)))
-                out.append(PassLayout(f"{direction}_flow_occluded", "uint8", (height, width)))
-        return out
+        return [self.layout(key, width, height) for key in self.keys()]
 
-    def tables(self, view: Any) -> "LabelTables":
+    def tables(self, view: Any) -> LabelTables:
         """Per-object lookups the keypoints share (built once per view)."""
         luts = {a: view.category_lut(a) for a in self.segmap_attributes()}
         records = {o.instance_id: {k: v for k, v in o.state().items() if k != "local2world"}
                    for o in view.scene.objects}
         return LabelTables(luts, records)
 
-    def compute(self, raw: RasterOutput, tables: "LabelTables") -> dict[str, Any]:
-        """All requested values of one keypoint from its raster readback."""
+    def compute(self, frame: KeypointFrame | RasterOutput, tables: LabelTables | None = None) -> dict[str, Any]:
+        """All requested values of one keypoint, each by its catalogue entry. ``frame`` may also be a bare
+        readback with its ``tables`` (passes that need more than the readback then fail)."""
+        if isinstance(frame, RasterOutput):
+            assert tables is not None, "a bare readback needs its tables"
+            frame = KeypointFrame.of_readback(frame, tables)
         values: dict[str, Any] = {}
-        for flag, key in ((self.depth, "depth"), (self.distance, "distance"), (self.normals, "normals")):
-            if flag:
-                values[key] = PASSES[key].compute(raw)
-        for attribute, lut in tables.luts.items():
-            values[f"{attribute}_segmaps"] = lut[raw.instance]
-        if self.wants_instances:
-            values["instance_segmaps"] = raw.instance.astype(np.int32)
-            values["instance_attribute_maps"] = tables.visible(raw.instance)
+        for key in self.keys():
+            compute = spec(key).compute
+            assert compute is not None, key
+            values[key] = compute(frame, key)
         return values
 
 
-@dataclass
-class LabelTables:
-    """``luts``: instance id -> segmap value per attribute; ``records``: instance id -> JSON record."""
-
-    luts: dict[str, np.ndarray]
-    records: dict[int, dict[str, Any]]
-
-    def visible(self, instance: np.ndarray) -> list[dict[str, Any]]:
-        """``[{"idx", "category_id", "name", custom attributes...}]`` of each instance in the map, by id."""
-        present = np.flatnonzero(np.bincount(instance.ravel()))
-        return [self.records[int(i)] for i in present if i != 0]
+def value_ranges(request: LabelRequest, tables: LabelTables, scene: Scene) -> dict[str, np.ndarray]:
+    """Id passes -> the values they can hold in ``scene`` (writers store them in the narrowest type)."""
+    ranges = {f"{attribute}_segmaps": lut for attribute, lut in tables.luts.items()}
+    ranges["instance_segmaps"] = np.array([0, *(o.instance_id for o in scene.objects)])
+    return ranges
 
 
 def parse_map_by(value: str | list[str]) -> list[str]:

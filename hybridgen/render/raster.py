@@ -16,7 +16,8 @@ from ..errors import InputError
 from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
 from .gl_context import shared_context
-from .passes import PASSES, RasterOutput
+from .raster_passes import RASTER_PASSES
+from .readback import RasterOutput
 from .projection import near_plane_corner_distance, projection_from_K
 from .shader_source import shader_source
 
@@ -126,16 +127,21 @@ class RasterView:
 
     # ----------------------------------------------------------------- rendering
     def render_raw(self, cam2world: np.ndarray, intrinsics: Intrinsics | None = None,
-                   hidden: frozenset[int] = frozenset()) -> RasterOutput:
+                   hidden: frozenset[int] = frozenset(), normals_space: str | None = None) -> RasterOutput:
         """Draw one keypoint (OpenCV-axes ``cam2world``) and read back normals+depth and instance ids.
 
-        Objects whose instance id is in ``hidden`` are left out (rays pass through them).
+        Objects whose instance id is in ``hidden`` are left out (rays pass through them). ``intrinsics``
+        (default: the scene camera's) and ``normals_space`` (default: the view's) may differ per call: one
+        view serves labels, amodal silhouettes on a wider canvas and supersampled denoising guides, keeping a
+        framebuffer per image size.
         """
-        self.submit(cam2world, intrinsics, hidden, slot="now")
-        return self.collect("now")
+        intr = intrinsics or self.scene.camera.intrinsics
+        slot = ("now", intr.width, intr.height)
+        self.submit(cam2world, intr, hidden, slot=slot, normals_space=normals_space)
+        return self.collect(slot)
 
     def submit(self, cam2world: np.ndarray, intrinsics: Intrinsics | None = None,
-               hidden: frozenset[int] = frozenset(), slot: Any = 0) -> None:
+               hidden: frozenset[int] = frozenset(), slot: Any = 0, normals_space: str | None = None) -> None:
         """Issue the draws of one keypoint into framebuffer ``slot`` without waiting for them.
 
         The rasterizer (llvmpipe's threads, or the GPU) works on it while the caller goes on - e.g. turning
@@ -155,7 +161,7 @@ class RasterView:
         prog = self.program
         prog["u_projection"].write(projection_from_K(intr.K, width, height, intr.clip_start, intr.clip_end)
                                    .T.astype(np.float32).tobytes())
-        to_output = np.eye(3) if self.normals_space == "camera" else cam2world[:3, :3]
+        to_output = np.eye(3) if (normals_space or self.normals_space) == "camera" else cam2world[:3, :3]
         prog["u_cam_to_output"].write(to_output.T.astype(np.float32).tobytes())
         near_reach = near_plane_corner_distance(intr.K, width, height, intr.clip_start)
         draws = self._object_uniforms(cam2world, world2cam, near_reach, hidden)
@@ -227,14 +233,14 @@ class RasterView:
         return self._cached_pose
 
     def render(self, cam2world: np.ndarray, passes: Iterable[str] = ("depth", "normals", "instance_segmaps"),
-               intrinsics: Intrinsics | None = None) -> dict[str, np.ndarray]:
-        """Render one keypoint and return the requested passes (keys of :data:`PASSES`) by name."""
+               intrinsics: Intrinsics | None = None, normals_space: str | None = None) -> dict[str, np.ndarray]:
+        """Render one keypoint and return the requested passes (keys of :data:`RASTER_PASSES`) by name."""
         names = list(passes)
-        unknown = [n for n in names if n not in PASSES]
+        unknown = [n for n in names if n not in RASTER_PASSES]
         if unknown:
-            raise InputError(f"unknown label pass(es) {unknown}; known: {sorted(PASSES)}")
-        raw = self.render_raw(cam2world, intrinsics)
-        return {name: PASSES[name].compute(raw) for name in names}
+            raise InputError(f"unknown label pass(es) {unknown}; known: {sorted(RASTER_PASSES)}")
+        raw = self.render_raw(cam2world, intrinsics, normals_space=normals_space)
+        return {name: RASTER_PASSES[name](raw) for name in names}
 
     def release(self) -> None:
         """Free the GL resources of this view (the context stays)."""

@@ -10,6 +10,7 @@ from ..scene.scene import Scene
 from .denoise import denoise as oidn_denoise
 from .denoise import require_oidn
 from .denoise_guides import DenoiseGuides
+from .keypoint_frame import SceneRaster
 from .keypoint_loop import ProgressFactory, Producer, StereoProducer, run_keypoints
 from .label_request import LabelRequest
 from .path_trace import PathTraceSettings, PathTraceView
@@ -34,13 +35,13 @@ class ColorProducer:
 
     def __init__(self, scene: Scene, settings: PathTraceSettings, *, seed: int = 0, variant: str | None = None,
                  hdr: bool = False, denoise: bool = False, view: PathTraceView | None = None,
-                 keep_raw: bool = False, sample_counts: bool = False) -> None:
+                 keep_raw: bool = False, sample_counts: bool = False, raster: SceneRaster | None = None) -> None:
         self.scene, self.settings, self.seed, self.hdr, self.denoise = scene, settings, int(seed), hdr, denoise
         self.keep_raw, self.sample_counts = keep_raw and denoise, sample_counts
         self._guides: DenoiseGuides | None = None
         if denoise:
             require_oidn()
-            self._guides = DenoiseGuides(scene)
+            self._guides = DenoiseGuides(scene, raster=raster)  # raster: the labels' view, shared
         self.view = view or PathTraceView(scene, settings, variant=variant)
 
     def layouts(self) -> list[PassLayout]:
@@ -96,11 +97,22 @@ def render_color(scene: Scene, sinks: Iterable[FrameSink], settings: PathTraceSe
                  indices: Sequence[int] | None = None, keep_raw: bool = False, sample_counts: bool = False) -> int:
     """Color (and ``labels`` if given) of every keypoint, as left/right pairs when ``stereo_baseline`` (m).
     ``keep_raw`` and ``sample_counts`` as in :class:`ColorProducer`."""
+    sinks = list(sinks)
     producers: list[Producer] = []
-    if labels is not None:
-        producers.append(LabelProducer(scene, labels, default_category_id=default_category_id))
-    producers.insert(0, ColorProducer(scene, settings or PathTraceSettings(), seed=seed, variant=variant, hdr=hdr,
-                                      denoise=denoise, keep_raw=keep_raw, sample_counts=sample_counts))
-    if stereo_baseline is not None:
-        producers = [StereoProducer(producers, stereo_baseline, scene)]
-    return run_keypoints(scene, sinks, producers, progress=progress, what="color", indices=indices)
+    raster = None  # one raster view for labels and denoising guides
+    if labels is not None or denoise:
+        raster = SceneRaster(scene, normals_space=labels.normals_space if labels else "camera",
+                             depth_background=labels.depth_background if labels else float("inf"))
+    try:
+        if labels is not None:
+            producers.append(LabelProducer(scene, labels.with_sinks(sinks), default_category_id=default_category_id,
+                                           raster=raster))
+        producers.insert(0, ColorProducer(scene, settings or PathTraceSettings(), seed=seed, variant=variant,
+                                          hdr=hdr, denoise=denoise, keep_raw=keep_raw, sample_counts=sample_counts,
+                                          raster=raster))
+        if stereo_baseline is not None:
+            producers = [StereoProducer(producers, stereo_baseline, scene)]
+        return run_keypoints(scene, sinks, producers, progress=progress, what="color", indices=indices)
+    finally:
+        if raster is not None:
+            raster.release()

@@ -9,41 +9,40 @@ import numpy as np
 from ..errors import InputError
 from ..io.frame_sink import FrameSink, PassLayout
 from ..scene.scene import Scene
-from .albedo_pass import AlbedoPass
-from .geometry_passes import nocs, optical_flow
+from .keypoint_frame import KeypointFrame, SceneRaster
 from .keypoint_loop import ProgressFactory, run_keypoints
-from .object_records import object_records
-from .label_request import LabelRequest
+from .label_request import LabelRequest, value_ranges
 from .raster import RasterView
 
 
 class LabelProducer:
-    """Producer of the label passes a :class:`LabelRequest` asks for (one raster draw per keypoint).
+    """Producer of the label passes a :class:`LabelRequest` asks for (one raster draw per keypoint; the
+    catalogue's functions turn its readback into passes, :mod:`hybridgen.render.passes`).
 
-    The geometry is uploaded once when it is built (or ``view`` is reused and left open).
+    The geometry is uploaded once: into ``raster`` when given (shared with other producers and left open),
+    else into a view built here (or ``view`` reused and left open).
     """
 
     def __init__(self, scene: Scene, request: LabelRequest, *, default_category_id: int | None = None,
-                 view: RasterView | None = None) -> None:
+                 view: RasterView | None = None, raster: SceneRaster | None = None) -> None:
         if not scene.objects:
             raise InputError("the scene has no objects to render")
         request.check_scene(scene, default_category_id)
         self.scene, self.request = scene, request
-        self._own_view = view is None
-        self.view = view or RasterView(scene, normals_space=request.normals_space,
-                                       depth_background=request.depth_background)
+        self._own_raster = raster is None
+        self.raster = raster or SceneRaster(scene, normals_space=request.normals_space,
+                                            depth_background=request.depth_background, view=view)
+        self.view = self.raster.view
         self._tables = request.tables(self.view)
-        self._albedo = AlbedoPass(self.view) if request.albedo else None
         self._pending: dict[int, tuple[int, int, bytes]] = {}
 
     def layouts(self) -> list[PassLayout]:
         """The request's layouts; id passes carry the range of ids this scene can produce (writers store
         them in the smallest integer type that holds it)."""
         intr = self.scene.camera.intrinsics
-        ranges = {f"{attribute}_segmaps": lut for attribute, lut in self._tables.luts.items()}
-        ranges["instance_segmaps"] = np.array([0, *(o.instance_id for o in self.scene.objects)])
+        ranges = value_ranges(self.request, self._tables, self.scene)
         return [replace(layout, value_range=(min(0, int(ranges[layout.key].min())), int(ranges[layout.key].max())))
-                if layout.key in ranges and layout.dtype != "json" else layout
+                if layout.key in ranges else layout
                 for layout in self.request.layouts(intr.width, intr.height)]
 
     def attributes(self) -> dict[str, Any]:
@@ -65,21 +64,9 @@ class LabelProducer:
             raw = self.view.collect(slot)
         else:
             raw = self.view.render_raw(cam2world)
-        values = self.request.compute(raw, self._tables)
-        intr = self.scene.camera.intrinsics
-        if self._albedo is not None:
-            values["albedo"] = self._albedo.render(cam2world)
-        if self.request.nocs:
-            values["nocs"] = nocs(raw, intr, cam2world, self.scene)
-        if self.request.object_records:
-            values["object_records"] = object_records(self.view, raw, cam2world)
-        if self.request.flow:
-            for direction, step in (("forward", 1), ("backward", -1)):
-                other = self._neighbour(index, step, cam2world)
-                depth = None if other is None else self.view.render(other, ["depth"])["depth"]
-                flow, occluded = optical_flow(raw, intr, cam2world, other, depth)
-                values[f"{direction}_flow"], values[f"{direction}_flow_occluded"] = flow, occluded
-        return values
+        frame = KeypointFrame(index, eye, cam2world, raw, self.raster, self._tables,
+                              lambda step: self._neighbour(index, step, cam2world))
+        return self.request.compute(frame)
 
     def _neighbour(self, index: int, step: int, cam2world: np.ndarray) -> np.ndarray | None:
         """Keypoint ``index + step``'s pose, moved like ``cam2world`` is from keypoint ``index`` (stereo eyes)."""
@@ -89,16 +76,16 @@ class LabelProducer:
         return keypoints[index + step] @ np.linalg.inv(keypoints[index]) @ cam2world
 
     def close(self) -> None:
-        if self._albedo is not None:
-            self._albedo.release()
-        if self._own_view:
-            self.view.release()
+        if self._own_raster:
+            self.raster.release()
 
 
 def render_labels(scene: Scene, sinks: Iterable[FrameSink], request: LabelRequest | None = None, *,
                   default_category_id: int | None = None, view: RasterView | None = None,
                   progress: ProgressFactory | None = None, indices: Sequence[int] | None = None) -> int:
-    """Render the labels of the keypoints ``indices`` (default: all) of ``scene.camera`` into ``sinks``;
-    returns how many."""
-    producer = LabelProducer(scene, request or LabelRequest(), default_category_id=default_category_id, view=view)
+    """Render the label passes of the keypoints ``indices`` (default: all) of ``scene.camera`` into ``sinks``
+    (plus the on-request passes they ask for); returns how many."""
+    sinks = list(sinks)
+    request = (request or LabelRequest()).with_sinks(sinks)
+    producer = LabelProducer(scene, request, default_category_id=default_category_id, view=view)
     return run_keypoints(scene, sinks, [producer], progress=progress, what="labels", indices=indices)

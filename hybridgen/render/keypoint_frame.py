@@ -1,0 +1,128 @@
+"""One keypoint as the pass catalogue's functions see it: its pose, its raster readback and what several
+passes share, each made at most once per keypoint (single-object silhouettes, neighbour depth, albedo).
+
+:class:`SceneRaster` is the one raster view of a scene and what is drawn with its buffers (albedo), shared
+by the label producer, the denoising guides and the silhouette passes - the geometry is uploaded once.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from ..scene.camera import Intrinsics
+from ..scene.mesh_object import MeshObject
+from ..scene.scene import Scene
+from .albedo_pass import AlbedoPass
+from .raster import RasterView
+from .readback import RasterOutput
+from .silhouettes import Placement, Silhouette, draw_alone, full_silhouette, placement
+
+
+class SceneRaster:
+    """The raster view of ``scene`` (built here, or ``view`` reused and left open) and its albedo pass
+    (built on first use)."""
+
+    def __init__(self, scene: Scene, *, normals_space: str = "camera", depth_background: float = float("inf"),
+                 view: RasterView | None = None) -> None:
+        self._own_view = view is None
+        self.view = view or RasterView(scene, normals_space=normals_space, depth_background=depth_background)
+        self._albedo: AlbedoPass | None = None
+
+    @property
+    def scene(self) -> Scene:
+        return self.view.scene
+
+    @property
+    def albedo(self) -> AlbedoPass:
+        if self._albedo is None:
+            self._albedo = AlbedoPass(self.view)
+        return self._albedo
+
+    def release(self) -> None:
+        if self._albedo is not None:
+            self._albedo.release()
+            self._albedo = None
+        if self._own_view:
+            self.view.release()
+            self._own_view = False
+
+
+@dataclass
+class LabelTables:
+    """``luts``: instance id -> segmap value per attribute; ``records``: instance id -> JSON record."""
+
+    luts: dict[str, np.ndarray]
+    records: dict[int, dict[str, Any]]
+
+    def visible(self, instance: np.ndarray) -> list[dict[str, Any]]:
+        """``[{"idx", "category_id", "name", custom attributes...}]`` of each instance in the map, by id."""
+        present = np.flatnonzero(np.bincount(instance.ravel()))
+        return [self.records[int(i)] for i in present if i != 0]
+
+
+@dataclass
+class KeypointFrame:
+    """Keypoint ``index`` (stereo ``eye``) at ``cam2world`` (4x4, OpenCV axes) with its readback ``raw``.
+    ``neighbour(step)`` is the pose of keypoint ``index + step`` moved like this eye (None past the ends)."""
+
+    index: int
+    eye: int
+    cam2world: np.ndarray
+    raw: RasterOutput
+    raster: SceneRaster
+    tables: LabelTables
+    neighbour: Callable[[int], np.ndarray | None]
+    _shared: dict[Any, Any] = field(default_factory=dict)
+
+    @classmethod
+    def of_readback(cls, raw: RasterOutput, tables: LabelTables) -> "KeypointFrame":
+        """A frame of a bare readback: enough for the passes that need only ``raster``."""
+        return cls(0, 0, np.eye(4), raw, None, tables, lambda step: None)  # type: ignore[arg-type]
+
+    @property
+    def scene(self) -> Scene:
+        return self.raster.scene
+
+    @property
+    def view(self) -> RasterView:
+        return self.raster.view
+
+    @property
+    def intrinsics(self) -> Intrinsics:
+        return self.scene.camera.intrinsics
+
+    def shared(self, key: Any, make: Callable[[], Any]) -> Any:
+        """``make()``, computed once per keypoint for ``key``."""
+        if key not in self._shared:
+            self._shared[key] = make()
+        return self._shared[key]
+
+    def placements(self) -> dict[int, Placement]:
+        """Every object's :class:`~hybridgen.render.silhouettes.Placement`, by instance id."""
+        def make() -> dict[int, Placement]:
+            world2cam = np.linalg.inv(self.cam2world)
+            return {o.instance_id: placement(o, world2cam, self.intrinsics) for o in self.scene.objects}
+        return self.shared("placements", make)
+
+    def image_silhouette(self, obj: MeshObject) -> np.ndarray:
+        """(H, W) bool: ``obj`` drawn alone on the image canvas."""
+        return self.shared(("image", obj.instance_id),
+                           lambda: draw_alone(self.view, obj, self.cam2world, self.intrinsics))
+
+    def silhouettes(self) -> dict[int, Silhouette]:
+        """Every object's full silhouette (also counted outside the image), by instance id."""
+        def make() -> dict[int, Silhouette]:
+            return {obj.instance_id: full_silhouette(self.view, obj, self.cam2world,
+                                                     self.placements()[obj.instance_id],
+                                                     lambda obj=obj: self.image_silhouette(obj))  # type: ignore[misc]
+                    for obj in self.scene.objects}
+        return self.shared("silhouettes", make)
+
+    def neighbour_depth(self, step: int) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """(pose, z-depth image) of the neighbour keypoint ``index + step`` (None, None past the ends)."""
+        def make() -> tuple[np.ndarray | None, np.ndarray | None]:
+            other = self.neighbour(step)
+            return other, None if other is None else self.view.render(other, ["depth"])["depth"]
+        return self.shared(("neighbour", step), make)

@@ -1,0 +1,127 @@
+"""Render-side per-object passes (amodal masks, visible fractions, boxes) against analytic silhouettes, their
+delivery to the sinks that ask for them only, and one raster view shared by labels and denoising guides."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import hybridgen as hg
+from hybridgen.io.memory_sink import MemorySink
+from hybridgen.render import passes
+
+WANTED = ("amodal_masks", "visible_fractions", "object_boxes")
+
+
+class AskingSink(MemorySink):
+    def wanted_passes(self) -> tuple[str, ...]:
+        return WANTED
+
+
+def _half_hidden_cube(cube_x: float = 0.0) -> hg.Scene:
+    """A unit cube 6 m ahead whose right half (world x >= 0) a wall hides; its front face (y = -0.5, 5.5 m
+    from the camera) spans pixel centres 28..35 in u and 20..27 in v when ``cube_x`` is 0 (fx = fy = 40)."""
+    scene = hg.Scene()
+    scene.add(hg.make_primitive("cube", 1.0, name="cube", category_id=3, local2world=hg.object_pose([cube_x, 0, 0])))
+    wall = hg.MeshObject("wall", [[0, -5, -5], [10, -5, -5], [10, -5, 5], [0, -5, 5]], [[0, 1, 2], [0, 2, 3]],
+                         category_id=1)
+    scene.add(wall)
+    wall.local2world = hg.object_pose([0, 4.0, 0])  # the wall plane y = -1 covers x >= 0
+    scene.camera.intrinsics = hg.Intrinsics(np.array([[40.0, 0, 31.5], [0, 40.0, 23.5], [0, 0, 1]]), 64, 48)
+    scene.camera.add_keypoint(hg.look_at([0, -6, 0], [0, 0, 0]))
+    return scene
+
+
+def test_amodal_mask_counts_and_boxes_of_a_half_hidden_cube(gl_context):
+    scene = _half_hidden_cube()
+    asking, plain = AskingSink(), MemorySink()
+    hg.render_labels(scene, [asking, plain], hg.LabelRequest(map_by=["instance"], depth=False, normals=False))
+    frame = asking.frames[0]
+    cube = scene.by_name("cube").instance_id
+    expected = np.zeros((48, 64), bool)
+    expected[20:28, 28:36] = True
+    np.testing.assert_array_equal(frame["amodal_masks"][cube], expected)
+    assert frame["visible_fractions"][cube] == {"px_count_all": 64, "px_count_visib": 32, "visib_fract": 0.5}
+    assert frame["object_boxes"][cube] == {"bbox_obj": [28, 20, 7, 7], "bbox_visib": [28, 20, 3, 7]}
+    assert set(frame) == {"instance_segmaps", "instance_attribute_maps", *WANTED}
+    assert set(plain.frames[0]) == {"instance_segmaps", "instance_attribute_maps"}  # only to the sink that asked
+    assert not set(WANTED) & set(plain.layouts) and asking.layouts["amodal_masks"].dtype == "object"
+
+
+def _left_cube_frame(cx: float) -> tuple[dict, int]:
+    scene = _half_hidden_cube(cube_x=-0.55)  # x in [-1.05, -0.05] m: left of the wall, all visible
+    scene.camera.intrinsics = hg.Intrinsics(np.array([[40.0, 0, cx], [0, 40.0, 23.5], [0, 0, 1]]), 16, 48)
+    sink = AskingSink()
+    hg.render_labels(scene, [sink], hg.LabelRequest(map_by=["instance"], depth=False, normals=False))
+    return sink.frames[0], scene.by_name("cube").instance_id
+
+
+def test_pixels_outside_the_image_are_counted_and_boxed(gl_context):
+    """The front face (5.5 m away) spans u = cx + 40 x / 5.5 for x in [-1.05, -0.05]: cx - 7.64 .. cx - 0.36
+    (the side face x = -0.05 adds nothing: it ends at cx - 0.31), v = 23.5 -+ 3.64: rows 20..27."""
+    frame, cube = _left_cube_frame(7.5)  # columns 0..7, all inside the image
+    assert frame["amodal_masks"][cube].nonzero()[1].min() == 0 and frame["amodal_masks"][cube].sum() == 64
+    assert frame["visible_fractions"][cube] == {"px_count_all": 64, "px_count_visib": 64, "visib_fract": 1.0}
+    assert frame["object_boxes"][cube] == {"bbox_obj": [0, 20, 7, 7], "bbox_visib": [0, 20, 7, 7]}
+
+    frame, cube = _left_cube_frame(3.5)  # columns -4..3: four of them left of the image
+    expected = np.zeros((48, 16), bool)
+    expected[20:28, 0:4] = True
+    np.testing.assert_array_equal(frame["amodal_masks"][cube], expected)
+    assert frame["visible_fractions"][cube] == {"px_count_all": 64, "px_count_visib": 32, "visib_fract": 0.5}
+    assert frame["object_boxes"][cube] == {"bbox_obj": [-4, 20, 7, 7], "bbox_visib": [0, 20, 3, 7]}
+
+
+def test_on_request_passes_need_the_instance_map_of_the_same_renderer(gl_context):
+    scene = _half_hidden_cube()
+    sink = AskingSink()
+    hg.render_labels(scene, [sink], hg.LabelRequest(map_by=["class"], depth=True, normals=False))
+    assert set(sink.frames[0]) == {"depth", "category_id_segmaps"}
+
+
+def test_every_requested_key_has_a_catalogue_entry_with_a_layout_and_a_hint():
+    request = hg.LabelRequest(distance=True, map_by=["class", "instance", "tag"], albedo=True, flow=True, nocs=True,
+                              object_records=True, extra=WANTED)
+    keys = request.keys()
+    assert keys[-3:] == list(WANTED) and "tag_segmaps" in keys
+    for key in keys:
+        entry = passes.spec(key)
+        assert entry.compute is not None and entry.request
+        layout = request.layout(key, 8, 6)
+        assert layout.shape == (() if entry.channels is None else (6, 8) if entry.channels == 0
+                                else (6, 8, entry.channels))
+    assert passes.recognise("depth_m") is None and passes.recognise("left_depth").key == "depth"
+    assert passes.recognise("tag_segmaps").key == "<attribute>_segmaps" and passes.recognise("cam_K") is None
+    assert passes.hint("instance_segmaps").startswith("add 'instance' to map_by")
+
+
+def test_labels_and_denoising_guides_share_one_raster_view(gl_context, monkeypatch):
+    pytest.importorskip("pyoidn")
+    from hybridgen.render import raster
+    from hybridgen.render.denoise_guides import DenoiseGuides
+    from hybridgen.render.path_trace import PathTraceSettings
+    from hybridgen.render.render_color import render_color
+
+    scene = _half_hidden_cube()
+    scene.lights.append(hg.Light("sun", "SUN", energy=2.0, local2world=hg.object_pose([0, 0, 5], [0.4, 0.2, 0])))
+    own = DenoiseGuides(scene)
+    alone = own.render(scene.camera.keypoints[0])
+    own.release()
+    built, guides = [], []
+    original_init, original_render = raster.RasterView.__init__, DenoiseGuides.render
+
+    def counting_init(self, *args, **kwargs):
+        built.append(self)
+        original_init(self, *args, **kwargs)
+
+    def keeping_render(self, cam2world):
+        guides.append(original_render(self, cam2world))
+        return guides[-1]
+
+    monkeypatch.setattr(raster.RasterView, "__init__", counting_init)
+    monkeypatch.setattr(DenoiseGuides, "render", keeping_render)
+    sink = MemorySink()
+    render_color(scene, [sink], PathTraceSettings(samples=2, max_bounces=1), labels=hg.LabelRequest(albedo=True),
+                 denoise=True)
+    assert len(built) == 1  # one upload of the geometry for labels, albedo and the guides
+    for ours, reference in zip(guides[0], alone):  # the shared view draws the same guides bit for bit
+        np.testing.assert_array_equal(ours, reference)
