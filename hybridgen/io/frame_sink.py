@@ -37,8 +37,9 @@ class PassLayout:
 
     @property
     def image_size(self) -> tuple[int, int] | None:
-        """``(height, width)`` in pixels of an image-like pass, None for JSON values."""
-        if self.dtype == "json":
+        """``(height, width)`` in pixels of an image-like pass, None for JSON values and Python objects
+        (on-request passes, :mod:`hybridgen.render.passes`)."""
+        if self.dtype in ("json", "object"):
             return None
         first = 1 if self.stereo else 0
         height, width = self.shape[first:first + 2]
