@@ -22,7 +22,7 @@ from ._version import __version__
 from .errors import ConfigError, HybridgenError, InputError, SystemSetupError
 from .io.hdf5_single import Hdf5SingleFileWriter
 from .io.memory_sink import MemorySink
-from .io.mesh_loader import load_objects, object_pose
+from .io.mesh_loader import load_objects
 from .render.label_request import LabelRequest
 from .render.path_trace import PathTraceSettings
 from .render.raster import RasterView
@@ -30,7 +30,7 @@ from .render.render_color import render_color
 from .render.render_labels import render_labels
 from .run.pipeline import run_config
 from .scene import Camera, Intrinsics, Light, Material, MeshObject, Scene, World
-from .scene.frames import blender_to_opencv, look_at_blender, make_pose, opencv_to_blender
+from .scene.frames import blender_to_opencv, look_at_blender, make_pose, object_pose, opencv_to_blender
 from .scene.primitives import make_primitive
 
 

@@ -1,5 +1,14 @@
-"""Error types that the CLI turns into one line and exit status 2."""
+"""Error types that the CLI turns into one line and exit status 2, and the "did you mean" of their messages."""
 from __future__ import annotations
+
+import difflib
+from typing import Iterable
+
+
+def closest(name: str, known: Iterable[str]) -> str:
+    """' (did you mean ...?)' with the closest known names, or '' when none is close."""
+    matches = difflib.get_close_matches(str(name), list(known), n=3, cutoff=0.6)
+    return f" (did you mean {' or '.join(repr(m) for m in matches)}?)" if matches else ""
 
 
 class HybridgenError(Exception):

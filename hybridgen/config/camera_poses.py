@@ -25,12 +25,11 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError, InputError
+from ..errors import ConfigError, InputError, closest
 from ..io.bounded_read import MAX_POSE_FILE_BYTES, read_bounded_text
 from ..scene.camera import Intrinsics
 from ..scene.frames import BLENDER_TO_OPENCV, euler_xyz_to_matrix, forward_to_rotation_blender, look_at_blender, \
     make_pose, source_frame_matrix
-from .schema import closest
 
 ROTATION_FORMATS = ("euler", "look_at", "forward_vec")
 POSE_KEYS = ("location", "rotation", "cam2world_matrix", "source_frame")

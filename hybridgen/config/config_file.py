@@ -7,13 +7,12 @@ from typing import Any, Mapping, Sequence
 
 import yaml
 
-from ..errors import ConfigError
+from ..errors import ConfigError, closest
 from .blenderproc import (BLENDER_PYTHON_PACKAGES, BLENDER_SETUP_KEYS, GLOBAL_IGNORED, translate_module)
 from .blenderproc import finish as finish_translation
 from .notices import notice
 from .placeholders import resolve_placeholders
 from .requirements import NOT_A_REQUIREMENT, RequirementCheck, check_requirements
-from .schema import closest
 from .yaml_safety import MAX_CONFIG_BYTES, load_yaml, read_limited
 
 TOP_LEVEL_KEYS = ("setup", "global", "modules", "version")

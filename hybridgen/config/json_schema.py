@@ -88,10 +88,9 @@ def module_schema(name: str, cls: Any) -> dict[str, Any]:
 
 def config_schema() -> dict[str, Any]:
     """The whole config format: ``setup``, ``global``, ``modules`` (and BlenderProc's ``version``)."""
-    from ..sampling.registry import ALIASES, SAMPLERS, _load_builtins
+    from ..sampling.registry import ALIASES, SAMPLERS
     from .registry import all_modules
 
-    _load_builtins()
     modules = all_modules()
     translated = _blenderproc_names()
     names = sorted(modules)

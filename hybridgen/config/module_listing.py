@@ -42,9 +42,7 @@ def sampler_parameters(fn: Any) -> list[tuple[str, Any]]:
 
 def describe_samplers() -> str:
     """Every sampler and getter usable as ``{provider: NAME, ...}``, with aliases and parameters."""
-    from ..sampling.registry import ALIASES, SAMPLERS, _load_builtins
-
-    _load_builtins()
+    from ..sampling.registry import ALIASES, SAMPLERS
     lines = ["samplers (any value marked sampleable may be {provider: NAME, parameter: value, ...}):"]
     for name, spec in sorted(SAMPLERS.items()):
         aliases = sorted(a for a, target in ALIASES.items() if target == name)

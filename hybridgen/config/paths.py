@@ -16,10 +16,12 @@ import contextvars
 import glob
 import os
 from pathlib import Path
-from typing import Iterable, Iterator
+from typing import TYPE_CHECKING, Iterable, Iterator
 
 from ..errors import ConfigError
-from .schema import Param
+
+if TYPE_CHECKING:
+    from .schema import Param
 
 OUTPUT_KEYS = frozenset({"output_dir"})
 """Path parameters that name something a run writes: relative to the working directory only, never looked up."""

@@ -10,8 +10,7 @@ import importlib
 from importlib import metadata
 from typing import TYPE_CHECKING, Callable, TypeVar
 
-from ..errors import ConfigError
-from .schema import closest
+from ..errors import ConfigError, closest
 
 if TYPE_CHECKING:
     from ..modules.base import Module

@@ -1,12 +1,11 @@
 """Declared module parameters: one place for name, type, default, unit and doc; validation with suggestions."""
 from __future__ import annotations
 
-import difflib
 import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping
 
-from ..errors import ConfigError
+from ..errors import ConfigError, closest
 
 REQUIRED = object()
 """Default marker of a parameter that has to be given."""
@@ -24,12 +23,6 @@ _TYPE_CHECKS: dict[str, Callable[[Any], bool]] = {
     "vec3": lambda v: isinstance(v, list) and len(v) == 3 and all(_TYPE_CHECKS["float"](x) for x in v),
     "null": lambda v: v is None,
 }
-
-
-def closest(name: str, known: list[str] | Any) -> str:
-    """' (did you mean ...?)' with the closest known names, or '' when none is close."""
-    matches = difflib.get_close_matches(str(name), list(known), n=3, cutoff=0.6)
-    return f" (did you mean {' or '.join(repr(m) for m in matches)}?)" if matches else ""
 
 
 @dataclass(frozen=True)

@@ -213,13 +213,11 @@ class GeneratorDataset:
         if _inherited_renderer:
             raise SystemSetupError(f"GeneratorDataset: {_FORK_HINT}")
         if workers > 1:
-            from ..run.runner import limit_threads
+            from ..run.unit_task import apply_thread_limit, limit_threads
 
             limit_threads(max(1, (os.cpu_count() or 1) // workers))
             if self.color:
-                from ..run.runner import _apply_thread_limit
-
-                _apply_thread_limit()
+                apply_thread_limit()
         config = self._load()
         for scene in self.worker_scenes(worker, workers):
             yield from self.scene_samples(scene, config)

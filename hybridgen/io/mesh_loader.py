@@ -21,14 +21,14 @@ from __future__ import annotations
 import io
 import re
 from pathlib import Path
-from typing import Any, Callable, Iterable, Sequence
+from typing import Any, Callable, Iterable
 
 import numpy as np
 
 from ..config.notices import notice
 from ..config.paths import not_found
 from ..errors import InputError
-from ..scene.frames import euler_xyz_to_matrix, make_pose
+from ..scene.frames import Y_UP_TO_Z_UP
 from ..scene.material import Material
 from ..scene.mesh_object import MeshObject
 from .mesh_references import check_references, is_lenient
@@ -43,9 +43,6 @@ LOADERS: dict[str, tuple[str, str]] = {
 }
 """Suffix -> (trimesh file type, native up axis as Blender's importer reads the format)."""
 
-Y_UP_TO_Z_UP = np.array([[1.0, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1]])
-"""Rotation of +90 degrees about X: a +Y-up file's up axis becomes +Z ((x, y, z) -> (x, -z, y))."""
-
 BLENDER_NAME_BYTES = 63
 """Blender truncates object names to 63 bytes."""
 
@@ -53,15 +50,6 @@ _SENTINEL = "__hybridgen_object_{}__"
 _SENTINEL_RE = re.compile(r"__hybridgen_object_(\d+)__")
 
 Notify = Callable[[str], None]
-
-
-def object_pose(location: Sequence[float] = (0, 0, 0), rotation: Sequence[float] = (0, 0, 0),
-                scale: float | Sequence[float] = 1.0) -> np.ndarray:
-    """4x4 local2world from a location (m), Blender XYZ Euler rotation (rad) and scale (uniform or per axis)."""
-    factors = np.broadcast_to(np.asarray(scale, dtype=np.float64), (3,))
-    if np.any(factors == 0) or not np.all(np.isfinite(factors)):
-        raise InputError(f"scale must be finite and non-zero, got {list(factors)}")
-    return make_pose(euler_xyz_to_matrix(rotation) @ np.diag(factors), location)
 
 
 def blender_name(text: str) -> str:

@@ -3,13 +3,13 @@ from __future__ import annotations
 
 from ..config.registry import register_module
 from ..config.schema import Param, positive
-from ..io.bop_writer import ANNOTATION_UNITS, COLOR_FORMATS, BopWriter as BopSink
+from ..io.bop_writer import ANNOTATION_UNITS, COLOR_FORMATS, NEEDED_KEYS, BopWriter as BopSink
 from ..io.renamed_sink import check_output_keys, renamed_sinks
 from ..run.context import RunContext
 from ..sampling.getters import parse_selector
 from ..scene.mesh_object import MeshObject
 from .base import Module, Role
-from .writer_support import refuse_work_units, require_planned
+from .writer_support import refuse_work_units
 
 
 @register_module("writer.BopWriter")
@@ -42,6 +42,11 @@ class BopWriter(Module):
               check=positive),
     )
 
+    def consumes(self) -> dict[str, str]:
+        stored = self.config["input_keys"] or {}  # instance maps are needed only for masks and COCO info
+        return {stored.get(key, key): how for key, how in NEEDED_KEYS.items()
+                if key != "instance_segmaps" or self.config["calc_mask_info_coco"]}
+
     def prepare(self, context: RunContext) -> None:
         cfg = self.config
         refuse_work_units(context, self.module_name)
@@ -54,7 +59,6 @@ class BopWriter(Module):
                               calc_mask_info_coco=cfg["calc_mask_info_coco"],
                               ignore_dist_thres=cfg["ignore_dist_thres"], log=context.log)
         stored = cfg["input_keys"] or {}
-        require_planned(context, self.index, {stored.get(k, k): v for k, v in self.writer.needed_keys().items()})
         context.sinks += renamed_sinks([self.writer], {name: own for own, name in stored.items()})
         context.cleanups.append(self.writer.abort)
 

@@ -6,7 +6,7 @@ from typing import Any
 from ..config.camera_poses import intrinsics_from_config, pose_from_entry
 from ..config.registry import register_module
 from ..config.schema import Param, positive
-from ..errors import ConfigError, InputError
+from ..errors import ConfigError, InputError, closest
 from ..render.raster import RasterView
 from ..run.context import RunContext
 from ..sampling.camera_checks import NoveltyCheck, ProximityChecks
@@ -55,8 +55,6 @@ class CameraSampler(Module):
                     raise ConfigError("a pose entry is a mapping", key=where)
                 for key in entry:
                     if key not in ENTRY_KEYS:
-                        from ..config.schema import closest
-
                         raise ConfigError(f"unknown key{closest(key, ENTRY_KEYS)}", key=f"{where}.{key}")
                 count = int(entry.get("number_of_samples", 1))
                 checks = self._checks(entry, context, where)

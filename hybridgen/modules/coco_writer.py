@@ -8,7 +8,7 @@ from ..io.coco_writer import (COLOR_FORMATS, DEFAULT_SUPERCATEGORY, IMAGE_NAMES,
 from ..io.renamed_sink import renamed_sinks
 from ..run.context import RunContext
 from .base import Module, Role
-from .writer_support import refuse_work_units, require_planned
+from .writer_support import refuse_work_units
 
 
 def _prefix_check(value: str) -> str | None:
@@ -45,15 +45,19 @@ class CocoAnnotationsWriter(Module):
               "under (its output_keys)"),
     )
 
+    def _stored(self) -> dict[str, str]:
+        """The instance passes by the names the renderers store them under -> their own names."""
+        return {self.config["segcolormap_output_key"]: "instance_attribute_maps",
+                self.config["segmap_output_key"]: "instance_segmaps"}
+
+    def consumes(self) -> dict[str, str]:
+        image_key = self.config["rgb_output_key"]
+        return {image_key: image_key_hint(image_key), **{key: NEEDED_KEYS[own] for key, own in self._stored().items()}}
+
     def prepare(self, context: RunContext) -> None:
         cfg = self.config
         refuse_work_units(context, self.module_name)
-        stored = {cfg["segcolormap_output_key"]: "instance_attribute_maps",
-                  cfg["segmap_output_key"]: "instance_segmaps"}
-        renamed = {key: own for key, own in stored.items() if key != own}
-        needed = {cfg["rgb_output_key"]: image_key_hint(cfg["rgb_output_key"]),
-                  **{key: NEEDED_KEYS[own] for key, own in stored.items()}}
-        require_planned(context, self.index, needed)
+        renamed = {key: own for key, own in self._stored().items() if key != own}
         self.writer = CocoWriter(cfg["output_dir"], image_key=cfg["rgb_output_key"],
                                  mask_encoding=cfg["mask_encoding_format"], color_file_format=cfg["color_file_format"],
                                  jpg_quality=cfg["jpg_quality"], supercategory=cfg["supercategory"],

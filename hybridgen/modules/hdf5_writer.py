@@ -12,7 +12,7 @@ from ..run.context import RunContext
 from ..run.staged_output import DEFAULT_CHUNK_KEYPOINTS, JournalingWriter
 from ..run.units import SHARD_FOLDER
 from ..scene.scene import Scene
-from .base import Module, Role
+from .base import Module, Role, SingleFile
 
 
 def _file_name_check(value: str) -> str | None:
@@ -60,6 +60,12 @@ class Hdf5Writer(Module):
               "(merging the parts copies every chunk once more: ~40 % on top of fast label rasterizing)",
               check=lambda v: None if v >= -1 else f"must be >= -1, got {v}"),
     )
+
+    def single_file(self) -> SingleFile | None:
+        cfg = self.config
+        if cfg["layout"] != "single":
+            return None
+        return SingleFile(Path(cfg["output_dir"]) / cfg["file_name"], cfg["resume_chunk_keypoints"])
 
     def prepare(self, context: RunContext) -> None:
         cfg = self.config

@@ -2,9 +2,10 @@
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, Iterable
 
 from ..config.schema import Param
+from ..errors import HybridgenError
 from ..io.renamed_sink import check_output_keys
 from ..render.label_request import LabelRequest, parse_map_by
 from ..render.raster import NORMAL_SPACES
@@ -56,3 +57,16 @@ def label_request(config: dict[str, Any]) -> LabelRequest:
         depth_background=math.inf if isinstance(background, str) else float(background),
         normals_space=config["normals_space"], albedo=config["render_albedo"], flow=config["render_flow"],
         nocs=config["render_nocs"], object_records=config["render_object_records"])
+
+
+def stored_keys(config: dict[str, Any], extra: Iterable[str] = ()) -> frozenset[str] | None:
+    """The keys a renderer module with validated ``config`` stores: its label passes and ``extra`` (e.g.
+    ``colors``), under the names its ``output_keys`` give them; None when its label options are invalid (the
+    renderer reports that when it runs)."""
+    try:
+        written = {layout.key for layout in label_request(config).layouts(1, 1)}
+    except HybridgenError:
+        return None
+    written.update(extra)
+    names = config.get("output_keys") or {}
+    return frozenset(names.get(key, key) for key in written)

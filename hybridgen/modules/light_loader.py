@@ -4,9 +4,9 @@ from __future__ import annotations
 from typing import Any
 
 from ..config.registry import register_module
-from ..config.schema import Param, closest
-from ..errors import ConfigError
-from ..io.mesh_loader import object_pose
+from ..config.schema import Param
+from ..errors import ConfigError, closest
+from ..scene.frames import object_pose
 from ..run.context import RunContext
 from ..scene.light import LIGHT_TYPES, Light
 from .base import Module, Role

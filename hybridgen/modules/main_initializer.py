@@ -4,7 +4,7 @@ from __future__ import annotations
 from ..config.registry import register_module
 from ..config.schema import Param
 from ..run.context import DEFAULT_SEED, RunContext
-from .base import Module, Role
+from .base import Module, Role, SceneUnits
 
 
 def _color_check(value: list) -> str | None:
@@ -36,6 +36,9 @@ class Initializer(Module):
               "(0: one unit per scene); units run in parallel with --workers and resume independently",
               check=lambda v: None if v >= 0 else "must be >= 0"),
     )
+
+    def scene_units(self) -> SceneUnits:
+        return SceneUnits(self.config["number_of_scenes"], self.config["keypoints_per_chunk"])
 
     def run(self, context: RunContext) -> None:
         cfg = self.config

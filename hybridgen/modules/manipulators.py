@@ -8,7 +8,7 @@ from ..config.material_config import apply_material_config
 from ..config.registry import register_module
 from ..config.schema import Param
 from ..errors import InputError
-from ..io.mesh_loader import object_pose
+from ..scene.frames import object_pose
 from ..run.context import RunContext
 from ..scene.frames import matrix_to_euler_xyz
 from .base import Role

@@ -11,7 +11,7 @@ from ..config.schema import Param, positive
 from ..errors import InputError
 from ..run.context import RunContext
 from ..sampling.getters import parse_selector
-from ..io.mesh_loader import object_pose
+from ..scene.frames import object_pose
 from ..sampling.placement import (PlacementResult, SurfaceProbe, check_spacing, rest_on_surface, sample_poses,
                                   scale_of)
 from .base import Role

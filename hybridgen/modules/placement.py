@@ -10,7 +10,7 @@ from ..config.schema import Param
 from ..run.context import RunContext
 from ..scene.mesh_object import MeshObject
 from .base import Module
-from ..io.mesh_loader import object_pose
+from ..scene.frames import object_pose
 
 
 def _scale_check(value: Any) -> str | None:

@@ -11,7 +11,7 @@ from ..render.path_trace import PathTraceSettings
 from ..render.render_color import render_color
 from ..run.context import RunContext
 from .base import Module, Role
-from .label_params import label_params, label_request
+from .label_params import label_params, label_request, stored_keys
 
 
 def _non_negative(value: Any) -> str | None:
@@ -73,6 +73,9 @@ class RgbRenderer(Module):
               doc="Mitsuba variant; auto: cuda, else llvm, else scalar ($HYBRIDGEN_MITSUBA_VARIANT overrides)"),
         *label_params(depth=False, normals=False, map_by=None),
     )
+
+    def produces(self) -> frozenset[str] | None:
+        return stored_keys(self.config, ("colors", "colors_hdr") if self.config["output_hdr"] else ("colors",))
 
     def run(self, context: RunContext) -> None:
         cfg = self.config

@@ -6,7 +6,7 @@ from ..io.renamed_sink import renamed_sinks
 from ..render.render_labels import render_labels
 from ..run.context import RunContext
 from .base import Module, Role
-from .label_params import label_params, label_request
+from .label_params import label_params, label_request, stored_keys
 
 
 @register_module("renderer.SegMapRenderer")
@@ -16,6 +16,9 @@ class SegMapRenderer(Module):
     role = Role.RENDERER
 
     params = label_params(depth=True, normals=True, map_by=["class", "instance"])
+
+    def produces(self) -> frozenset[str] | None:
+        return stored_keys(self.config)
 
     def run(self, context: RunContext) -> None:
         sinks = renamed_sinks(context.sinks, self.config["output_keys"])

@@ -17,6 +17,8 @@ from typing import Any, Callable, Mapping, Sequence
 from ..config.config_file import ConfigFile, load_config
 from ..modules.base import Module
 from .context import RunContext
+from .plan import scene_stage
+from .steps import build_modules, execute, run_cleanups, run_modules
 from .units import WorkUnit
 
 
@@ -40,10 +42,8 @@ class SceneReuse:
     def execute(self, path: str, args: Sequence[str], env: Mapping[str, str] | None, unit: WorkUnit, *,
                 attributes: Mapping[str, Any] | None = None,
                 progress: Callable[[int, str], Any] | None = None) -> RunContext:
-        """Run ``unit`` like :func:`hybridgen.run.pipeline.execute`, reusing the scene built for the
+        """Run ``unit`` like :func:`hybridgen.run.steps.execute`, reusing the scene built for the
         previous unit when it is the same config, arguments and scene index."""
-        from .pipeline import build_modules, execute, run_cleanups, run_modules, scene_stage
-
         key = (str(path), tuple(args), tuple(sorted((env or {}).items())), unit.scene,
                tuple(sorted((attributes or {}).items())))
         if self._built is None or self._built.key != key:
@@ -73,8 +73,6 @@ class SceneReuse:
     def close(self) -> None:
         """Forget the built scene and run the cleanups its modules registered."""
         if self._built is not None:
-            from .pipeline import run_cleanups
-
             built, self._built = self._built, None
             run_cleanups(built.context)
 

@@ -5,7 +5,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .registry import DrawContext, register_sampler
+from .sampler_table import DrawContext, register_sampler
 
 
 def _check(p: dict[str, Any]) -> None:

@@ -16,7 +16,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..errors import ConfigError, InputError
-from .registry import DrawContext, register_sampler
+from .sampler_table import DrawContext, register_sampler
 
 SELECTOR_KEYS = ("provider", "conditions", "random_samples", "index", "check_empty")
 

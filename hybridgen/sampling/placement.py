@@ -7,7 +7,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ..errors import InputError
-from ..io.mesh_loader import object_pose
+from ..scene.frames import object_pose
 from ..scene.collision import CollisionWorld
 from ..scene.mesh_object import MeshObject
 

@@ -9,60 +9,17 @@ from __future__ import annotations
 
 import inspect
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
-from ..config.schema import closest
-from ..errors import ConfigError, InputError
-
-
-@dataclass
-class DrawContext:
-    """What a sampler may use: the run's generator and, for object-relative samplers, the scene."""
-
-    rng: np.random.Generator
-    scene: Any = None
-
-
-SamplerFn = Callable[..., Any]
-
-
-@dataclass(frozen=True)
-class SamplerSpec:
-    """A registered sampler: its function ``fn(ctx, **params)`` and a validator run at config load."""
-
-    name: str
-    fn: SamplerFn
-    validate: Callable[[dict[str, Any]], None]
-    doc: str
-
-
-SAMPLERS: dict[str, SamplerSpec] = {}
-ALIASES: dict[str, str] = {}
-
-
-def register_sampler(name: str, *aliases: str, validate: Callable[[dict[str, Any]], None] | None = None
-                     ) -> Callable[[SamplerFn], SamplerFn]:
-    """Register ``fn(ctx: DrawContext, **params)`` as ``name`` (e.g. ``sampler.Uniform3d``) and aliases
-    (e.g. the paper's ``Uniform3dSampler``)."""
-
-    def decorate(fn: SamplerFn) -> SamplerFn:
-        SAMPLERS[name] = SamplerSpec(name, fn, validate or (lambda params: None), (fn.__doc__ or "").strip())
-        for alias in aliases:
-            ALIASES[alias] = name
-        return fn
-
-    return decorate
+from ..errors import ConfigError, InputError, closest
+from . import attribute_merger, getters, samplers  # noqa: F401  (the built-ins register themselves)
+from .sampler_table import ALIASES, SAMPLERS, DrawContext, SamplerSpec
 
 
 def _known() -> list[str]:
-    _load_builtins()
     return sorted([*SAMPLERS, *ALIASES])
-
-
-def _load_builtins() -> None:
-    from . import attribute_merger, getters, samplers  # noqa: F401  (registration side effects)
 
 
 @dataclass
@@ -90,7 +47,6 @@ def is_sampler_dict(value: Any) -> bool:
 
 def parse_sampled(value: dict[str, Any], key: str = "") -> Sampled:
     """Turn a sampler dict into a :class:`Sampled`, validating name and parameters."""
-    _load_builtins()
     if "provider" in value:
         name = value["provider"]
         params = {k: v for k, v in value.items() if k != "provider"}

@@ -8,7 +8,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..config.paths import describe_glob_miss, glob_inputs
-from .registry import DrawContext, register_sampler
+from .sampler_table import DrawContext, register_sampler
 
 
 def _vec(value: Any, n: int, name: str) -> np.ndarray:

@@ -10,8 +10,13 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from ..errors import InputError
+
 BLENDER_TO_OPENCV = np.diag([1.0, -1.0, -1.0, 1.0])
 """Right-multiplying a Blender-axes cam2world by this gives the OpenCV-axes cam2world (it is its own inverse)."""
+
+Y_UP_TO_Z_UP = np.array([[1.0, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1]])
+"""Rotation of +90 degrees about X: a +Y-up file's up axis becomes +Z ((x, y, z) -> (x, -z, y))."""
 
 _AXIS_VECTORS = {"X": np.array([1.0, 0, 0]), "Y": np.array([0, 1.0, 0]), "Z": np.array([0, 0, 1.0])}
 
@@ -122,3 +127,12 @@ def make_pose(rotation: np.ndarray, location: Sequence[float]) -> np.ndarray:
     pose[:3, :3] = rotation
     pose[:3, 3] = np.asarray(location, dtype=np.float64)
     return pose
+
+
+def object_pose(location: Sequence[float] = (0, 0, 0), rotation: Sequence[float] = (0, 0, 0),
+                scale: float | Sequence[float] = 1.0) -> np.ndarray:
+    """4x4 local2world from a location (m), Blender XYZ Euler rotation (rad) and scale (uniform or per axis)."""
+    factors = np.broadcast_to(np.asarray(scale, dtype=np.float64), (3,))
+    if np.any(factors == 0) or not np.all(np.isfinite(factors)):
+        raise InputError(f"scale must be finite and non-zero, got {list(factors)}")
+    return make_pose(euler_xyz_to_matrix(rotation) @ np.diag(factors), location)

@@ -36,7 +36,7 @@ KILLER = textwrap.dedent("""
     import os, signal, sys
     from hybridgen.cli import main
     from hybridgen.io import hdf5_single
-    from hybridgen.run import runner
+    from hybridgen.run import unit_task as runner
     chunk, at = int(sys.argv[1]), int(sys.argv[2])
     run_unit, write = runner.run_unit, hdf5_single.Hdf5SingleFileWriter.write
     def unit(*call):
