@@ -87,9 +87,7 @@ class FloorExtractor(SelectingModule):
                 floor.category_id = labels["category_id"]
             floor.attributes.update(labels.get("attributes", {}))
             if not np.all(mask):
-                rest = split_faces(obj, ~mask, obj.name)
-                rest.instance_id = obj.instance_id
-                scene.objects[scene.objects.index(obj)] = rest
+                scene.replace(obj, split_faces(obj, ~mask, obj.name))
             else:
-                scene.objects.remove(obj)
+                scene.remove(obj)
             scene.add(floor)

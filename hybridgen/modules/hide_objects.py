@@ -20,5 +20,4 @@ class Hide(SelectingModule):
     )
 
     def run(self, context: RunContext) -> None:
-        hidden = {id(o) for o in self.selected(context)}
-        context.scene.objects[:] = [o for o in context.scene.objects if id(o) not in hidden]
+        context.scene.remove(*self.selected(context))

@@ -127,7 +127,7 @@ class ObjectSwapper(SelectingModule):
                               relative_rotation=rotation, ignore=ignore, copy_attributes=cfg["copy_attributes"],
                               drop_attributes=self._marker_keys())
         if in_scene and cfg["remove_pool_objects"]:
-            context.scene.objects[:] = [o for o in context.scene.objects if all(o is not p for p in in_scene)]
+            context.scene.remove(*in_scene)
         context.log(f"{self.module_name}: swapped {len(result.swapped)} of {len(originals)} object(s) in "
                     f"{result.tries} tries")
         if result.failed:

@@ -156,10 +156,10 @@ def swap_objects(scene: Scene, originals: Sequence[MeshObject], pool: Sequence[M
                 attributes.update({k: v for k, v in original.attributes.items() if k != "source_path"})
             attributes["swapped_from"] = original.name
             new = copy_object(template, pose, attributes)
-            new.instance_id = original.instance_id
+            new.instance_id = original.instance_id  # the id it will have: collision checks name objects by it
             if world.collides(new):
                 continue
-            scene.objects[scene.objects.index(original)] = new
+            scene.replace(original, new)
             world.add(new)
             result.swapped.append((original, new))
             break

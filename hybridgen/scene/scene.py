@@ -24,7 +24,9 @@ class World:
 class Scene:
     """Everything a renderer needs. Knows nothing about OpenGL or Mitsuba.
 
-    Objects get instance ids 1..N in the order they are added; ids are never reused within a scene.
+    Objects get instance ids 1..N in the order they are added; ids are never reused within a scene. The
+    scene owns the ids: change ``objects`` through :meth:`add`, :meth:`remove` and :meth:`replace` (a
+    replacement takes the replaced object's slot and id, a removed object's id stays unused).
     """
 
     objects: list[MeshObject] = field(default_factory=list)
@@ -39,6 +41,29 @@ class Scene:
         self._next_id += 1
         self.objects.append(obj)
         return obj
+
+    def remove(self, *objects: MeshObject) -> None:
+        """Take ``objects`` out of the scene (by identity); the others keep their ids and order, and the
+        removed ids are not given to later objects. An object that is not in the scene is an error."""
+        gone = {id(obj) for obj in objects}
+        present = {id(obj) for obj in self.objects}
+        for obj in objects:
+            if id(obj) not in present:
+                raise InputError(f"object '{obj.name}' is not in the scene")
+        self.objects[:] = [obj for obj in self.objects if id(obj) not in gone]
+
+    def replace(self, old: MeshObject, new: MeshObject) -> MeshObject:
+        """Put ``new`` in ``old``'s place: same position in ``objects`` and same instance id; returns ``new``."""
+        position = self._position(old)
+        new.instance_id = old.instance_id
+        self.objects[position] = new
+        return new
+
+    def _position(self, obj: MeshObject) -> int:
+        for position, candidate in enumerate(self.objects):
+            if candidate is obj:
+                return position
+        raise InputError(f"object '{obj.name}' is not in the scene")
 
     def add_light(self, light: Light) -> Light:
         """Add a light; returns it."""
