@@ -6,7 +6,8 @@ from ..config.registry import register_module
 from ..config.schema import Param, positive
 from ..errors import ConfigError, InputError
 from ..physics.shapes import SHAPES, DecompositionSettings
-from ..physics.simulate import PhysicsSettings, simulate_physics
+from ..physics.settings import PhysicsSettings
+from ..physics.simulate import simulate_physics
 from ..run.context import RunContext
 from ..sampling.getters import parse_selector
 from .base import Role

@@ -6,7 +6,8 @@ or a decomposition first needs them, with an actionable error when missing.
 from __future__ import annotations
 
 from .shapes import CollisionGeometry, DecompositionSettings, cache_dir, collision_geometry, convex_decomposition
-from .simulate import PhysicsResult, PhysicsSettings, simulate_physics
+from .settings import PhysicsResult, PhysicsSettings
+from .simulate import simulate_physics
 
 __all__ = ["CollisionGeometry", "DecompositionSettings", "PhysicsResult", "PhysicsSettings", "cache_dir",
            "collision_geometry", "convex_decomposition", "simulate_physics"]

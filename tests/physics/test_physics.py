@@ -18,7 +18,7 @@ import trimesh
 
 import hybridgen as hg
 from hybridgen.physics import DecompositionSettings, PhysicsSettings, convex_decomposition, simulate_physics
-from hybridgen.physics.simulate import split_linear
+from hybridgen.physics.bodies import split_linear
 from tests.conftest import REPO
 from tests.sampling.test_placement import _context, surfaces_intersect
 
