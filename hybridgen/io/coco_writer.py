@@ -28,10 +28,11 @@ import numpy as np
 from ..errors import InputError
 from .atomic import prepare_output_dir
 from .bounded_read import MAX_TABLE_BYTES, read_bounded_text
-from .output_lock import hold_output_lock
+from .coco_content import annotation, coco_file, load_coco_file
 from .frame_sink import PassLayout
 from .image_files import StagedFiles, jpeg_bytes, png_bytes, write_file
 from .mask_encoding import bbox_of, mask_to_polygons, require_pycocotools, rle_compressed
+from .output_lock import hold_output_lock
 
 ANNOTATIONS_FILE = "coco_annotations.json"
 MASK_ENCODINGS = ("rle", "polygon")
@@ -80,31 +81,6 @@ def load_label_mapping(value: Mapping[Any, Any] | str | Path | None) -> dict[int
     return mapping
 
 
-def load_existing(path: Path) -> dict[str, Any]:
-    """A COCO annotations file to append to, checked enough that appending cannot corrupt it."""
-    try:
-        content = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read '{path}' to append to it: {exc}") from None
-    except json.JSONDecodeError as exc:
-        raise InputError(f"cannot append to '{path}': it is not valid JSON ({exc.msg} at line {exc.lineno}, "
-                         f"column {exc.colno}); fix or remove it, or set append_to_existing_output: false") from None
-    problem = None
-    if not isinstance(content, dict):
-        problem = "it is not a JSON object"
-    else:
-        for section in ("images", "annotations", "categories"):
-            entries = content.get(section)
-            if not isinstance(entries, list) or not all(isinstance(e, dict) and isinstance(e.get("id"), int)
-                                                        for e in entries):
-                problem = f"'{section}' is not a list of entries with integer ids"
-                break
-    if problem:
-        raise InputError(f"cannot append to '{path}': {problem}; fix or remove it, or set "
-                         "append_to_existing_output: false")
-    return content
-
-
 class CocoWriter:
     """Frame sink writing COCO annotations to ``output_dir`` (see the module documentation).
 
@@ -130,13 +106,11 @@ class CocoWriter:
             raise InputError(f"'{self.path}' exists and is not a file")
         self._unlock = hold_output_lock(self.output_dir)  # ids and image names stay ours until finalize/abort
         try:
-            self.existing = load_existing(self.path) if append and self.path.exists() else None
+            self.existing = load_coco_file(self.path) if append and self.path.exists() else None
         except BaseException:
             self._unlock()
             raise
         self.image_offset = 1 + max((e["id"] for e in self.existing["images"]), default=-1) if self.existing else 0
-        self.annotation_offset = max((e["id"] for e in self.existing["annotations"]), default=0) \
-            if self.existing else 0
         self.image_key, self.mask_encoding = image_key, mask_encoding
         self.extension = ".png" if color_file_format == "PNG" else ".jpg"
         self.jpg_quality, self.supercategory = int(jpg_quality), supercategory
@@ -173,7 +147,7 @@ class CocoWriter:
             if key in values:
                 pending[key] = values[key]
         if all(key in pending for key in NEEDED_KEYS):
-            self.annotations[index] = self._annotate(np.asarray(pending["instance_segmaps"]),
+            self.annotations[index] = self._annotate(self.image_id(index), np.asarray(pending["instance_segmaps"]),
                                                      pending["instance_attribute_maps"])
             del self._pending[index]
 
@@ -255,7 +229,7 @@ class CocoWriter:
             self.categories[category] = {"id": category, "name": name, "supercategory": supercategory}
         return category
 
-    def _annotate(self, instance: np.ndarray, records: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    def _annotate(self, image_id: int, instance: np.ndarray, records: list[dict[str, Any]]) -> list[dict[str, Any]]:
         """Annotations (without ids) of one keypoint's visible instances, by instance id."""
         if isinstance(records, (str, bytes)):
             records = json.loads(records)
@@ -276,26 +250,12 @@ class CocoWriter:
                 segmentation: Any = rle_compressed(mask)
             else:
                 segmentation = mask_to_polygons(mask)
-            out.append({"category_id": category, "iscrowd": 0, "area": int(counts[idx]), "bbox": bbox_of(mask),
-                        "segmentation": segmentation, "width": int(mask.shape[1]), "height": int(mask.shape[0])})
+            out.append(annotation(image_id, category, int(counts[idx]), bbox_of(mask), segmentation,
+                                  width=mask.shape[1], height=mask.shape[0]))
         return out
 
     def _content(self) -> dict[str, Any]:
-        images = [self.images[i] for i in range(self.count)]
-        annotations = []
-        next_id = self.annotation_offset + 1
-        for index in range(self.count):
-            for annotation in self.annotations[index]:
-                annotations.append({"id": next_id, "image_id": self.image_id(index), **annotation})
-                next_id += 1
-        if self.existing is not None:
-            content = dict(self.existing)
-            known = {c["id"] for c in content["categories"]}
-            content["categories"] = content["categories"] + [c for i, c in sorted(self.categories.items())
-                                                             if i not in known]
-            content["images"] = content["images"] + images
-            content["annotations"] = content["annotations"] + annotations
-            return content
-        return {"info": {"description": self.supercategory, "version": "1.0", "contributor": "hybridgen"},
-                "licenses": [], "categories": [c for _, c in sorted(self.categories.items())],
-                "images": images, "annotations": annotations}
+        info = {"description": self.supercategory, "version": "1.0", "contributor": "hybridgen"}
+        return coco_file(self.existing, info, [c for _, c in sorted(self.categories.items())],
+                         [self.images[i] for i in range(self.count)],
+                         [a for index in range(self.count) for a in self.annotations[index]])

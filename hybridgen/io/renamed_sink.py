@@ -55,6 +55,11 @@ class RenamedSink:
     def end(self) -> None:
         self.sink.end()
 
+    def wanted_passes(self) -> tuple[str, ...]:
+        """The on-request passes the wrapped sink asks for (:mod:`hybridgen.render.passes`)."""
+        wanted = getattr(self.sink, "wanted_passes", None)
+        return tuple(wanted()) if wanted is not None else ()
+
     def finalize(self, records: dict[str, Any] | None = None,
                  attributes: dict[str, Any] | None = None) -> list[Path]:
         return self.sink.finalize(records, attributes)

@@ -50,7 +50,7 @@ def test_flow_preview_scale_without_finite_flow_starts_and_ends_at_zero():
 def test_bop_depth_png_values_in_units_of_depth_scale_and_too_far_as_zero():
     """value * depth_scale = mm, rounded; background, non-finite and beyond-16-bit depths are 0 and the
     too-far ones are counted (worked out by hand: depth_scale 0.5 -> 2 units per mm)."""
-    from hybridgen.io.bop_writer import depth_png_values
+    from hybridgen.io.depth_png import depth_png_values
 
     depth = np.array([[1.0, 32.7675, 32.768, np.inf], [0.0, np.nan, 0.00025, 5.0]])
     values, too_far = depth_png_values(depth, 0.5, background=5.0)
