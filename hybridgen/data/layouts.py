@@ -19,10 +19,11 @@ import h5py
 import numpy as np
 
 from ..errors import InputError
+from ..render.passes import RECORDS, exact
 from .decode import blenderproc_camera, blenderproc_normals, decode_attribute, decode_text
 
-SCENE_RECORDS = ("object_states", "light_states")
-POSITION_KEYS = ("scene_index", "keypoint_index")
+SCENE_RECORDS = tuple(key for key, kind in RECORDS.items() if kind == "scene")
+POSITION_KEYS = tuple(key for key, kind in RECORDS.items() if kind == "position")
 _NUMBERED = re.compile(r"(\d+)\.hdf5")
 
 
@@ -157,13 +158,18 @@ class BlenderProcLayout:
                 value = f[key][()]
                 if isinstance(value, (bytes, np.bytes_)) or f[key].dtype.kind in ("S", "O"):
                     item[key] = decode_text(value)
-                elif key == "normals" and "cam2world" in camera:
+                elif _blenderproc_normals(key) and "cam2world" in camera:
                     item[key] = blenderproc_normals(value, camera["cam2world"],
                                                     str(self.attributes.get("normals_space", "camera")))
                 else:
                     item[key] = value
         item["scene_index"], item["keypoint_index"] = self.position(None, index)
         return item
+
+
+def _blenderproc_normals(key: str) -> bool:
+    entry = exact(key)
+    return entry is not None and entry.blenderproc == "blender_half_unit"
 
 
 def numbered_files(folder: Path) -> list[Path]:

@@ -4,7 +4,8 @@ Reads both layouts: the single file (keypoint axis first, docs/conventions.md se
 ``<i>.hdf5`` per keypoint. Files are named ``<file stem>_<keypoint, 4 digits>_<key>.<ext>`` (single file) or
 ``<file stem>_<key>.<ext>`` (per-keypoint file); stereo keys get ``_left`` / ``_right``.
 
-``png`` (default) encodings, chosen so that values survive:
+``png`` (default) encodings, chosen so that values survive (each pass's ``png`` field of the catalogue,
+:mod:`hybridgen.render.passes`; otherwise by dtype and shape):
 
 - ``colors`` (uint8): 8-bit RGB as stored (sRGB); other uint8 maps (e.g. flow occlusion masks) as stored.
 - ``depth``, ``distance`` (metres): 16-bit grey, value * depth_scale = millimetres (depth_scale 1.0 by
@@ -31,6 +32,7 @@ import h5py
 import numpy as np
 
 from ..errors import InputError
+from ..render.passes import RECORDS, recognise
 from ..render.tonemap import to_srgb8
 from ..run.shard_index import check_index_sources
 from .atomic import prepare_output_dir
@@ -39,9 +41,18 @@ from .label_encoding import decode_dataset
 from .image_files import json_bytes, npy_bytes, png_bytes, write_exr_file, write_file
 
 FORMATS = ("png", "npy", "exr")
-_METRIC = ("depth", "distance")
-_LINEAR_COLOR = ("colors_hdr", "albedo")
-_ONE_CHANNEL = ("depth", "distance", "instance_segmaps", "category_id_segmaps")
+
+
+def _png(key: str) -> str:
+    """The catalogue's PNG encoding of a stored key ('' when it has none or is no pass)."""
+    entry = recognise(key)
+    return entry.png if entry is not None else ""
+
+
+def _one_channel(key: str) -> bool:
+    """Whether a stored key is a one-channel image pass (H, W) - stereo pairs of them are (2, H, W)."""
+    entry = recognise(key)
+    return entry is not None and entry.channels == 0
 
 
 @dataclass
@@ -68,7 +79,7 @@ def inspect(path: Path, h5: h5py.File) -> Source:
     per_keypoint = not (cam_K is not None and cam_K.ndim == 3)
     count = 1 if per_keypoint else int(cam_K.shape[0])  # type: ignore[union-attr]
     if per_keypoint:
-        stereo = any((d.ndim == 4 and d.shape[0] == 2) or (k in _ONE_CHANNEL and d.ndim == 3 and d.shape[0] == 2)
+        stereo = any((d.ndim == 4 and d.shape[0] == 2) or (_one_channel(k) and d.ndim == 3 and d.shape[0] == 2)
                      for k, d in datasets.items())
     else:
         stereo = "stereo_baseline" in h5.attrs
@@ -76,11 +87,11 @@ def inspect(path: Path, h5: h5py.File) -> Source:
     for key, dset in sorted(datasets.items()):
         is_text = dset.dtype.kind in ("S", "O", "U")
         per_frame = dset.shape if per_keypoint else dset.shape[1:] if dset.ndim and dset.shape[0] == count else None
-        if per_frame is None or (not per_keypoint and key in ("object_states", "light_states")):
+        if per_frame is None or (not per_keypoint and RECORDS.get(key) == "scene"):
             continue
         if is_text:
             source.texts.append(key)
-        elif len(per_frame) - (1 if stereo else 0) >= 2 and key not in ("cam_K", "cam2world", "cam2world_right"):
+        elif len(per_frame) - (1 if stereo else 0) >= 2 and RECORDS.get(key) != "camera":
             source.images.append(key)
         elif not per_keypoint:
             source.arrays.append(key)
@@ -99,7 +110,7 @@ def png_image(key: str, value: np.ndarray, *, encoded_normals: bool, depth_scale
     """The PNG samples of one image value and how many valid depth pixels did not fit (written as 0)."""
     if value.dtype == np.uint8:
         return value, 0
-    if key in _METRIC or key.endswith(_METRIC):
+    if _png(key) == "millimetres":
         metres = value.astype(np.float64)
         valid = np.isfinite(metres) & (metres > 0)
         units = np.rint(np.where(valid, metres, 0.0) * (1000.0 / depth_scale))
@@ -116,9 +127,9 @@ def png_image(key: str, value: np.ndarray, *, encoded_normals: bool, depth_scale
         kitti = np.clip(np.rint(np.where(finite[..., None], value, 0.0) * 64.0 + 2 ** 15), 0, 65535)
         return np.dstack([kitti, finite]).astype(np.uint16), 0
     if value.ndim == 3 and value.shape[2] in (3, 4) and np.issubdtype(value.dtype, np.floating):
-        if key in _LINEAR_COLOR:
+        if _png(key) == "srgb":
             return to_srgb8(value[..., :3].astype(np.float32)), 0
-        unit = value if (encoded_normals or not key.startswith("normals")) else (value + 1.0) / 2.0
+        unit = value if (encoded_normals or _png(key) != "half_unit") else (value + 1.0) / 2.0
         return np.rint(np.clip(np.nan_to_num(unit), 0.0, 1.0) * 255.0).astype(np.uint8), 0
     raise InputError(f"no PNG encoding for '{key}' ({value.dtype}, shape {value.shape}); use --format npy or exr")
 
@@ -134,8 +145,9 @@ def exr_image(key: str, value: np.ndarray) -> tuple[np.ndarray, Sequence[str] | 
         return value.astype(np.uint32), None
     if value.ndim == 3 and value.shape[2] == 2:
         return value.astype(np.float32), ("u", "v")
-    if value.ndim == 3 and value.shape[2] == 3 and key.startswith("normals"):
-        return value.astype(np.float32), ("X", "Y", "Z")
+    entry = recognise(key)
+    if value.ndim == 3 and entry is not None and entry.exr_channels and value.shape[2] == len(entry.exr_channels):
+        return value.astype(np.float32), entry.exr_channels
     dtype = np.float16 if value.dtype == np.float16 else np.float32
     return value.astype(dtype), None
 

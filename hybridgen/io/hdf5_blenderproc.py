@@ -21,6 +21,7 @@ from typing import Any
 import h5py
 import numpy as np
 
+from ..render.passes import exact
 from ..scene.frames import opencv_to_blender
 from .atomic import commit, discard, prepare_output_dir, temporary_path
 from .output_lock import hold_output_lock
@@ -95,7 +96,8 @@ class BlenderProcHdf5Writer:
             h5.create_dataset(key, data=np.bytes_(json.dumps(value)))
             return
         array = np.asarray(value)
-        if key == "normals":
+        entry = exact(key)
+        if entry is not None and entry.blenderproc == "blender_half_unit":
             cam2world = self._records["cam2world"][index]
             frame = layout.frame if layout is not None and layout.frame else "camera"
             array = encode_normals(array, cam2world, frame)

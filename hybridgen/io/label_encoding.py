@@ -29,6 +29,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..render.passes import exact
 from .frame_sink import PassLayout
 
 NARROWED = "narrowed_integer"
@@ -184,11 +185,13 @@ def plan_storage(layout: PassLayout, *, compact: bool, keys: set[str], depth_bac
                        _as_stored(dtype))
     if not compact:
         return plain
-    if layout.key == "normals" and dtype == np.float32 and layout.shape[-1] == 3:
+    entry = exact(layout.key)  # the pass catalogue names each pass's compact encoding
+    encoding = entry.hdf5 if entry is not None else ""
+    if encoding == "octahedral" and dtype == np.float32 and layout.shape[-1] == 3:
         return StoredPass(layout.key, np.dtype(np.uint16), (*layout.shape[:-1], 2), False,
                           {"encoding": OCTAHEDRAL, "decoded_dtype": "float32",
                            "max_error_rad": OCTAHEDRAL_MAX_ERROR_RAD}, encode_octahedral)
-    if layout.key == "distance" and "depth" in keys and can_derive_distance(depth_background):
+    if encoding == "derived_from_depth" and "depth" in keys and can_derive_distance(depth_background):
         return StoredPass(layout.key, dtype, layout.shape, False,
                           {"encoding": DERIVED_DISTANCE, "derived_from": "depth",
                            "depth_background": float(depth_background), "decoded_dtype": "float32"}, None)

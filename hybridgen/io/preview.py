@@ -8,7 +8,8 @@
 - ``*_flow``: the Middlebury color wheel (legend: the largest magnitude in pixels).
 - ``normals``: ``(n + 1) / 2`` as RGB; ``nocs``: as stored; ``albedo``/``colors_hdr`` (linear): sRGB;
   uint8 colors as stored; uint8 masks (``*_occluded``) white where 1.
-Stereo values (a leading axis of 2) are split by :func:`eyes` first.
+Stereo values (a leading axis of 2) are split by :func:`eyes` first. Which key is which comes from the
+pass catalogue (:mod:`hybridgen.render.passes`: ``show``, stored names recognised by their patterns).
 """
 from __future__ import annotations
 
@@ -17,11 +18,16 @@ from typing import Any
 
 import numpy as np
 
+from ..render.passes import RECORDS, recognise
 from ..render.tonemap import to_srgb8
 from .colormaps import flow_to_color, id_colors, viridis
 
-NOT_IMAGES = ("cam_K", "cam2world", "cam2world_right")
-_LINEAR = ("albedo", "colors_hdr")
+NOT_IMAGES = tuple(key for key, kind in RECORDS.items() if kind == "camera")
+
+
+def _show(key: str) -> str:
+    entry = recognise(key)
+    return entry.show if entry is not None else ""
 
 
 @dataclass
@@ -74,7 +80,9 @@ def _names(visible: list[dict[str, Any]], attribute: str) -> dict[int, list[dict
 
 def id_legend(key: str, ids: np.ndarray, visible: list[dict[str, Any]] | None) -> Legend:
     """The legend of an id map: every id in it, its color and what it is."""
-    attribute = "idx" if key.startswith("instance") else key[: -len("_segmaps")] if key.endswith("_segmaps") else key
+    entry = recognise(key)
+    attribute = ("idx" if key.startswith("instance") else key[: -len("_segmaps")]
+                 if entry is not None and entry.key == "<attribute>_segmaps" else key)
     groups = _names(visible or [], attribute)
     entries = []
     present = [int(i) for i in np.unique(ids)]
@@ -104,9 +112,9 @@ def preview(key: str, value: np.ndarray, visible: list[dict[str, Any]] | None = 
         return Preview(np.ascontiguousarray(value[..., :3]))
     if value.ndim == 3 and np.issubdtype(value.dtype, np.floating):
         rgb = np.nan_to_num(value[..., :3].astype(np.float32))
-        if key.startswith("normals"):
+        if _show(key) == "half_unit":
             return Preview(np.rint(np.clip((rgb + 1) / 2, 0, 1) * 255).astype(np.uint8))
-        if key in _LINEAR:
+        if _show(key) == "srgb":
             return Preview(to_srgb8(np.clip(rgb, 0, None)))
         return Preview(np.rint(np.clip(rgb, 0, 1) * 255).astype(np.uint8))
     if value.ndim == 2 and value.dtype == np.uint8:

@@ -13,6 +13,7 @@ from typing import Any, Iterable, Sequence
 from PIL import Image, ImageDraw
 
 from ..errors import InputError
+from ..render.passes import recognise
 from .colormaps import flow_to_color, viridis
 from .preview import Legend, eye_visible, eyes, is_image, preview
 
@@ -90,9 +91,14 @@ def contact_sheet(tiles: Sequence[tuple[str, Image.Image]], columns: int = 3) ->
 
 
 def image_keys(sample: dict[str, Any], stereo: bool) -> list[str]:
-    """Keys of a sample holding images (colors first)."""
+    """Keys of a sample holding images (colors first: the catalogue's rank, :mod:`hybridgen.render.passes`)."""
     keys = [k for k, v in sample.items() if any(is_image(k, eye) for _, eye in eyes(k, v, stereo))]
-    return sorted(keys, key=lambda k: (not k.startswith("colors"), k))
+    return sorted(keys, key=lambda k: (_rank(k), k))
+
+
+def _rank(key: str) -> int:
+    entry = recognise(key)
+    return entry.rank if entry is not None else 1
 
 
 def keypoint_tiles(sample: dict[str, Any], keys: Sequence[str], stereo: bool) -> list[tuple[str, Image.Image]]:
