@@ -39,6 +39,8 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..config.options import option
+from ..config.schema import positive
 from ..errors import InputError
 from ..scene.mesh_object import MeshObject
 from ..scene.rigid_pose import model_to_camera
@@ -47,21 +49,40 @@ from .atomic import confined_path, prepare_output_dir
 from .bop_chunks import Chunks
 from .coco_content import annotation
 from .depth_png import depth_png_values
+from ..render.passes import hint
 from .frame_sink import PassLayout
-from .image_files import StagedFiles, jpeg_bytes, png_bytes, write_file
+from .image_files import StagedFiles, color_format_option, jpeg_bytes, jpg_quality_option, png_bytes, write_file
 from .mask_encoding import bbox_of, rle_uncompressed
 from .output_lock import hold_output_lock
 
 ANNOTATION_UNITS = {"m": 1.0, "dm": 10.0, "cm": 100.0, "mm": 1000.0}
-COLOR_FORMATS = ("PNG", "JPEG")
-NEEDED_KEYS = {
-    "colors": "render color with renderer.RgbRenderer before this writer",
-    "depth": "set render_depth: true on the renderer",
-    "instance_segmaps": "add 'instance' to map_by of the renderer",
-}
+NEEDED_KEYS = {key: hint(key) for key in ("colors", "depth", "instance_segmaps")}
 OBJECT_PASSES = ("amodal_masks", "visible_fractions", "object_boxes")
 """The render-side passes this writer asks for when it writes masks (they come with ``instance_segmaps``)."""
 NO_BOX = [-1, -1, -1, -1]
+
+
+@dataclass(frozen=True)
+class BopOptions:
+    """The options of a BOP dataset, declared once: writer.BopWriter's parameters are these
+    (:func:`~hybridgen.config.options.option_params`); Python callers build them with
+    :func:`~hybridgen.config.options.checked_options`."""
+
+    dataset: str = option("", "str", "dataset folder inside output_dir; if set, only objects whose "
+                          "'bop_dataset_name' attribute is this are annotated")
+    append: bool = option(False, "bool", "continue the last chunk's image ids; otherwise existing chunks are an "
+                          "error", key="append_to_existing_output")
+    depth_scale: float = option(1.0, "float", "depth PNG value * depth_scale = depth in mm", unit="mm",
+                                check=positive)
+    color_file_format: str = color_format_option("rgb/ file format")
+    jpg_quality: int = jpg_quality_option()
+    frames_per_chunk: int = option(1000, "int", "images per train_pbr chunk", check=positive)
+    annotation_unit: str = option("mm", "str", "unit of cam_t_m2c, cam_t_w2c", choices=tuple(ANNOTATION_UNITS))
+    save_world2cam: bool = option(True, "bool", "write cam_R_w2c, cam_t_w2c in scene_camera.json")
+    calc_mask_info_coco: bool = option(True, "bool", "write mask/, mask_visib/, scene_gt_info.json and "
+                                       "scene_gt_coco.json (needs instance maps)")
+    ignore_dist_thres: float = option(100.0, "float", "objects farther from the camera are left out", unit="m",
+                                      check=positive)
 
 
 @dataclass
@@ -78,31 +99,31 @@ class _Frame:
 
 
 class BopWriter:
-    """Frame sink writing a BOP dataset (see the module documentation). Options are writer.BopWriter's
-    parameters, validated there (:mod:`hybridgen.modules.bop_writer`); this class trusts them.
-    ``select()`` gives the objects to annotate, called once at the first renderer."""
+    """Frame sink writing a BOP dataset (see the module documentation) with ``options`` (validated where
+    they were made; the defaults without). ``select()`` gives the objects to annotate, called once at the
+    first renderer."""
 
-    def __init__(self, output_dir: str | Path, scene: Scene, select: Callable[[], list[MeshObject]] | None = None, *,
-                 dataset: str = "", append: bool = False, depth_scale: float = 1.0, color_file_format: str = "PNG",
-                 jpg_quality: int = 95, frames_per_chunk: int = 1000, annotation_unit: str = "mm",
-                 save_world2cam: bool = True, calc_mask_info_coco: bool = True, ignore_dist_thres: float = 100.0,
-                 log: Callable[[str], None] | None = None) -> None:
+    def __init__(self, output_dir: str | Path, scene: Scene, select: Callable[[], list[MeshObject]] | None = None,
+                 options: BopOptions | None = None, *, log: Callable[[str], None] | None = None) -> None:
+        opts = options if options is not None else BopOptions()
         self.scene, self.select = scene, select
         self.output_dir = prepare_output_dir(Path(output_dir))
-        self.dataset_dir = confined_path(self.output_dir, dataset, "dataset") if dataset else self.output_dir
-        self.dataset_name = dataset or self.output_dir.resolve().name
+        self.dataset_dir = (confined_path(self.output_dir, opts.dataset, "dataset") if opts.dataset
+                            else self.output_dir)
+        self.dataset_name = opts.dataset or self.output_dir.resolve().name
         chunks_dir = self.dataset_dir / "train_pbr"
         for folder in (self.dataset_dir, chunks_dir):
             if folder.exists() and not folder.is_dir():
                 raise InputError(f"'{folder}' exists and is not a directory")
-        self.depth_scale, self.unit = float(depth_scale), ANNOTATION_UNITS[annotation_unit]
-        self.extension = ".png" if color_file_format == "PNG" else ".jpg"
-        self.jpg_quality, self.save_world2cam = int(jpg_quality), save_world2cam
-        self.calc_mask_info_coco, self.ignore_dist_thres = calc_mask_info_coco, float(ignore_dist_thres)
+        self.depth_scale, self.unit = float(opts.depth_scale), ANNOTATION_UNITS[opts.annotation_unit]
+        self.extension = ".png" if opts.color_file_format == "PNG" else ".jpg"
+        self.jpg_quality, self.save_world2cam = int(opts.jpg_quality), opts.save_world2cam
+        self.calc_mask_info_coco, self.ignore_dist_thres = opts.calc_mask_info_coco, float(opts.ignore_dist_thres)
         self.log = log or (lambda message: None)
         self._unlock = hold_output_lock(self.output_dir)  # ids and chunks stay ours until finalize/abort
         try:
-            self.chunks = Chunks(chunks_dir, frames_per_chunk, append=append, with_info=calc_mask_info_coco)
+            self.chunks = Chunks(chunks_dir, opts.frames_per_chunk, append=opts.append,
+                                 with_info=opts.calc_mask_info_coco)
         except BaseException:
             self._unlock()
             raise

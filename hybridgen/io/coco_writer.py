@@ -29,6 +29,7 @@ from ..errors import InputError
 from .atomic import prepare_output_dir
 from .bounded_read import MAX_TABLE_BYTES, read_bounded_text
 from .coco_content import annotation, coco_file, load_coco_file
+from ..render.passes import hint
 from .frame_sink import PassLayout
 from .image_files import StagedFiles, jpeg_bytes, png_bytes, write_file
 from .mask_encoding import bbox_of, mask_to_polygons, require_pycocotools, rle_compressed
@@ -41,17 +42,13 @@ IMAGE_NAMES = ("hybridgen", "blenderproc")
 """hybridgen: images/<prefix><id:06d>; blenderproc: rgb_<id:04d> next to coco_annotations.json."""
 DEFAULT_SUPERCATEGORY = "coco_annotations"
 
-NEEDED_KEYS = {
-    "instance_segmaps": "add 'instance' to map_by of the renderer (renderer.SegMapRenderer or renderer.RgbRenderer)",
-    "instance_attribute_maps": "add 'instance' to map_by of the renderer (renderer.SegMapRenderer or "
-                               "renderer.RgbRenderer)",
-}
+NEEDED_KEYS = {key: hint(key) for key in ("instance_segmaps", "instance_attribute_maps")}
 
 
 def image_key_hint(key: str) -> str:
     """How to make the image key ``key``."""
     if key == "colors":
-        return "render color with renderer.RgbRenderer before this writer"
+        return hint(key)
     return f"make a renderer write '{key}', or set rgb_output_key to a key it writes"
 
 

@@ -7,6 +7,7 @@ from ..config.registry import register_module
 from ..config.schema import Param, positive
 from ..io.renamed_sink import renamed_sinks
 from ..render.mitsuba_variant import choose_variant
+from ..render.passes import color_keys
 from ..render.path_trace import PathTraceSettings
 from ..render.render_color import render_color
 from ..run.context import RunContext
@@ -75,7 +76,9 @@ class RgbRenderer(Module):
     )
 
     def produces(self) -> frozenset[str] | None:
-        return stored_keys(self.config, ("colors", "colors_hdr") if self.config["output_hdr"] else ("colors",))
+        cfg = self.config
+        return stored_keys(cfg, color_keys(hdr=cfg["output_hdr"], raw=cfg["output_raw"] and cfg["denoise"],
+                                           sample_counts=cfg["output_sample_counts"]))
 
     def run(self, context: RunContext) -> None:
         cfg = self.config

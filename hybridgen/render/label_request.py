@@ -10,7 +10,7 @@ from ..errors import InputError
 from ..io.frame_sink import PassLayout
 from ..scene.scene import Scene
 from .keypoint_frame import KeypointFrame, LabelTables
-from .passes import PASSES, spec
+from .passes import PASSES, layout, spec
 from .readback import RasterOutput
 
 MAP_BY_ALIASES = {"class": "category_id", "instance": "instance"}
@@ -83,15 +83,12 @@ class LabelRequest:
 
     def layout(self, key: str, width: int, height: int) -> PassLayout:
         """Per-keypoint shape, dtype and meaning of output ``key``."""
-        entry = spec(key)
         meaning: dict[str, Any] = {}
         if key in ("depth", "distance"):
-            meaning = {"units": entry.units, "background": float(self.depth_background)}
+            meaning = {"background": float(self.depth_background)}
         elif key == "normals":
             meaning = {"frame": self.normals_space}
-        elif entry.units:
-            meaning = {"units": entry.units}
-        return PassLayout(key, entry.dtype, entry.shape(width, height), **meaning)
+        return layout(key, width, height, **meaning)
 
     def layouts(self, width: int, height: int) -> list[PassLayout]:
         """Per-keypoint shape and dtype of every output key."""

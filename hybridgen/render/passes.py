@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
+from ..io.frame_sink import PassLayout
 from . import raster_passes as raster
 from .geometry_passes import nocs, optical_flow
 from .object_passes import amodal_masks, object_boxes, visible_fractions
@@ -197,6 +198,21 @@ def hint(key: str) -> str:
     """How to make ``key`` (for 'needs ... which no renderer writes' errors)."""
     found = recognise(key)
     return found.request if found else f"make a renderer write '{key}'"
+
+
+def layout(key: str, width: int, height: int, **meaning: Any) -> PassLayout:
+    """The :class:`~hybridgen.io.frame_sink.PassLayout` of output ``key`` at ``width`` x ``height`` pixels: the
+    entry's dtype, shape and units; ``meaning`` adds what depends on the run (background, frame)."""
+    entry = spec(key)
+    units = {"units": entry.units} if entry.units else {}
+    return PassLayout(key, entry.dtype, entry.shape(width, height), **{**units, **meaning})
+
+
+def color_keys(*, hdr: bool = False, raw: bool = False, sample_counts: bool = False) -> list[str]:
+    """The keys the color producer writes: ``colors``, and ``colors_hdr``/``colors_raw``/``sample_counts``
+    when asked for (``raw`` only means something with denoising)."""
+    flags = {"colors": True, "colors_hdr": hdr, "colors_raw": raw, "sample_counts": sample_counts}
+    return [key for key, wanted in flags.items() if wanted]
 
 
 def on_request(key: str) -> bool:

@@ -13,6 +13,7 @@ from .denoise_guides import DenoiseGuides
 from .keypoint_frame import SceneRaster
 from .keypoint_loop import ProgressFactory, Producer, StereoProducer, run_keypoints
 from .label_request import LabelRequest
+from .passes import color_keys, layout
 from .path_trace import PathTraceSettings, PathTraceView
 from .render_labels import LabelProducer
 from .tonemap import to_srgb8
@@ -46,15 +47,8 @@ class ColorProducer:
 
     def layouts(self) -> list[PassLayout]:
         intr = self.scene.camera.intrinsics
-        shape = (intr.height, intr.width, 3)
-        layouts = [PassLayout("colors", "uint8", shape)]
-        if self.hdr:
-            layouts.append(PassLayout("colors_hdr", "float16", shape))
-        if self.keep_raw:
-            layouts.append(PassLayout("colors_raw", "uint8", shape))
-        if self.sample_counts:
-            layouts.append(PassLayout("sample_counts", "uint32", shape[:2]))
-        return layouts
+        return [layout(key, intr.width, intr.height)
+                for key in color_keys(hdr=self.hdr, raw=self.keep_raw, sample_counts=self.sample_counts)]
 
     def attributes(self) -> dict[str, Any]:
         s, plan = self.settings, self.settings.plan()
