@@ -23,9 +23,11 @@ import numpy as np
 from PIL import Image
 
 from ..errors import InputError
+from ..render.passes import exact
 from .colormaps import flow_to_color, viridis
 from .image_files import png_bytes, write_file
 from .preview import Legend, eye_visible, eyes, is_image, preview
+from .visualize import image_keys
 
 THUMB_WIDTH = 192
 _PAGE = Path(__file__).with_name("gallery_page.html")
@@ -71,7 +73,8 @@ def _keypoint_html(sample: dict[str, Any], index: int, keys: Sequence[str], ster
             shown = preview(key, value, eye_visible(visible, eye, stereo))
             name = f"{index:06d}_{title.replace(' (', '_').rstrip(')')}.png"
             full = _write_png(folder / "images" / name, shown.image)
-            smooth = value.dtype == np.uint8 and value.ndim == 3 or key in ("albedo", "normals", "nocs")
+            entry = exact(key)
+            smooth = value.dtype == np.uint8 and value.ndim == 3 or (entry is not None and entry.smooth)
             thumb = _write_png(folder / "thumbs" / name, _thumbnail(shown.image, smooth))
             figures.append(
                 f'<figure class="pass" data-key="{html.escape(key)}"><figcaption>{html.escape(title)}</figcaption>'
@@ -95,8 +98,7 @@ def build_gallery(source: str | Path, out_dir: str | Path | None = None, *, keys
         raise InputError(f"'{source}' has no keypoints to show")
     stereo = "stereo_baseline" in data.attributes
     first = data[0]
-    available = sorted((k for k, v in first.items() if any(is_image(k, e) for _, e in eyes(k, v, stereo))),
-                       key=lambda k: (not k.startswith("colors"), k))
+    available = image_keys(first, stereo)
     chosen = list(keys) if keys else available
     missing = [k for k in chosen if k not in available]
     if missing:

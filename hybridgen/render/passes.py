@@ -51,7 +51,8 @@ class PassSpec:
     (made by the color producer; ``compute`` is None). ``png``: ``millimetres`` (16-bit, value *
     depth_scale = mm), ``srgb`` (linear -> 8-bit sRGB), ``half_unit`` ((n + 1) / 2 -> 8 bit), ``kitti_flow``;
     empty: chosen by dtype and shape. ``show``: ``metric``, ``ids``, ``half_unit``, ``srgb``, ``flow``,
-    ``mask``, ``as_stored``; empty: chosen by dtype and shape.
+    ``mask``, ``as_stored``; empty: chosen by dtype and shape. ``smooth``: gallery thumbnails resample it
+    with interpolation (continuous values; uint8 color images are too).
     """
 
     key: str
@@ -73,6 +74,7 @@ class PassSpec:
     on_request: bool = False
     with_keys: tuple[str, ...] = ()
     rank: int = 1  # contact sheets: lower first
+    smooth: bool = False
 
     def shape(self, width: int, height: int) -> tuple[int, ...]:
         """Per-keypoint shape at ``width`` x ``height`` pixels."""
@@ -124,7 +126,8 @@ _SPECS = (
     PassSpec("normals", "float32", 3, "unit surface normal facing the camera, xyz in [-1, 1]", "set "
              "render_normals: true on the renderer", _raster(raster.normals), frame="camera (OpenCV) or world "
              "(normals_space)", background="(0, 0, 0)", pattern="normals*", hdf5="octahedral",
-             blenderproc="blender_half_unit", png="half_unit", exr_channels=("X", "Y", "Z"), show="half_unit"),
+             blenderproc="blender_half_unit", png="half_unit", exr_channels=("X", "Y", "Z"), show="half_unit",
+             smooth=True),
     PassSpec("<attribute>_segmaps", "int32", 0, "the object's numeric attribute (category_id_segmaps: its "
              "category_id)", "add 'class' (category_id) or the attribute to map_by of the renderer", _segmap,
              pattern="*_segmaps", show="ids"),
@@ -134,10 +137,10 @@ _SPECS = (
              "instance in the map, by id", INSTANCE_HINT, lambda frame, key: frame.tables.visible(frame.raw.instance)),
     PassSpec("albedo", "float32", 3, "diffuse base color / texture at each pixel centre", "set render_albedo: "
              "true on the renderer", lambda frame, key: frame.raster.albedo.render(frame.cam2world), ("albedo",),
-             units="linear RGB", background="the world color", png="srgb", show="srgb"),
+             units="linear RGB", background="the world color", png="srgb", show="srgb", smooth=True),
     PassSpec("nocs", "float32", 3, "normalized object coordinates in [0, 1] (NOCS paper)", "set render_nocs: "
              "true on the renderer", lambda frame, key: nocs(frame.raw, frame.intrinsics, frame.cam2world,
-                                                             frame.scene), show="as_stored"),
+                                                             frame.scene), show="as_stored", smooth=True),
     PassSpec("object_records", "json", None, "per object in view: obj2cam, 3D box, visible and amodal 2D boxes, "
              "pixel counts, visible fraction (render/object_records.py)", "set render_object_records: true on "
              "the renderer", lambda frame, key: object_records(frame), ("raster", "silhouettes")),
