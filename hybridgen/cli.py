@@ -17,7 +17,7 @@ import os
 import sys
 import time
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 from ._version import __version__
 from .errors import HybridgenError, InputError
@@ -176,9 +176,23 @@ def _add_global_options(parser: argparse.ArgumentParser, *, in_command: bool) ->
                        help="end with one JSON summary line on stdout (status, outputs, timings)", **unset)
 
 
-def _command(sub: Any, name: str, summary: str, description: str) -> argparse.ArgumentParser:
+def _command(sub: Any, name: str, func: Callable[[argparse.Namespace], dict[str, Any]], summary: str,
+             description: str) -> argparse.ArgumentParser:
+    """The sub-command ``name`` that calls ``func``, with the global options."""
     parser = sub.add_parser(name, help=summary, description=description, formatter_class=_HelpFormatter)
     _add_global_options(parser, in_command=True)
+    parser.set_defaults(func=func)
+    return parser
+
+
+def _reader_command(sub: Any, name: str, func: Callable[[argparse.Namespace], dict[str, Any]], summary: str,
+                    description: str, inputs: tuple[str, str | None, str], keys: str) -> argparse.ArgumentParser:
+    """A command that reads outputs: its positional ``inputs`` (name, nargs, help) and ``--keys`` (the passes
+    it works on, ``keys`` says what it does with them; default: every image key)."""
+    parser = _command(sub, name, func, summary, description)
+    input_name, nargs, input_help = inputs
+    parser.add_argument(input_name, nargs=nargs, help=input_help)
+    parser.add_argument("--keys", nargs="+", help=f"{keys} (default: every image key)")
     return parser
 
 
@@ -189,7 +203,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_global_options(parser, in_command=False)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    run = _command(sub, "run", "run a config and write its outputs",
+    run = _command(sub, "run", _cmd_run, "run a config and write its outputs",
                    "Run CONFIG; the values after it fill <args:0>, <args:1>, ... in the config.\n"
                    "Rerunning the same command resumes: complete work units are verified and kept.")
     run.add_argument("config", help="YAML config file")
@@ -212,44 +226,37 @@ def build_parser() -> argparse.ArgumentParser:
                      "(the result then mixes both)")
     run.add_argument("--max-tasks-per-child", type=int, default=25,
                      help="work units a pool worker renders before it is replaced (bounds memory growth)")
-    run.set_defaults(func=_cmd_run)
 
-    modules = _command(sub, "modules", "list modules, their parameters and the samplers",
+    modules = _command(sub, "modules", _cmd_modules, "list modules, their parameters and the samplers",
                        "List every module a config may name, with each parameter's type, unit, default, allowed\n"
                        "choices and whether it may be a sampler; then the samplers with their parameters.")
     modules.add_argument("name", nargs="?", help="show only this module")
     modules.add_argument("--schema", nargs="?", const="-", metavar="FILE",
                          help="write a JSON Schema of the config format to FILE (or stdout) for editors")
-    modules.set_defaults(func=_cmd_modules)
 
-    vis = _command(sub, "vis", "save a contact sheet PNG per keypoint of HDF5 outputs",
-                   "Save one PNG per keypoint showing its color and label passes side by side.")
-    vis.add_argument("files", nargs="+", help="HDF5 files written by hybridgen (either layout)")
-    vis.add_argument("--keys", nargs="+", help="keys to show (default: every image key)")
+    vis = _reader_command(sub, "vis", _cmd_vis, "save a contact sheet PNG per keypoint of HDF5 outputs",
+                          "Save one PNG per keypoint showing its color and label passes side by side.",
+                          ("files", "+", "HDF5 files written by hybridgen (either layout)"), "keys to show")
     vis.add_argument("--save", required=True, help="folder for the PNG files")
-    vis.set_defaults(func=_cmd_vis)
 
-    gallery = _command(sub, "gallery", "write a static HTML page of an output folder",
-                       "Write OUT/gallery/index.html: thumbnails of every pass of every keypoint with legends,\n"
-                       "click to enlarge, filters by scene and keypoint. No server or network needed.")
-    gallery.add_argument("output", help="output folder (data.hdf5 or BlenderProc <i>.hdf5 files) or HDF5 file")
+    gallery = _reader_command(
+        sub, "gallery", _cmd_gallery, "write a static HTML page of an output folder",
+        "Write OUT/gallery/index.html: thumbnails of every pass of every keypoint with legends,\n"
+        "click to enlarge, filters by scene and keypoint. No server or network needed.",
+        ("output", None, "output folder (data.hdf5 or BlenderProc <i>.hdf5 files) or HDF5 file"), "passes to show")
     gallery.add_argument("--open", action="store_true", help="open the page in the default web browser")
-    gallery.add_argument("--keys", nargs="+", help="passes to show (default: every image key)")
     gallery.add_argument("--limit", type=int, help="show only the first N keypoints")
-    gallery.set_defaults(func=_cmd_gallery)
 
-    ext = _command(sub, "extract", "write the keys of HDF5 outputs as PNG, EXR or npy files",
-                   "Write each keypoint's keys as files: PNG (8-bit images, 16-bit ids, depth and distance as\n"
-                   "16-bit millimetres), EXR (the stored floats) or npy (the stored arrays).")
-    ext.add_argument("files", nargs="+", help="HDF5 files (single-file or BlenderProc <i>.hdf5 layout)")
+    ext = _reader_command(sub, "extract", _cmd_extract, "write the keys of HDF5 outputs as PNG, EXR or npy files",
+                          "Write each keypoint's keys as files: PNG (8-bit images, 16-bit ids, depth and distance as\n"
+                          "16-bit millimetres), EXR (the stored floats) or npy (the stored arrays).",
+                          ("files", "+", "HDF5 files (single-file or BlenderProc <i>.hdf5 layout)"), "keys to extract")
     ext.add_argument("--output_dir", required=True, help="folder for the extracted files")
-    ext.add_argument("--keys", nargs="+", help="keys to extract (default: every image key)")
     ext.add_argument("--format", choices=("png", "npy", "exr"), default="png",
                      help="png: 8-bit images, 16-bit ids, depth/distance as 16-bit mm, flow as 16-bit KITTI; "
                      "npy: the stored arrays; exr: the stored floats (default: png)")
     ext.add_argument("--depth_scale", type=float, default=1.0,
                      help="png only: depth/distance PNG value * depth_scale = mm (default 1.0)")
-    ext.set_defaults(func=_cmd_extract)
     return parser
 
 

@@ -42,10 +42,9 @@ import numpy as np
 from ..config.config_file import ConfigFile, load_config
 from ..errors import ConfigError, InputError, SystemSetupError
 from ..io.memory_sink import MemorySink
-from ..modules.base import Module
+from ..modules.base import Module, Role
 from ..run.units import WorkUnit
 
-_COLOR_RENDERER = "renderer.RgbRenderer"
 _FORK_HINT = ("this process was forked from one that had already rendered (its OpenGL/EGL and Dr.Jit threads do "
               "not survive a fork, rendering would hang): create the DataLoader with "
               "multiprocessing_context='spawn' (or render nothing in the parent before the workers start)")
@@ -79,6 +78,7 @@ class _MemoryOutput(Module):
     when an explicit root seed is given and the config has no ``main.Initializer`` to do it."""
 
     module_name = "generator.MemoryOutput"
+    role = Role.SETUP  # runs first; its sink collects what the renderers after it make
 
     def __init__(self, seed: int | None) -> None:
         super().__init__({}, -1)
@@ -99,7 +99,7 @@ def _labels_only(renderer: Module) -> Module:
 
     cfg = renderer.config
     if cfg.get("stereo"):
-        raise ConfigError("color=False cannot render stereo labels; use color=True", module=_COLOR_RENDERER,
+        raise ConfigError("color=False cannot render stereo labels; use color=True", module=renderer.module_name,
                           index=renderer.index, key="stereo")
     labels = SegMapRenderer({p.name: cfg[p.name] for p in SegMapRenderer.params}, renderer.index)
     resize = (cfg.get("resolution_x"), cfg.get("resolution_y"))
@@ -138,9 +138,8 @@ class GeneratorDataset:
         if seed is not None and seed < 0:
             raise InputError(f"seed must be >= 0, got {seed}")
         modules = self._modules(self._load())  # checks the whole config now, not in the workers
-        initializer = next((m for m in modules if m.module_name == "main.Initializer"), None)
-        self.scenes = int(scenes if scenes is not None else initializer.config["number_of_scenes"] if initializer
-                          else 1)
+        units = next((u for u in (m.scene_units() for m in modules) if u is not None), None)
+        self.scenes = int(scenes if scenes is not None else units.scenes if units else 1)
         if self.scenes < 1 or self.first_scene < 0:
             raise InputError(f"scenes must be >= 1 and first_scene >= 0, got {self.scenes}, {self.first_scene}")
 
@@ -149,26 +148,28 @@ class GeneratorDataset:
         return load_config(self.config_path, self.args, self.env)
 
     def _modules(self, config: ConfigFile) -> list[Module]:
-        from ..run.pipeline import build_modules
+        from ..modules.main_initializer import Initializer
+        from ..modules.rgb_renderer import RgbRenderer
+        from ..run.steps import build_modules
 
         modules = build_modules(config)
-        if not any(m.module_name.startswith("renderer.") for m in modules):
+        if not any(m.role is Role.RENDERER for m in modules):
             raise ConfigError("the config has no renderer module: nothing to generate", file=config.path,
                               key="modules")
         if not self.write:
-            modules = [m for m in modules if not m.module_name.startswith("writer.")]
+            modules = [m for m in modules if m.role is not Role.WRITER]
         if not self.color:
-            modules = [_labels_only(m) if m.module_name == _COLOR_RENDERER else m for m in modules]
+            modules = [_labels_only(m) if isinstance(m, RgbRenderer) else m for m in modules]
         if self.seed is not None:
             for module in modules:
-                if module.module_name == "main.Initializer":
+                if isinstance(module, Initializer):
                     module.config = {**module.config, "seed": self.seed}
         return modules
 
     def scene_samples(self, scene: int, config: ConfigFile | None = None) -> list[dict[str, Any]]:
         """Render scene ``scene`` (in this process) and return its keypoints' samples in keypoint order."""
         from ..modules.hdf5_writer import scene_records
-        from ..run.pipeline import execute
+        from ..run.steps import execute
 
         config = config or self._load()
         output = _MemoryOutput(self.seed)
