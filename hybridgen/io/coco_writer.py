@@ -20,24 +20,25 @@ from __future__ import annotations
 import csv
 import io
 import json
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 
+from ..config.options import checked_options, option
 from ..errors import InputError
 from .atomic import prepare_output_dir
 from .bounded_read import MAX_TABLE_BYTES, read_bounded_text
 from .coco_content import annotation, coco_file, load_coco_file
 from ..render.passes import hint
 from .frame_sink import PassLayout
-from .image_files import StagedFiles, jpeg_bytes, png_bytes, write_file
+from .image_files import StagedFiles, color_format_option, jpeg_bytes, jpg_quality_option, png_bytes, write_file
 from .mask_encoding import bbox_of, mask_to_polygons, require_pycocotools, rle_compressed
 from .output_lock import hold_output_lock
 
 ANNOTATIONS_FILE = "coco_annotations.json"
 MASK_ENCODINGS = ("rle", "polygon")
-COLOR_FORMATS = ("PNG", "JPEG")
 IMAGE_NAMES = ("hybridgen", "blenderproc")
 """hybridgen: images/<prefix><id:06d>; blenderproc: rgb_<id:04d> next to coco_annotations.json."""
 DEFAULT_SUPERCATEGORY = "coco_annotations"
@@ -78,6 +79,33 @@ def load_label_mapping(value: Mapping[Any, Any] | str | Path | None) -> dict[int
     return mapping
 
 
+def _prefix_check(value: str) -> str | None:
+    return f"must be a plain file name prefix (no '/'), got {value!r}" if "/" in value or "\\" in value else None
+
+
+@dataclass(frozen=True)
+class CocoOptions:
+    """The options of a COCO annotations writer, declared once: writer.CocoAnnotationsWriter's parameters
+    are these (:func:`~hybridgen.config.options.option_params`)."""
+
+    image_key: str = option("colors", "str", "uint8 image key written to images/", key="rgb_output_key")
+    mask_encoding: str = option("rle", "str", "rle: compressed RLE (pycocotools, exact); polygon: exact pixel "
+                                "outlines (holes filled)", choices=MASK_ENCODINGS, key="mask_encoding_format")
+    color_file_format: str = color_format_option("image file format")
+    jpg_quality: int = jpg_quality_option()
+    supercategory: str = option(DEFAULT_SUPERCATEGORY, "str", "only objects whose 'supercategory' (or "
+                                "'bop_dataset_name') attribute is this; the default takes every object")
+    label_mapping: Any = option(None, "dict|path|null", "category names: {category_id: name} or a CSV file with "
+                                "id,name columns; default: the name of the first object of the category")
+    append: bool = option(False, "bool", "extend an existing coco_annotations.json: image and annotation ids "
+                          "continue after its highest ones", key="append_to_existing_output")
+    file_prefix: str = option("", "str", "prefix of the image file names", check=_prefix_check)
+    image_names: str = option("hybridgen", "str", "hybridgen: images/<prefix><id:06d>.png; blenderproc: "
+                              "BlenderProc's <prefix>rgb_<id:04d>.png next to coco_annotations.json, file_name "
+                              "'<folder>/rgb_0000.png' (the default for configs in BlenderProc's form)",
+                              choices=IMAGE_NAMES)
+
+
 class CocoWriter:
     """Frame sink writing COCO annotations to ``output_dir`` (see the module documentation).
 
@@ -85,41 +113,36 @@ class CocoWriter:
     several renderers. :meth:`finalize` commits, :meth:`abort` drops everything staged.
     """
 
-    def __init__(self, output_dir: str | Path, *, image_key: str = "colors", mask_encoding: str = "rle",
-                 color_file_format: str = "PNG", jpg_quality: int = 95,
-                 supercategory: str = DEFAULT_SUPERCATEGORY, label_mapping: Mapping[int, str] | None = None,
-                 append: bool = False, file_prefix: str = "", image_names: str = "hybridgen") -> None:
-        if image_names not in IMAGE_NAMES:
-            raise InputError(f"image_names must be one of {IMAGE_NAMES}, got {image_names!r}")
-        if mask_encoding not in MASK_ENCODINGS:
-            raise InputError(f"mask encoding must be one of {MASK_ENCODINGS}, got {mask_encoding!r}")
-        if color_file_format not in COLOR_FORMATS:
-            raise InputError(f"color_file_format must be one of {COLOR_FORMATS}, got {color_file_format!r}")
-        if mask_encoding == "rle":
+    def __init__(self, output_dir: str | Path, options: CocoOptions | None = None, **given: Any) -> None:
+        """``options`` (validated where they were made), or the options ``given`` by name (validated here)."""
+        if options is not None and given:
+            raise TypeError("give CocoWriter either options or single options, not both")
+        opts = options if options is not None else checked_options(CocoOptions, **given)
+        if opts.mask_encoding == "rle":
             require_pycocotools()
+        self.label_mapping = load_label_mapping(opts.label_mapping)
         self.output_dir = prepare_output_dir(Path(output_dir))
         self.path = self.output_dir / ANNOTATIONS_FILE
         if self.path.exists() and not self.path.is_file():
             raise InputError(f"'{self.path}' exists and is not a file")
         self._unlock = hold_output_lock(self.output_dir)  # ids and image names stay ours until finalize/abort
         try:
-            self.existing = load_coco_file(self.path) if append and self.path.exists() else None
+            self.existing = load_coco_file(self.path) if opts.append and self.path.exists() else None
         except BaseException:
             self._unlock()
             raise
         self.image_offset = 1 + max((e["id"] for e in self.existing["images"]), default=-1) if self.existing else 0
-        self.image_key, self.mask_encoding = image_key, mask_encoding
-        self.extension = ".png" if color_file_format == "PNG" else ".jpg"
-        self.jpg_quality, self.supercategory = int(jpg_quality), supercategory
-        self.label_mapping = dict(label_mapping) if label_mapping is not None else None
-        self.file_prefix = file_prefix
+        self.image_key, self.mask_encoding = opts.image_key, opts.mask_encoding
+        self.extension = ".png" if opts.color_file_format == "PNG" else ".jpg"
+        self.jpg_quality, self.supercategory = int(opts.jpg_quality), opts.supercategory
+        self.file_prefix = opts.file_prefix
         self.count = 0
         self.images: dict[int, dict[str, Any]] = {}
         self.annotations: dict[int, list[dict[str, Any]]] = {}
         self.categories: dict[int, dict[str, Any]] = {}
         self._pending: dict[int, dict[str, Any]] = {}
         self._staged = StagedFiles()
-        self.blenderproc_names = image_names == "blenderproc"
+        self.blenderproc_names = opts.image_names == "blenderproc"
         self._image_dir = self.output_dir if self.blenderproc_names else self.output_dir / "images"
 
     # ------------------------------------------------------------------ FrameSink

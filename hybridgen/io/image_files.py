@@ -19,10 +19,23 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from ..config.options import option
 from ..errors import InputError, SystemSetupError
 from .atomic import commit, prepare_output_dir, temporary_path
 
 EXR_HINT = "EXR files are written with Mitsuba's Bitmap (the `mitsuba` package); it failed to import"
+COLOR_FORMATS = ("PNG", "JPEG")
+
+
+def color_format_option(doc: str) -> Any:
+    """The ``color_file_format`` option of a dataset writer (PNG or JPEG)."""
+    return option("PNG", "str", doc, choices=COLOR_FORMATS)
+
+
+def jpg_quality_option() -> Any:
+    """The ``jpg_quality`` option of a dataset writer."""
+    return option(95, "int", "JPEG quality 1..100",
+                  check=lambda v: None if 1 <= v <= 100 else f"must be in 1..100, got {v}")
 
 
 # ----------------------------------------------------------------------------------------------- encoders
