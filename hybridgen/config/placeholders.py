@@ -10,6 +10,7 @@ import re
 from typing import Any, Mapping, Sequence
 
 from ..errors import ConfigError
+from .nested import map_nested
 
 PLACEHOLDER = re.compile(r"<(args|env):([^<>]*)>")
 
@@ -39,16 +40,7 @@ def resolve_placeholders(value: Any, args: Sequence[str], env: Mapping[str, str]
 
         return PLACEHOLDER.sub(one, text)
 
-    def walk(node: Any, where: str) -> Any:
-        if isinstance(node, str):
-            return substitute(node, where)
-        if isinstance(node, dict):
-            return {k: walk(v, f"{where}.{k}" if where else str(k)) for k, v in node.items()}
-        if isinstance(node, list):
-            return [walk(v, f"{where}[{i}]") for i, v in enumerate(node)]
-        return node
-
-    resolved = walk(value, "")
+    resolved = map_nested(value, lambda item, where: substitute(item, where) if isinstance(item, str) else item)
     if missing:
         given = f"{len(args)} argument(s) given after the config path" + (f": {list(args)}" if args else "")
         raise ConfigError(f"missing placeholder value(s): {'; '.join(missing)} ({given})", file=file)

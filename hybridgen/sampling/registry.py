@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from ..config.nested import map_nested
 from ..errors import ConfigError, InputError, closest
 from . import attribute_merger, getters, samplers  # noqa: F401  (the built-ins register themselves)
 from .sampler_table import ALIASES, SAMPLERS, DrawContext, SamplerSpec
@@ -82,13 +83,8 @@ def parse_sampled(value: dict[str, Any], key: str = "") -> Sampled:
 
 def parse_value(value: Any, key: str = "") -> Any:
     """A config value with every sampler dict inside it (at any depth) turned into a :class:`Sampled`."""
-    if is_sampler_dict(value):
-        return parse_sampled(value, key)
-    if isinstance(value, dict):
-        return {k: parse_value(v, f"{key}.{k}" if key else str(k)) for k, v in value.items()}
-    if isinstance(value, list):
-        return [parse_value(v, f"{key}[{i}]") for i, v in enumerate(value)]
-    return value
+    return map_nested(value, lambda item, where: parse_sampled(item, where) if is_sampler_dict(item) else item, key,
+                      is_sampler_dict)
 
 
 def contains_sampled(value: Any) -> bool:
@@ -103,14 +99,9 @@ def contains_sampled(value: Any) -> bool:
 
 
 def draw(value: Any, ctx: DrawContext) -> Any:
-    """``value`` with every :class:`Sampled` inside it drawn once (numpy results become lists/scalars)."""
-    if isinstance(value, Sampled):
-        return _plain(value.draw(ctx))
-    if isinstance(value, dict):
-        return {k: draw(v, ctx) for k, v in value.items()}
-    if isinstance(value, list):
-        return [draw(v, ctx) for v in value]
-    return value
+    """``value`` with every :class:`Sampled` inside it drawn once, in order (numpy results become
+    lists/scalars)."""
+    return map_nested(value, lambda item, where: _plain(item.draw(ctx)) if isinstance(item, Sampled) else item)
 
 
 def _plain(value: Any) -> Any:
