@@ -4,12 +4,13 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from ..config.options import from_config, option_params
 from ..config.registry import register_module
 from ..config.schema import Param
 from ..io.hdf5_blenderproc import BlenderProcHdf5Writer
-from ..io.hdf5_single import COMPRESSIONS, ENCODINGS, Hdf5SingleFileWriter
+from ..io.hdf5_single import Hdf5Options, Hdf5SingleFileWriter
 from ..run.context import RunContext
-from ..run.staged_output import DEFAULT_CHUNK_KEYPOINTS, JournalingWriter
+from ..run.staged_output import DEFAULT_CHUNK_KEYPOINTS, DEFAULT_LABEL_CHUNK_KEYPOINTS, JournalingWriter
 from ..run.units import SHARD_FOLDER
 from ..scene.scene import Scene
 from .base import Module, Role, SingleFile
@@ -43,21 +44,14 @@ class Hdf5Writer(Module):
               doc="single: one file, keypoint axis first; blenderproc: one <i>.hdf5 per keypoint, BlenderProc's keys"),
         Param("append_to_existing_output", "bool", False,
               doc="blenderproc layout: number the files after the highest <i>.hdf5 already in output_dir"),
-        Param("compression", "str", "gzip", choices=COMPRESSIONS, doc="dataset compression"),
-        Param("encoding", "str", "compact", choices=ENCODINGS,
-              doc="single layout: compact (ids in the smallest integer type, normals octahedral uint16 within "
-              "1e-4 rad, distance derived from depth; read them with hybridgen.data or "
-              "hybridgen.io.label_encoding.decode_dataset, docs/outputs.md) or plain (the documented "
-              "dtypes as they are); the blenderproc layout always stores BlenderProc's encodings"),
-        Param("compression_level", "int", 1, doc="gzip level 0..9 (1: twice as fast as 4, files ~10 % larger)",
-              check=lambda v: None if 0 <= v <= 9 else f"must be in 0..9, got {v}"),
+        *option_params(Hdf5Options),
         Param("resume_chunk_keypoints", "int", -1,
               doc="single layout, run without sharding as the only writer: render this many keypoints per "
               "verified part in the hidden folder .<file_name>.parts, merged at the end into the same bytes a "
               "direct write gives, so a killed run resumes; the scene is built once and each part renders its "
               "keypoints. 0: write directly (a killed run starts over); -1: "
-              f"{DEFAULT_CHUNK_KEYPOINTS} when the config path-traces color (renderer.RgbRenderer), else 0 "
-              "(merging the parts copies every chunk once more: ~40 % on top of fast label rasterizing)",
+              f"{DEFAULT_CHUNK_KEYPOINTS} when the config path-traces color, else {DEFAULT_LABEL_CHUNK_KEYPOINTS} "
+              "(merging copies the parts' stored chunks once, without compressing them again)",
               check=lambda v: None if v >= -1 else f"must be >= -1, got {v}"),
     )
 
@@ -69,6 +63,7 @@ class Hdf5Writer(Module):
 
     def prepare(self, context: RunContext) -> None:
         cfg = self.config
+        options = from_config(Hdf5Options, cfg)
         self.writer: Hdf5SingleFileWriter | BlenderProcHdf5Writer
         if cfg["layout"] == "blenderproc":
             self.writer = BlenderProcHdf5Writer(cfg["output_dir"], append=cfg["append_to_existing_output"],
@@ -76,13 +71,9 @@ class Hdf5Writer(Module):
                                                 compression_level=cfg["compression_level"])
         elif context.unit is not None:  # one work unit of a sharded run (or part of a staged one): its own file
             writer_class = JournalingWriter if context.unit.folder != SHARD_FOLDER else Hdf5SingleFileWriter
-            self.writer = writer_class(context.unit.shard_path(cfg["output_dir"]), compression=cfg["compression"],
-                                       compression_level=cfg["compression_level"], encoding=cfg["encoding"])
+            self.writer = writer_class(context.unit.shard_path(cfg["output_dir"]), options)
         else:
-            self.writer = Hdf5SingleFileWriter(Path(cfg["output_dir"]) / cfg["file_name"],
-                                               compression=cfg["compression"],
-                                               compression_level=cfg["compression_level"],
-                                               encoding=cfg["encoding"])
+            self.writer = Hdf5SingleFileWriter(Path(cfg["output_dir"]) / cfg["file_name"], options)
         context.sinks.append(self.writer)
         context.cleanups.append(self.writer.abort)
 
