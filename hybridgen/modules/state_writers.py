@@ -11,11 +11,12 @@ from __future__ import annotations
 from typing import ClassVar
 
 from ..config.notices import notice
-from ..config.registry import register_module
+from ..config.registry import get_module, register_module
 from ..config.schema import Param
 from ..errors import ConfigError
 from ..run.context import RunContext
 from .base import Module, Role
+from .hdf5_writer import Hdf5Writer
 
 
 class StateWriter(Module):
@@ -34,9 +35,10 @@ class StateWriter(Module):
     def prepare(self, context: RunContext) -> None:
         config = context.config
         later = [e for e in (config.modules if config is not None else []) if e.index > self.index]
-        if config is not None and not any(e.name == "writer.Hdf5Writer" for e in later):
-            raise ConfigError(f"writes through writer.Hdf5Writer ({self.written_as}); add one after this module")
-        notice(f"hybridgen's writer.Hdf5Writer writes {self.written_as}", module=self.module_name,
+        writer = Hdf5Writer.module_name
+        if config is not None and not any(issubclass(get_module(e.name), Hdf5Writer) for e in later):
+            raise ConfigError(f"writes through {writer} ({self.written_as}); add one after this module")
+        notice(f"hybridgen's {writer} writes {self.written_as}", module=self.module_name,
                index=self.index)
 
     def run(self, context: RunContext) -> None:
