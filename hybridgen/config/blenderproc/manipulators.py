@@ -1,0 +1,123 @@
+"""Key translation of EntityManipulator (``cf_*`` functions, ``matrix_world``, ``cf_randomize_materials``) and
+MaterialManipulator (``cf_set_*`` values, ``getter.Material`` selectors)."""
+from __future__ import annotations
+
+from typing import Any
+
+from ...errors import ConfigError
+from .common import Note, custom_properties, pop_ignored, pop_mode, pop_shading
+from .selectors import selector
+
+
+def matrix_world(cfg: dict[str, Any]) -> None:
+    """``matrix_world`` (4x4, metres) -> location, Euler XYZ rotation and scale."""
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    if "matrix_world" not in cfg:
+        return
+    try:
+        matrix = np.asarray(cfg.pop("matrix_world"), dtype=np.float64).reshape(4, 4)
+    except (TypeError, ValueError):
+        raise ConfigError("must be a 4x4 matrix", key="matrix_world") from None
+    linear = matrix[:3, :3]
+    scale = np.linalg.norm(linear, axis=0)
+    if np.any(scale == 0) or not np.all(np.isfinite(matrix)):
+        raise ConfigError("must be an invertible, finite 4x4 matrix", key="matrix_world")
+    rotation = linear / scale
+    if np.linalg.det(rotation) < 0:
+        scale[0], rotation[:, 0] = -scale[0], -rotation[:, 0]
+    if not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-4):
+        raise ConfigError("must be a rotation times a per-axis scale (no shear)", key="matrix_world")
+    cfg.setdefault("location", matrix[:3, 3].tolist())
+    cfg.setdefault("rotation", Rotation.from_matrix(rotation).as_euler("xyz").tolist())
+    if "scale" in cfg:  # BlenderProc sets matrix_world, then scale on top of it
+        given = np.broadcast_to(np.asarray(cfg["scale"], dtype=np.float64), (3,))
+        cfg["scale"] = (scale * given).tolist()
+    else:
+        cfg["scale"] = scale.tolist()
+
+
+def entity(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]]]:
+    cfg = dict(config)
+    if "selector" in cfg:
+        cfg["selector"] = selector(cfg["selector"], note)
+    props = {k: cfg.pop(k) for k in list(cfg) if k.startswith("cp_")}
+    custom_properties(props, cfg)
+    if "rotation_euler" in cfg:
+        cfg["rotation"] = cfg.pop("rotation_euler")
+    matrix_world(cfg)
+    mode = cfg.get("mode")
+    if "cf_randomize_materials" in cfg:
+        cfg.pop("mode", None)  # the randomizer draws once for all or for each, as BlenderProc
+    pop_mode(cfg, note)
+    pop_shading(cfg, note)
+    for key in ("cf_add_modifier", "cf_add_displace_modifier_with_texture", "cf_add_uv_mapping"):
+        pop_ignored(cfg, key, note, "Blender modifiers (displacement, subdivision, UV projection) are not applied")
+    out = []
+    randomize = cfg.pop("cf_randomize_materials", None)
+    if randomize is not None:
+        if not isinstance(randomize, dict):
+            raise ConfigError("must be a mapping {randomization_level, materials_to_replace_with}",
+                              key="cf_randomize_materials")
+        extra = [k for k in randomize if k not in ("randomization_level", "materials_to_replace_with")]
+        if extra:
+            raise ConfigError(f"unknown key {extra[0]!r}; hybridgen takes randomization_level and "
+                              "materials_to_replace_with", key="cf_randomize_materials")
+        source = randomize.get("materials_to_replace_with")
+        if isinstance(source, dict):
+            source = {k: v for k, v in source.items() if k != "check_empty"}
+        out.append(("manipulators.MaterialRandomizer", {
+            "selector": cfg.get("selector", {"conditions": {}}),
+            "randomization_level": randomize.get("randomization_level", 0.2),
+            "materials_to_replace_with": source, "mode": mode or "once_for_each"}))
+    if set(cfg) - {"selector"} or not out:
+        out.insert(0, ("manipulators.EntityManipulator", cfg))
+    return out
+
+
+_MATERIAL_VALUES = {"base_color": "base_color", "roughness": "roughness", "metallic": "metallic",
+                    "specular": "specular", "ior": "ior", "alpha": "alpha", "transmission": "transmission",
+                    "emission_strength": "emission_strength", "emission": "emission"}
+
+
+def material(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]]]:
+    cfg = dict(config)
+    sel = cfg.get("selector")
+    if isinstance(sel, dict) and sel.get("provider") == "getter.Material":
+        # materials are selected through the objects that carry them (hybridgen objects hold one material)
+        conditions = sel.get("conditions", {})
+        cfg["selector"] = {k: v for k, v in sel.items() if k not in ("provider", "conditions")}
+        cfg["selector"]["conditions"] = _material_conditions(conditions)
+        cfg["selector"].setdefault("check_empty", False)
+    elif "selector" in cfg:
+        cfg["selector"] = selector(cfg["selector"], note)
+    pop_mode(cfg, note)
+    values = dict(cfg.pop("material", {}) or {})
+    for key in list(cfg):
+        if not key.startswith("cf_"):
+            continue
+        function = key[3:]
+        if function.startswith("set_"):
+            name = function[4:].lower().replace(" ", "_")
+            if name in _MATERIAL_VALUES:
+                values[_MATERIAL_VALUES[name]] = cfg.pop(key)
+                continue
+        if function == "switch_to_emission_shader":
+            emission = cfg.pop(key) or {}
+            color = emission.get("color", [1.0, 1.0, 1.0, 1.0]) if isinstance(emission, dict) else [1, 1, 1, 1]
+            values["emission"] = color[:3] if isinstance(color, list) else color
+            values["emission_strength"] = emission.get("strength", 1.0) if isinstance(emission, dict) else 1.0
+            continue
+        pop_ignored(cfg, key, note, f"Blender node-graph function '{function}' has no counterpart in hybridgen's "
+             "principled material")
+    cfg["material"] = values
+    return [("manipulators.MaterialManipulator", cfg)]
+
+
+def _material_conditions(conditions: Any) -> Any:
+    if isinstance(conditions, list):
+        return [_material_conditions(c) for c in conditions]
+    if not isinstance(conditions, dict):
+        return conditions
+    return {("material_name" if k == "name" else k): v for k, v in conditions.items()}

@@ -1,0 +1,60 @@
+"""BlenderProc module names: the hybridgen module each one runs as, and those hybridgen cannot provide (why, and
+what to do instead)."""
+from __future__ import annotations
+
+ALIASES = {
+    "loader.ObjectLoader": "loader.ObjLoader",
+    "loader.PlyLoader": "loader.ObjLoader",
+    "renderer.NormalRenderer": "renderer.SegMapRenderer",
+    "renderer.DepthRenderer": "renderer.SegMapRenderer",
+    "renderer.DistanceRenderer": "renderer.SegMapRenderer",
+    "renderer.FlowRenderer": "renderer.SegMapRenderer",
+    "object.PositionSampler": "object.ObjectPoseSampler",
+    "manipulators.ObjectManipulator": "manipulators.EntityManipulator",
+    "manipulators.LightManipulator": "manipulators.EntityManipulator",
+    "manipulators.FloorExtractor": "object.FloorExtractor",
+    "object.ObjectReplacer": "object.ObjectSwapper",
+    "constructor.BasicMeshInitializer": "loader.PrimitiveLoader",
+}
+"""BlenderProc module name -> the hybridgen module that does its work (keys translated below)."""
+
+_EXPORT = "export the scene to glTF/GLB or OBJ (e.g. with Blender: File > Export) and load it with loader.ObjLoader"
+_DATASET = "convert its meshes to OBJ/glTF/PLY and load them with loader.ObjLoader"
+UNAVAILABLE = {
+    "loader.BlendLoader": f"reading .blend files needs Blender; {_EXPORT}",
+    "loader.SuncgLoader": f"the SUNCG dataset was withdrawn by its authors and is not distributed; {_DATASET}",
+    "lighting.SuncgLighting": "lights SUNCG scenes, a dataset that was withdrawn; use lighting.SurfaceLighting "
+                              "with a selector for the lamp objects",
+    "camera.SuncgCameraSampler": "samples cameras inside SUNCG rooms (a withdrawn dataset); use "
+                                 "camera.CameraSampler with proximity_checks",
+    "loader.ShapeNetLoader": f"ShapeNet's catalogue layout is not read by hybridgen; {_DATASET}",
+    "writer.ShapeNetWriter": "writes ShapeNet ids of the loader hybridgen does not have; use attributes + map_by",
+    "loader.SceneNetLoader": f"SceneNet's layout is not read by hybridgen; {_DATASET}",
+    "loader.Front3DLoader": f"3D-FRONT's JSON scenes are not read by hybridgen; {_DATASET}",
+    "camera.Front3DCameraSampler": "samples inside 3D-FRONT rooms; use camera.CameraSampler with "
+                                   "proximity_checks",
+    "loader.Pix3DLoader": f"Pix3D's layout is not read by hybridgen; {_DATASET}",
+    "loader.IKEALoader": f"the IKEA dataset's layout is not read by hybridgen; {_DATASET}",
+    "loader.ReplicaLoader": f"Replica's layout is not read by hybridgen; its mesh.ply loads with loader.ObjLoader",
+    "camera.ReplicaCameraSampler": "samples inside Replica scenes; use camera.CameraSampler with proximity_checks",
+    "loader.AMASSLoader": "posing SMPL bodies needs the AMASS data and the SMPL body model (licensed, not "
+                          "distributable); export posed bodies to OBJ and load them with loader.ObjLoader",
+    "loader.RockEssentialsRockLoader": "reads Blender .blend rock packs; " + _EXPORT,
+    "constructor.RockEssentialsGroundConstructor": "builds Blender node-displaced ground; use "
+                                                   "loader.PrimitiveLoader (plane) with a texture",
+    "materials.RockEssentialsTextureSampler": "samples Blender node textures; use manipulators.MaterialManipulator",
+    "constructor.RandomRoomConstructor": "extrudes rooms from Blender meshes with loaders hybridgen does not have; "
+                                         "model the room and load it with loader.ObjLoader",
+    "constructor.BasicEmptyInitializer": "Blender empties (axes without geometry) have no counterpart in "
+                                         "hybridgen scenes; use a location directly where an empty was a target",
+    "object.CalibrationboardSampler": "samples a Blender calibration-board asset; load the board as a mesh "
+                                      "and place it with object.ObjectPoseSampler",
+    "writer.StereoGlobalMatchingWriter": "stereo depth by SGM is not implemented; renderer.RgbRenderer with "
+                                         "stereo: true writes exact per-eye depth instead",
+    "composite.CameraObjectSampler": "not implemented yet: it re-samples objects and cameras together per "
+                                     "scene; use main.Initializer number_of_scenes with object.ObjectPoseSampler "
+                                     "and camera.CameraSampler (each scene draws both anew)",
+    "writer.MyWriter": "an example of a user plugin; write it as a hybridgen plugin (entry point "
+                       "'hybridgen.modules')",
+}
+"""Modules hybridgen cannot provide: one line why, and what to do instead."""

@@ -1,0 +1,30 @@
+"""BlenderProc ``setup`` and ``global`` keys that only configure Blender: what hybridgen ignores (with a notice)."""
+from __future__ import annotations
+
+BLENDER_SETUP_KEYS = ("blender_install_path", "blender_version", "custom_blender_path", "blender_url",
+                      "custom_blender_path_env")
+"""``setup`` keys that locate or download Blender: hybridgen renders without Blender, so they are ignored."""
+
+
+BLENDER_PYTHON_PACKAGES = frozenset({
+    "h5py", "imageio", "pypng", "scikit-image", "scipy", "matplotlib", "pytz", "torch", "scikit-learn",
+    "python-dateutil", "numpy", "pillow", "opencv-contrib-python", "opencv-python", "pyyaml", "smplx",
+    "human_body_prior", "trimesh", "pyrender", "numba", "chumpy", "tqdm",
+})
+"""Packages BlenderProc configs install into Blender's own Python; hybridgen's modules do not import them
+through the config, so a missing one is a notice, not an error."""
+
+
+GLOBAL_IGNORED = {
+    "sys_paths": "Blender's Python import paths; hybridgen needs none",
+    "transparency_bounces": "Cycles' limit on alpha-transparent surfaces; hybridgen's materials are opaque or "
+                            "refractive (transmission_bounces)",
+    "volume_bounces": "hybridgen renders no volumes",
+    "output_is_temp": "hybridgen keeps no temporary per-frame files; writers write the final files",
+    "pixel_aspect_x": "hybridgen cameras have square pixels unless cam_K says otherwise",
+    "pixel_aspect_y": "hybridgen cameras have square pixels unless cam_K says otherwise",
+    "data_set_name": "a dataset loader setting (Replica); that loader is not available",
+    "data_path": "a dataset loader setting; that loader is not available",
+    "avoid_rendering": "hybridgen always renders what the config's renderers ask",
+}
+"""``global`` keys that only configure Blender or BlenderProc internals: ignored with a notice."""

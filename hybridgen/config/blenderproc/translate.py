@@ -1,0 +1,69 @@
+"""One BlenderProc module entry -> hybridgen module entries (:func:`translate_module`)."""
+from __future__ import annotations
+
+import copy
+from typing import Any, Callable
+
+from ...errors import ConfigError
+from .common import Note
+from .manipulators import entity, material
+from .names import ALIASES, UNAVAILABLE
+from .objects import (bop_loader, camera_loader, loader, mesh_initializer, passthrough, physics, pose_sampler,
+                      replacer)
+from .renderers import rgb, segmap, single_pass
+from .selectors import samplers_as_blenderproc
+from .writers import writer
+
+
+TRANSLATORS: dict[str, Callable[..., list[tuple[str, dict[str, Any]]]]] = {
+    "loader.ObjectLoader": lambda c, n: loader("loader.ObjectLoader", c, n),
+    "loader.ObjLoader": lambda c, n: loader("loader.ObjLoader", c, n),
+    "loader.PlyLoader": lambda c, n: loader("loader.PlyLoader", c, n),
+    "renderer.RgbRenderer": rgb,
+    "renderer.SegMapRenderer": segmap,
+    "renderer.NormalRenderer": single_pass("render_normals"),
+    "renderer.DepthRenderer": single_pass("render_depth"),
+    "renderer.DistanceRenderer": single_pass("render_distance"),
+    "renderer.FlowRenderer": single_pass(None),
+    "manipulators.EntityManipulator": entity,
+    "manipulators.ObjectManipulator": entity,
+    "manipulators.MaterialManipulator": material,
+    "object.PhysicsPositioning": physics,
+    "camera.CameraLoader": camera_loader,
+    "object.ObjectPoseSampler": pose_sampler,
+    "object.PositionSampler": pose_sampler,
+    "object.OnSurfaceSampler": passthrough("object.OnSurfaceSampler", "objects_to_sample", "surface"),
+    "lighting.SurfaceLighting": passthrough("lighting.SurfaceLighting", "selector"),
+    "constructor.BasicMeshInitializer": mesh_initializer,
+    "loader.BopLoader": bop_loader,
+    "object.ObjectReplacer": replacer,
+    "object.FloorExtractor": passthrough("object.FloorExtractor", "selector"),
+    "object.Hide": passthrough("object.Hide", "selector"),
+    "manipulators.FloorExtractor": passthrough("object.FloorExtractor", "selector"),
+}
+KEYS_ONLY_BLENDERPROC = ("constructor.BasicMeshInitializer", "object.ObjectReplacer", "renderer.NormalRenderer",
+                         "renderer.DepthRenderer", "renderer.DistanceRenderer", "renderer.FlowRenderer",
+                         "loader.ObjectLoader", "loader.PlyLoader")
+"""BlenderProc names whose keys are BlenderProc's in any config (hybridgen has no module of that name)."""
+WRITERS = {name: writer(name) for name in ("writer.Hdf5Writer", "writer.BopWriter", "writer.CocoAnnotationsWriter")}
+
+
+def translate_module(name: str, config: dict[str, Any], note: Note,
+                     state: dict[str, Any]) -> list[tuple[str, dict[str, Any]]]:
+    """hybridgen ``(module name, config)`` entries doing what BlenderProc's ``name`` with ``config`` does.
+
+    Keys and defaults are translated for configs in BlenderProc's form (``state["blenderproc"]``: a
+    ``version``, ``module:`` entries or Blender ``setup`` keys); hybridgen's own form only resolves names.
+    ``state`` carries what one module tells others (``postprocessing.Dist2Depth`` asks the renderers for
+    depth); :func:`finish` applies it once every module is translated.
+    """
+    if name in UNAVAILABLE:
+        raise ConfigError(f"not available in hybridgen: {UNAVAILABLE[name]}", key="module")
+    if not state.get("blenderproc") and name not in KEYS_ONLY_BLENDERPROC:
+        return [(ALIASES.get(name, name), config)]  # hybridgen's own form: names only, hybridgen's keys
+    config = samplers_as_blenderproc(copy.deepcopy(config), note, "config")
+    if name in WRITERS:
+        return WRITERS[name](config, note, state)
+    if name in TRANSLATORS:
+        return TRANSLATORS[name](config, note)
+    return [(ALIASES.get(name, name), config)]
