@@ -22,6 +22,7 @@ from typing import Any, Callable, Sequence
 from ._version import __version__
 from .errors import HybridgenError, InputError
 from .logs import LOGGER, configure, level_for, log_line
+from .run.executor import DEFAULT_MAX_TASKS_PER_CHILD, EXECUTORS
 
 EXIT_USER_ERROR = 2
 EXIT_INTERRUPTED = 130
@@ -215,7 +216,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--workers", type=int, default=1, help="processes running work units in parallel (default 1)")
     run.add_argument("--shard", metavar="I/N",
                      help="run only the scenes with scene %% N == I (for SLURM arrays and indexed jobs)")
-    run.add_argument("--executor", default="pool", choices=("pool", "ray"),
+    run.add_argument("--executor", default=EXECUTORS[0], choices=EXECUTORS,
                      help="where work units run: a local process pool (default) or Ray")
     run.add_argument("--address", help="address of a running Ray cluster (with --executor ray; default: "
                      "start a local one)")
@@ -224,7 +225,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--force-resume", action="store_true",
                      help="reuse existing outputs that verify even if another config or other inputs made them "
                      "(the result then mixes both)")
-    run.add_argument("--max-tasks-per-child", type=int, default=25,
+    run.add_argument("--max-tasks-per-child", type=int, default=DEFAULT_MAX_TASKS_PER_CHILD,
                      help="work units a pool worker renders before it is replaced (bounds memory growth)")
 
     modules = _command(sub, "modules", _cmd_modules, "list modules, their parameters and the samplers",
