@@ -8,6 +8,7 @@ from ..config.schema import Param
 from ..errors import HybridgenError
 from ..io.renamed_sink import check_output_keys
 from ..render.label_request import LabelRequest, parse_map_by
+from ..render.passes import pass_options
 from ..render.raster import NORMAL_SPACES
 
 
@@ -24,11 +25,12 @@ def _background_check(value: Any) -> str | None:
 
 
 def label_params(*, depth: bool, normals: bool, map_by: Any) -> tuple[Param, ...]:
-    """The label keys with this renderer's defaults."""
+    """The label keys with this renderer's defaults: one boolean per pass option of the catalogue
+    (:func:`hybridgen.render.passes.pass_options`), then the options that shape the passes."""
+    defaults = {"render_depth": depth, "render_normals": normals}
     return (
-        Param("render_depth", "bool", depth, doc="write 'depth' (camera z, m)"),
-        Param("render_distance", "bool", False, doc="write 'distance' (Euclidean from the camera centre, m)"),
-        Param("render_normals", "bool", normals, doc="write 'normals' (unit, facing the camera)"),
+        *(Param(option, "bool", defaults.get(option, False), doc=entries[0].option_doc)
+          for option, entries in pass_options().items()),
         Param("normals_space", "str", "camera", choices=NORMAL_SPACES, doc="axes of 'normals': camera (OpenCV) "
               "or world"),
         Param("map_by", "str|list|null", map_by, check=lambda v: None if v is None else _map_by_check(v),
@@ -36,12 +38,6 @@ def label_params(*, depth: bool, normals: bool, map_by: Any) -> tuple[Param, ...
               "instance_attribute_maps, <attr> -> <attr>_segmaps; null: none"),
         Param("depth_background", "float|str", math.inf, "m", "depth/distance of pixels that hit nothing",
               check=_background_check),
-        Param("render_albedo", "bool", False, doc="write 'albedo': linear base color / texture at each pixel"),
-        Param("render_flow", "bool", False, doc="write forward/backward optical flow [px] between consecutive "
-              "keypoints with *_flow_occluded masks"),
-        Param("render_nocs", "bool", False, doc="write 'nocs': normalized object coordinates in [0, 1]"),
-        Param("render_object_records", "bool", False, doc="write 'object_records' per keypoint: object-to-camera "
-              "poses, 3D boxes, visible and amodal 2D boxes, pixel counts, visible fractions"),
         Param("output_keys", "dict|null", None, check=check_output_keys, doc="store passes under other names, "
               "{pass: name} (e.g. {colors: rgb, depth: depth_m}); every writer sees the new name "
               "(BlenderProc's output_key / *_output_key)"),
@@ -51,12 +47,10 @@ def label_params(*, depth: bool, normals: bool, map_by: Any) -> tuple[Param, ...
 def label_request(config: dict[str, Any]) -> LabelRequest:
     """The LabelRequest a renderer module's validated config asks for."""
     background = config["depth_background"]
-    return LabelRequest(
-        depth=config["render_depth"], distance=config["render_distance"], normals=config["render_normals"],
-        map_by=[] if config["map_by"] is None else parse_map_by(config["map_by"]),
+    return LabelRequest.from_options(
+        config, map_by=[] if config["map_by"] is None else parse_map_by(config["map_by"]),
         depth_background=math.inf if isinstance(background, str) else float(background),
-        normals_space=config["normals_space"], albedo=config["render_albedo"], flow=config["render_flow"],
-        nocs=config["render_nocs"], object_records=config["render_object_records"])
+        normals_space=config["normals_space"])
 
 
 def stored_keys(config: dict[str, Any], extra: Iterable[str] = ()) -> frozenset[str] | None:

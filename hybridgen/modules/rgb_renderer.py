@@ -86,8 +86,7 @@ class RgbRenderer(Module):
         if cfg["resolution_x"] is not None or cfg["resolution_y"] is not None:
             scene.camera.intrinsics = scene.camera.intrinsics.resized(cfg["resolution_x"], cfg["resolution_y"])
         request = label_request(cfg)
-        wants_labels = any((request.depth, request.distance, request.normals, request.map_by, request.albedo,
-                            request.flow, request.nocs, request.object_records))
+        wants_labels = request.wants_any
         threshold = cfg["noise_threshold"] if cfg["noise_threshold"] is not None else cfg["use_adaptive_sampling"]
         settings = PathTraceSettings(cfg["samples"], cfg["min_bounces"], cfg["max_bounces"], cfg["glossy_bounces"],
                                      noise_threshold=threshold, min_samples=cfg["min_samples"],

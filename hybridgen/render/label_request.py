@@ -10,7 +10,8 @@ from ..errors import InputError
 from ..io.frame_sink import PassLayout
 from ..scene.scene import Scene
 from .keypoint_frame import KeypointFrame, LabelTables
-from .passes import PASSES, layout, spec
+from . import passes as catalogue
+from .passes import layout, pass_options, spec
 from .readback import RasterOutput
 
 MAP_BY_ALIASES = {"class": "category_id", "instance": "instance"}
@@ -23,8 +24,8 @@ class LabelRequest:
     ``map_by`` entries: ``class`` (``category_id_segmaps``), ``instance`` (``instance_segmaps`` plus the
     per-keypoint ``instance_attribute_maps``) or the name of a numeric object attribute ``a``
     (``a_segmaps``). ``albedo``, ``flow``, ``nocs`` and ``object_records`` add those passes of
-    :mod:`hybridgen.render.passes`. ``extra`` names on-request passes sinks asked for; each is made when
-    this request makes its ``with_keys``.
+    :mod:`hybridgen.render.passes`; ``passes`` adds any other catalogue pass by key (after these). ``extra``
+    names on-request passes sinks asked for; each is made when this request makes its ``with_keys``.
     """
 
     depth: bool = True
@@ -37,6 +38,7 @@ class LabelRequest:
     flow: bool = False
     nocs: bool = False
     object_records: bool = False
+    passes: tuple[str, ...] = ()
     extra: tuple[str, ...] = ()
 
     def segmap_attributes(self) -> list[str]:
@@ -63,13 +65,28 @@ class LabelRequest:
         keys += [key for key, wanted in flags.items() if wanted]
         if self.flow:
             keys += ["forward_flow", "forward_flow_occluded", "backward_flow", "backward_flow_occluded"]
+        keys += [key for key in catalogue.PASSES if key in self.passes and key not in keys]
         return keys + [key for key in self.on_request(self.extra, keys)]
+
+    @classmethod
+    def from_options(cls, options: dict[str, Any], **settings: Any) -> "LabelRequest":
+        """The request of a renderer's boolean pass options (``render_depth``, ... - every catalogue
+        ``option``): options named after a field (``render_<field>``) set it, the others add their passes.
+        ``settings``: the other fields (map_by, depth_background, normals_space)."""
+        fields, passes = {}, []
+        for option, entries in pass_options().items():
+            name = option.removeprefix("render_")
+            if name in cls.__dataclass_fields__:
+                fields[name] = bool(options[option])
+            elif options[option]:
+                passes += [entry.key for entry in entries]
+        return cls(**fields, **settings, passes=tuple(passes))
 
     @staticmethod
     def on_request(wanted: Collection[str], keys: Collection[str]) -> list[str]:
         """The on-request passes of ``wanted`` a renderer making ``keys`` makes too."""
-        return [key for key in dict.fromkeys(wanted) if key in PASSES and PASSES[key].on_request
-                and all(k in keys for k in PASSES[key].with_keys)]
+        return [key for key in dict.fromkeys(wanted) if key in catalogue.PASSES and catalogue.PASSES[key].on_request
+                and all(k in keys for k in catalogue.PASSES[key].with_keys)]
 
     def with_sinks(self, sinks: Collection[Any]) -> "LabelRequest":
         """This request plus the on-request passes ``sinks`` ask for (``wanted_passes()``)."""

@@ -52,7 +52,9 @@ class PassSpec:
     depth_scale = mm), ``srgb`` (linear -> 8-bit sRGB), ``half_unit`` ((n + 1) / 2 -> 8 bit), ``kitti_flow``;
     empty: chosen by dtype and shape. ``show``: ``metric``, ``ids``, ``half_unit``, ``srgb``, ``flow``,
     ``mask``, ``as_stored``; empty: chosen by dtype and shape. ``smooth``: gallery thumbnails resample it
-    with interpolation (continuous values; uint8 color images are too).
+    with interpolation (continuous values; uint8 color images are too). ``option``: the boolean renderer
+    parameter that turns the pass on (renderer modules declare one per option, documented by
+    ``option_doc``; the hint is then 'set <option>: true on the renderer' unless ``request`` says more).
     """
 
     key: str
@@ -75,6 +77,8 @@ class PassSpec:
     with_keys: tuple[str, ...] = ()
     rank: int = 1  # contact sheets: lower first
     smooth: bool = False
+    option: str = ""
+    option_doc: str = ""
 
     def shape(self, width: int, height: int) -> tuple[int, ...]:
         """Per-keypoint shape at ``width`` x ``height`` pixels."""
@@ -105,29 +109,31 @@ def _flow(step: int, part: int) -> Compute:
 
 
 def _flow_specs(direction: str, step: int) -> tuple[PassSpec, PassSpec]:
-    request = "set render_flow: true on the renderer"
+    option = {"option": "render_flow", "option_doc": "write forward/backward optical flow [px] between consecutive "
+              "keypoints with *_flow_occluded masks"}
     return (PassSpec(f"{direction}_flow", "float32", 2, f"image motion (u, v) of each pixel's surface point to "
-                     f"keypoint i {'+' if step > 0 else '-'} 1 (static scene); 0 where undefined", request,
+                     f"keypoint i {'+' if step > 0 else '-'} 1 (static scene); 0 where undefined", "",
                      _flow(step, 0), ("raster", "neighbours"), units="px", png="kitti_flow",
-                     exr_channels=("u", "v"), show="flow"),
+                     exr_channels=("u", "v"), show="flow", **option),
             PassSpec(f"{direction}_flow_occluded", "uint8", 0, "1 where the point is not visible in the other "
-                     "keypoint (or there is none)", request, _flow(step, 1), ("raster", "neighbours"),
-                     background="1", show="mask"))
+                     "keypoint (or there is none)", "", _flow(step, 1), ("raster", "neighbours"),
+                     background="1", show="mask", **option))
 
 
 _COLOR = "render color with renderer.RgbRenderer before this writer"
 _SPECS = (
-    PassSpec("depth", "float32", 0, "distance along the optical axis (camera z)", "set render_depth: true on the "
-             "renderer", _raster(raster.depth), units="m", frame="camera", background="depth_background (inf by "
-             "default)", pattern="*depth", png="millimetres", show="metric"),
-    PassSpec("distance", "float32", 0, "Euclidean distance from the camera centre", "set render_distance: true on "
-             "the renderer", _raster(raster.distance), units="m", background="depth_background",
-             pattern="*distance", hdf5="derived_from_depth", png="millimetres", show="metric"),
-    PassSpec("normals", "float32", 3, "unit surface normal facing the camera, xyz in [-1, 1]", "set "
-             "render_normals: true on the renderer", _raster(raster.normals), frame="camera (OpenCV) or world "
-             "(normals_space)", background="(0, 0, 0)", pattern="normals*", hdf5="octahedral",
-             blenderproc="blender_half_unit", png="half_unit", exr_channels=("X", "Y", "Z"), show="half_unit",
-             smooth=True),
+    PassSpec("depth", "float32", 0, "distance along the optical axis (camera z)", "", _raster(raster.depth),
+             units="m", background="depth_background (inf by default)", pattern="*depth", png="millimetres",
+             show="metric", option="render_depth", option_doc="write 'depth' (camera z, m)"),
+    PassSpec("distance", "float32", 0, "Euclidean distance from the camera centre", "", _raster(raster.distance),
+             units="m", background="depth_background", pattern="*distance", hdf5="derived_from_depth",
+             png="millimetres", show="metric", option="render_distance",
+             option_doc="write 'distance' (Euclidean from the camera centre, m)"),
+    PassSpec("normals", "float32", 3, "unit surface normal facing the camera, xyz in [-1, 1]", "",
+             _raster(raster.normals), frame="camera (OpenCV) or world (normals_space)", background="(0, 0, 0)",
+             pattern="normals*", hdf5="octahedral", blenderproc="blender_half_unit", png="half_unit",
+             exr_channels=("X", "Y", "Z"), show="half_unit", smooth=True, option="render_normals",
+             option_doc="write 'normals' (unit, facing the camera)"),
     PassSpec("<attribute>_segmaps", "int32", 0, "the object's numeric attribute (category_id_segmaps: its "
              "category_id)", "add 'class' (category_id) or the attribute to map_by of the renderer", _segmap,
              pattern="*_segmaps", show="ids"),
@@ -135,15 +141,18 @@ _SPECS = (
              _raster(raster.instance_ids), show="ids"),
     PassSpec("instance_attribute_maps", "json", None, "[{idx, category_id, name, custom attributes}] of each "
              "instance in the map, by id", INSTANCE_HINT, lambda frame, key: frame.tables.visible(frame.raw.instance)),
-    PassSpec("albedo", "float32", 3, "diffuse base color / texture at each pixel centre", "set render_albedo: "
-             "true on the renderer", lambda frame, key: frame.raster.albedo.render(frame.cam2world), ("albedo",),
-             units="linear RGB", background="the world color", png="srgb", show="srgb", smooth=True),
-    PassSpec("nocs", "float32", 3, "normalized object coordinates in [0, 1] (NOCS paper)", "set render_nocs: "
-             "true on the renderer", lambda frame, key: nocs(frame.raw, frame.intrinsics, frame.cam2world,
-                                                             frame.scene), show="as_stored", smooth=True),
+    PassSpec("albedo", "float32", 3, "diffuse base color / texture at each pixel centre", "",
+             lambda frame, key: frame.raster.albedo.render(frame.cam2world), ("albedo",), units="linear RGB",
+             background="the world color", png="srgb", show="srgb", smooth=True, option="render_albedo",
+             option_doc="write 'albedo': linear base color / texture at each pixel"),
+    PassSpec("nocs", "float32", 3, "normalized object coordinates in [0, 1] (NOCS paper)", "",
+             lambda frame, key: nocs(frame.raw, frame.intrinsics, frame.cam2world, frame.scene), show="as_stored",
+             smooth=True, option="render_nocs", option_doc="write 'nocs': normalized object coordinates in [0, 1]"),
     PassSpec("object_records", "json", None, "per object in view: obj2cam, 3D box, visible and amodal 2D boxes, "
-             "pixel counts, visible fraction (render/object_records.py)", "set render_object_records: true on "
-             "the renderer", lambda frame, key: object_records(frame), ("raster", "silhouettes")),
+             "pixel counts, visible fraction (render/object_records.py)", "",
+             lambda frame, key: object_records(frame), ("raster", "silhouettes"), option="render_object_records",
+             option_doc="write 'object_records' per keypoint: object-to-camera poses, 3D boxes, visible and "
+             "amodal 2D boxes, pixel counts, visible fractions"),
     *_flow_specs("forward", 1), *_flow_specs("backward", -1),
     PassSpec("amodal_masks", "object", None, "{instance id: (H, W) bool full silhouette inside the image}",
              INSTANCE_HINT, amodal_masks, ("raster", "silhouettes"), on_request=True,
@@ -200,7 +209,9 @@ def exact(stored: str) -> PassSpec | None:
 def hint(key: str) -> str:
     """How to make ``key`` (for 'needs ... which no renderer writes' errors)."""
     found = recognise(key)
-    return found.request if found else f"make a renderer write '{key}'"
+    if found is None:
+        return f"make a renderer write '{key}'"
+    return found.request or f"set {found.option}: true on the renderer"
 
 
 def layout(key: str, width: int, height: int, **meaning: Any) -> PassLayout:
@@ -216,6 +227,15 @@ def color_keys(*, hdr: bool = False, raw: bool = False, sample_counts: bool = Fa
     when asked for (``raw`` only means something with denoising)."""
     flags = {"colors": True, "colors_hdr": hdr, "colors_raw": raw, "sample_counts": sample_counts}
     return [key for key, wanted in flags.items() if wanted]
+
+
+def pass_options() -> dict[str, list[PassSpec]]:
+    """Renderer options that turn passes on -> the passes each turns on, in catalogue order."""
+    out: dict[str, list[PassSpec]] = {}
+    for entry in _SPECS:
+        if entry.option:
+            out.setdefault(entry.option, []).append(entry)
+    return out
 
 
 def on_request(key: str) -> bool:

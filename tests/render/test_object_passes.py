@@ -85,7 +85,7 @@ def test_every_requested_key_has_a_catalogue_entry_with_a_layout_and_a_hint():
     assert keys[-3:] == list(WANTED) and "tag_segmaps" in keys
     for key in keys:
         entry = passes.spec(key)
-        assert entry.compute is not None and entry.request
+        assert entry.compute is not None and passes.hint(key).startswith(("set render_", "add '"))
         layout = request.layout(key, 8, 6)
         assert layout.shape == (() if entry.channels is None else (6, 8) if entry.channels == 0
                                 else (6, 8, entry.channels))
@@ -125,3 +125,26 @@ def test_labels_and_denoising_guides_share_one_raster_view(gl_context, monkeypat
     assert len(built) == 1  # one upload of the geometry for labels, albedo and the guides
     for ours, reference in zip(guides[0], alone):  # the shared view draws the same guides bit for bit
         np.testing.assert_array_equal(ours, reference)
+
+
+def test_a_new_catalogue_entry_is_a_renderer_option_and_a_delivered_pass(gl_context, monkeypatch):
+    """Adding a pass is one entry: the renderer modules get its option, the request and the sinks its values."""
+    from hybridgen.modules.label_params import label_params, label_request
+    from hybridgen.render.passes import PassSpec
+
+    entry = PassSpec("hit_mask", "uint8", 0, "1 where a surface was hit", "", lambda frame, key:
+                     frame.raw.hit.astype("uint8"), option="render_hit_mask", option_doc="write 'hit_mask'")
+    monkeypatch.setattr(passes, "_SPECS", (*passes._SPECS, entry))
+    monkeypatch.setattr(passes, "PASSES", {**passes.PASSES, "hit_mask": entry})
+    params = {p.name: p for p in label_params(depth=True, normals=False, map_by=None)}
+    assert params["render_hit_mask"].default is False and params["render_depth"].default is True
+    config = {name: p.default for name, p in params.items()} | {"render_hit_mask": True}
+    request = label_request(config)
+    assert request.keys() == ["depth", "hit_mask"]
+    scene = _half_hidden_cube()
+    sink = MemorySink()
+    hg.render_labels(scene, [sink], request)
+    frame = sink.frames[0]
+    np.testing.assert_array_equal(frame["hit_mask"], np.isfinite(frame["depth"]).astype(np.uint8))
+    assert sink.layouts["hit_mask"].shape == (48, 64) and passes.hint("hit_mask") == "set render_hit_mask: true " \
+        "on the renderer"
