@@ -56,12 +56,12 @@ def describe_samplers() -> str:
 
 def describe_aliases() -> str:
     """BlenderProc module names: the hybridgen module each one runs as, and those hybridgen cannot provide."""
-    from .blenderproc import ALIASES, UNAVAILABLE
+    from .blenderproc import ALIASES, UNAVAILABLE, unavailable_reason
 
     lines = ["BlenderProc module names (read with BlenderProc's keys in configs of BlenderProc's form):"]
     lines += [f"    {alias} -> {target}" for alias, target in sorted(ALIASES.items())]
     lines.append("not available (each fails with this reason):")
-    lines += [f"    {name}: {why}" for name, why in sorted(UNAVAILABLE.items())]
+    lines += [f"    {name}: {why}" for name in sorted(UNAVAILABLE) if (why := unavailable_reason(name))]
     return "\n".join(lines)
 
 

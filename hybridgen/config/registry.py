@@ -96,10 +96,11 @@ def get_module(name: object) -> type["Module"]:
     _load_all()
     if not isinstance(name, str) or not name:
         raise ConfigError(f"module 'name' must be a non-empty string, got {name!r}", key="name")
-    from .blenderproc import ALIASES, UNAVAILABLE
+    from .blenderproc import ALIASES, unavailable_reason
 
-    if name in UNAVAILABLE:
-        raise ConfigError(f"not available in hybridgen: {UNAVAILABLE[name]}", key="name")
+    reason = unavailable_reason(name)
+    if reason is not None:
+        raise ConfigError(f"not available in hybridgen: {reason}", key="name")
     name = ALIASES.get(name, name)
     if name not in MODULES:
         raise ConfigError(f"unknown module '{name}'{closest(name, MODULES)}; `hybridgen modules` lists them",

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from hybridgen.config.blenderproc import ALIASES, UNAVAILABLE
+from hybridgen.config.blenderproc import ALIASES, UNAVAILABLE, unavailable_reason
 from hybridgen.config.config_file import load_config
 from hybridgen.config.notices import set_sink
 from hybridgen.config.registry import all_modules, get_module
@@ -38,13 +38,28 @@ writer.ShapeNetWriter object.ObjectReplacer loader.PlyLoader manipulators.FloorE
 def test_every_blenderproc_module_name_resolves_or_says_why():
     known = all_modules()
     for name in BLENDERPROC_MODULES:
-        if name in UNAVAILABLE:
+        if unavailable_reason(name) is not None:
             with pytest.raises(ConfigError) as info:
                 get_module(name)
             assert "not available in hybridgen" in str(info.value) and "unknown module" not in str(info.value)
         else:
             cls = get_module(name)
             assert cls is known[ALIASES.get(name, name)]
+
+
+def test_a_registered_module_wins_over_its_unavailable_entry(monkeypatch):
+    """A loader added since (or a plugin) under a name listed as unavailable is the module that runs."""
+    from hybridgen.config import registry
+
+    name = "loader.Pix3DLoader"
+    assert name in UNAVAILABLE
+    all_modules()
+    if name not in registry.MODULES:
+        with pytest.raises(ConfigError, match="not available in hybridgen"):
+            get_module(name)
+    stand_in = type("Pix3DStandIn", (), {})
+    monkeypatch.setitem(registry.MODULES, name, stand_in)
+    assert unavailable_reason(name) is None and get_module(name) is stand_in
 
 
 def run_config_text(tmp_path: Path, text: str, args: list[str] | None = None):

@@ -14,7 +14,7 @@ documentation, to hybridgen's own modules.
 from __future__ import annotations
 
 from .common import Note, custom_properties
-from .names import ALIASES, UNAVAILABLE
+from .names import ALIASES, UNAVAILABLE, unavailable_reason
 from .selectors import samplers_as_blenderproc, selector
 from .setup_keys import BLENDER_PYTHON_PACKAGES, BLENDER_SETUP_KEYS, GLOBAL_IGNORED
 from .translate import KEYS_ONLY_BLENDERPROC, TRANSLATORS, WRITERS, translate_module
@@ -22,4 +22,4 @@ from .writers import finish
 
 __all__ = ["ALIASES", "BLENDER_PYTHON_PACKAGES", "BLENDER_SETUP_KEYS", "GLOBAL_IGNORED", "KEYS_ONLY_BLENDERPROC",
            "Note", "TRANSLATORS", "UNAVAILABLE", "WRITERS", "custom_properties", "finish", "samplers_as_blenderproc",
-           "selector", "translate_module"]
+           "selector", "translate_module", "unavailable_reason"]

@@ -58,3 +58,13 @@ UNAVAILABLE = {
                        "'hybridgen.modules')",
 }
 """Modules hybridgen cannot provide: one line why, and what to do instead."""
+
+
+def unavailable_reason(name: str) -> str | None:
+    """Why ``name`` is not available, or None: a registered module of that name (a loader added since, a
+    plugin) wins over its :data:`UNAVAILABLE` entry."""
+    if name not in UNAVAILABLE:
+        return None
+    from ..registry import all_modules
+
+    return None if name in all_modules() else UNAVAILABLE[name]

@@ -7,7 +7,7 @@ from typing import Any, Callable
 from ...errors import ConfigError
 from .common import Note
 from .manipulators import entity, material
-from .names import ALIASES, UNAVAILABLE
+from .names import ALIASES, unavailable_reason
 from .objects import (bop_loader, camera_loader, loader, mesh_initializer, passthrough, physics, pose_sampler,
                       replacer)
 from .renderers import rgb, segmap, single_pass
@@ -57,8 +57,9 @@ def translate_module(name: str, config: dict[str, Any], note: Note,
     ``state`` carries what one module tells others (``postprocessing.Dist2Depth`` asks the renderers for
     depth); :func:`finish` applies it once every module is translated.
     """
-    if name in UNAVAILABLE:
-        raise ConfigError(f"not available in hybridgen: {UNAVAILABLE[name]}", key="module")
+    reason = unavailable_reason(name)
+    if reason is not None:
+        raise ConfigError(f"not available in hybridgen: {reason}", key="module")
     if not state.get("blenderproc") and name not in KEYS_ONLY_BLENDERPROC:
         return [(ALIASES.get(name, name), config)]  # hybridgen's own form: names only, hybridgen's keys
     config = samplers_as_blenderproc(copy.deepcopy(config), note, "config")
