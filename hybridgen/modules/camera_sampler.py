@@ -73,10 +73,10 @@ class CameraSampler(Module):
                                f"({report.summary()})")
                     if cfg["on_failure"] == "error":
                         raise InputError(message + "; relax the checks or raise max_tries")
-                    context.log(f"warning: camera.CameraSampler {message}")
+                    context.log(f"warning: {self.module_name} {message}")
         finally:
             view.release()
-        context.log(f"camera.CameraSampler: {report.summary()}")
+        context.log(f"{self.module_name}: {report.summary()}")
 
     @staticmethod
     def _ids(value: Any, context: RunContext, key: str) -> frozenset[int]:
