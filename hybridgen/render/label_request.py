@@ -132,7 +132,7 @@ class LabelRequest:
         return values
 
 
-def value_ranges(request: LabelRequest, tables: LabelTables, scene: Scene) -> dict[str, np.ndarray]:
+def value_ranges(tables: LabelTables, scene: Scene) -> dict[str, np.ndarray]:
     """Id passes -> the values they can hold in ``scene`` (writers store them in the narrowest type)."""
     ranges = {f"{attribute}_segmaps": lut for attribute, lut in tables.luts.items()}
     ranges["instance_segmaps"] = np.array([0, *(o.instance_id for o in scene.objects)])

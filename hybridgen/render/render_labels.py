@@ -9,10 +9,11 @@ import numpy as np
 from ..errors import InputError
 from ..io.frame_sink import FrameSink, PassLayout
 from ..scene.scene import Scene
-from .keypoint_frame import KeypointFrame, SceneRaster
+from .keypoint_frame import KeypointFrame
 from .keypoint_loop import ProgressFactory, run_keypoints
 from .label_request import LabelRequest, value_ranges
 from .raster import RasterView
+from .scene_raster import SceneRaster
 
 
 class LabelProducer:
@@ -40,7 +41,7 @@ class LabelProducer:
         """The request's layouts; id passes carry the range of ids this scene can produce (writers store
         them in the smallest integer type that holds it)."""
         intr = self.scene.camera.intrinsics
-        ranges = value_ranges(self.request, self._tables, self.scene)
+        ranges = value_ranges(self._tables, self.scene)
         return [replace(layout, value_range=(min(0, int(ranges[layout.key].min())), int(ranges[layout.key].max())))
                 if layout.key in ranges else layout
                 for layout in self.request.layouts(intr.width, intr.height)]
