@@ -1,12 +1,21 @@
-"""BOP's per-image JSON files (``scene_camera.json``, ``scene_gt.json``, ``scene_gt_info.json``): written as
-the BOP toolkit writes them, read back when a run appends to a chunk."""
+"""BOP's JSON files: ``camera.json`` and the per-image ``scene_camera.json``, ``scene_gt.json``,
+``scene_gt_info.json``, written as the BOP toolkit writes them, read back when a run appends to a chunk."""
 from __future__ import annotations
 
 import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ..errors import InputError
+
+
+def camera_json_text(K: np.ndarray, depth_scale: float, height: int, width: int) -> str:
+    """``camera.json``: the intrinsics ``K`` (px) of every image, ``depth_scale`` and the image size."""
+    camera = {"cx": float(K[0, 2]), "cy": float(K[1, 2]), "depth_scale": depth_scale, "fx": float(K[0, 0]),
+              "fy": float(K[1, 1]), "height": height, "width": width}
+    return json.dumps(camera, sort_keys=True, indent=2)
 
 
 def bop_json_text(content: dict[int, Any]) -> str:

@@ -32,7 +32,6 @@ staged under temporary names and renamed, the JSON files last, only when the run
 """
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
@@ -42,14 +41,15 @@ import numpy as np
 from ..config.options import option
 from ..config.schema import positive
 from ..errors import InputError
+from ..render.passes import hint
 from ..scene.mesh_object import MeshObject
 from ..scene.rigid_pose import model_to_camera
 from ..scene.scene import Scene
 from .atomic import confined_path, prepare_output_dir
 from .bop_chunks import Chunks
+from .bop_json import camera_json_text
 from .coco_content import annotation
 from .depth_png import depth_png_values
-from ..render.passes import hint
 from .frame_sink import PassLayout
 from .image_files import StagedFiles, color_format_option, jpeg_bytes, jpg_quality_option, png_bytes, write_file
 from .mask_encoding import bbox_of, rle_uncompressed
@@ -64,9 +64,7 @@ NO_BOX = [-1, -1, -1, -1]
 
 @dataclass(frozen=True)
 class BopOptions:
-    """The options of a BOP dataset, declared once: writer.BopWriter's parameters are these
-    (:func:`~hybridgen.config.options.option_params`); Python callers build them with
-    :func:`~hybridgen.config.options.checked_options`."""
+    """The options of a BOP dataset, declared once (writer.BopWriter's parameters; :mod:`hybridgen.config.options`)."""
 
     dataset: str = option("", "str", "dataset folder inside output_dir; if set, only objects whose "
                           "'bop_dataset_name' attribute is this are annotated")
@@ -292,12 +290,9 @@ class BopWriter:
         self._unlock()
 
     def _json_texts(self) -> dict[Path, str]:
-        K = self.camera["cam_K"][0]
         assert self.image_size is not None
-        height, width = self.image_size
-        camera = {"cx": float(K[0, 2]), "cy": float(K[1, 2]), "depth_scale": self.depth_scale, "fx": float(K[0, 0]),
-                  "fy": float(K[1, 1]), "height": height, "width": width}
-        texts = {self.dataset_dir / "camera.json": json.dumps(camera, sort_keys=True, indent=2)}
+        texts = {self.dataset_dir / "camera.json": camera_json_text(self.camera["cam_K"][0], self.depth_scale,
+                                                                    *self.image_size)}
         for chunk_id in sorted(self.chunks.chunks):
             self._staged.make_dir(self.chunks.folder(chunk_id))
         categories = sorted({int(o.category_id) for o in self.objects or []})
