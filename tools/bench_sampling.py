@@ -146,15 +146,7 @@ class RayGrid:
 def ray_failures(grid: RayGrid, cam2world: np.ndarray, intr: Any, checks: Any) -> list[str]:
     """The checks ``pose_failures`` makes, answered from the ray grid (no hidden objects in this scene)."""
     distance, hit, instance = grid.cast(cam2world, intr)
-    failed = checks.proximity.failures(distance, hit)
-    if checks.must_see or checks.coverage_of:
-        present = set(np.unique(instance).tolist())
-        if not checks.must_see <= present:
-            failed.append("visible")
-        if checks.coverage_of and np.isin(instance, list(checks.coverage_of)).mean() < checks.min_coverage:
-            failed.append("coverage")
-    failed += checks.novelty.failures(cam2world)
-    return failed
+    return checks.failures(cam2world, distance, hit, lambda: instance)
 
 
 def bench_cameras(context: Any, module: Any, count: int, rounds: int) -> tuple[list[dict[str, Any]], dict]:

@@ -24,6 +24,22 @@ class PoseChecks:
     min_coverage: float = 0.0  # fraction of the check image those objects must cover
     novelty: NoveltyCheck = field(default_factory=NoveltyCheck)
 
+    def failures(self, cam2world: np.ndarray, distance: np.ndarray, hit: np.ndarray,
+                 instance_ids: Callable[[], np.ndarray]) -> list[str]:
+        """Names of the checks a candidate fails (empty: accepted), in check order, from its per-pixel
+        distance (m, rays passing through ``excluded`` objects), hit mask and - asked only when a visibility
+        or coverage check needs them - instance ids with every object drawn."""
+        failed = self.proximity.failures(distance, hit)
+        if self.must_see or self.coverage_of:
+            ids = instance_ids()
+            present = set(np.unique(ids).tolist())
+            if not self.must_see <= present:
+                failed.append("visible")
+            if self.coverage_of and np.isin(ids, list(self.coverage_of)).mean() < self.min_coverage:
+                failed.append("coverage")
+        failed += self.novelty.failures(cam2world)
+        return failed
+
 
 @dataclass
 class SamplingReport:
@@ -46,19 +62,13 @@ def check_intrinsics(intr: Intrinsics, width: int) -> Intrinsics:
 
 def pose_failures(view: RasterView, cam2world: np.ndarray, intr: Intrinsics, checks: PoseChecks) -> list[str]:
     """Names of the checks ``cam2world`` fails (empty: accepted), from one or two low-resolution draws."""
-    failed: list[str] = []
     raw = view.render_raw(cam2world, intr, hidden=checks.excluded)
     distance = raw.normal_depth[..., 3] * raw.ray_lengths
-    failed += checks.proximity.failures(distance, raw.hit)
-    if checks.must_see or checks.coverage_of:
-        ids = raw.instance if not checks.excluded else view.render_raw(cam2world, intr).instance
-        present = set(np.unique(ids).tolist())
-        if not checks.must_see <= present:
-            failed.append("visible")
-        if checks.coverage_of and np.isin(ids, list(checks.coverage_of)).mean() < checks.min_coverage:
-            failed.append("coverage")
-    failed += checks.novelty.failures(cam2world)
-    return failed
+
+    def instance_ids() -> np.ndarray:
+        return raw.instance if not checks.excluded else view.render_raw(cam2world, intr).instance
+
+    return checks.failures(cam2world, distance, raw.hit, instance_ids)
 
 
 def sample_camera_poses(scene: Scene, propose: Callable[[], np.ndarray], count: int, max_tries: int,
