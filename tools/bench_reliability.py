@@ -1,16 +1,29 @@
-"""What reliability costs: fingerprints and checksums on a 400-keypoint labels run, and peak memory of a
-labels-only run over 12 vs 120 scenes (memory must not grow with the number of scenes).
+"""What reliability costs: fingerprints, checksums and staged (resumable) writing on a 400-keypoint labels
+run, and peak memory of a labels-only run over 12 vs 120 scenes (memory must not grow with the number of
+scenes).
 
-Run: .venv/bin/python tools/bench_reliability.py [--keypoints 400] [--scenes 12 120] [--rounds 3]
+Run: .venv/bin/python tools/bench_reliability.py [--keypoints 400] [--size 128 96] [--scenes 12 120]
+     [--rounds 5]
 
-Overhead: the run is timed end to end (``hybridgen run`` in a fresh process), and the three added steps
-are timed on its outputs in this process: computing the fingerprint (config leaves + input file hashes,
-once per run), sealing (the SHA-256 over stored chunks written before commit, once per file) and
-verifying (what a resume does per existing file). Peak RSS is ``ru_maxrss`` of the run's process.
+Three variants of one config run in fresh processes, interleaved round by round (so load from other work
+hits them alike), each timed around ``hybridgen run`` (wall and CPU seconds, interpreter start excluded):
+
+- ``bare``: a direct write without the reliability work - no input file hashes in the fingerprint, no
+  ``content_sha256`` seal (both patched out in the child);
+- ``direct``: a direct write (``resume_chunk_keypoints: 0`` behaviour: one file streamed by the writer);
+- ``staged``: the default - keypoints rendered in verified, fingerprinted parts and merged into the same
+  bytes (the benchmark checks that ``staged`` and ``direct`` wrote identical files).
+
+All three run the same config text (the part size is patched in the child, so the fingerprint and thus the
+bytes agree). The steps are also timed one by one on the outputs in this process: computing the fingerprint
+(config leaves and input file hashes; a second time with the hash cache warm), sealing (SHA-256 over the
+stored chunks) and verifying (what a resume does per existing file). Peak RSS is ``ru_maxrss`` of the run's
+process.
 """
 from __future__ import annotations
 
 import argparse
+import json
 import shutil
 import statistics
 import subprocess
@@ -23,6 +36,19 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tools"))
 from bench_workers import CONFIG, KINDS  # noqa: E402  (one scene template for the run benchmarks)
 
+VARIANTS = ("bare", "direct", "staged")
+_PATCHES = {
+    "bare": ("import hybridgen.io.integrity as integrity, hybridgen.run.fingerprint as fingerprint, "
+             "hybridgen.run.staged_output as staged; integrity.content_digest = lambda h5: 'unsealed'; "
+             "fingerprint.input_files = lambda config: []; staged.part_keypoints = lambda requested, traces: 0"),
+    "direct": "import hybridgen.run.staged_output as staged; staged.part_keypoints = lambda requested, traces: 0",
+    "staged": "pass",
+}
+_CHILD = ("import json, resource, sys, time; {patch}; from hybridgen.cli import main; "
+          "t = time.perf_counter(); c = time.process_time(); rc = main(['run', '-q', sys.argv[1], sys.argv[2]]); "
+          "print(json.dumps([time.perf_counter() - t, time.process_time() - c, "
+          "resource.getrusage(resource.RUSAGE_SELF).ru_maxrss])); sys.exit(rc)")
+
 
 def config_text(scenes: int, width: int, height: int, keypoints: int) -> str:
     """bench_workers.py's labels-only scene (knot over a floor, sampled cameras, depth/distance/normals/ids)."""
@@ -31,49 +57,71 @@ def config_text(scenes: int, width: int, height: int, keypoints: int) -> str:
                          renderer=labels["renderer"], renderer_config=labels["renderer_config"])
 
 
-def _run(config: Path, out: Path) -> tuple[float, int]:
-    """(seconds, peak RSS in MiB) of one ``hybridgen run`` in a fresh process."""
-    code = ("import resource, sys, time; from hybridgen.cli import main; t = time.perf_counter(); "
-            "rc = main(['run', '-q', sys.argv[1], sys.argv[2]]); "
-            "print(time.perf_counter() - t, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss); sys.exit(rc)")
+def _run(config: Path, out: Path, variant: str = "staged") -> tuple[float, float, int]:
+    """(wall seconds, CPU seconds, peak RSS in MiB) of one ``hybridgen run`` into ``out`` in a fresh process."""
+    shutil.rmtree(out, ignore_errors=True)
+    code = _CHILD.format(patch=_PATCHES[variant])
     result = subprocess.run([sys.executable, "-c", code, str(config), str(out)], cwd=REPO, capture_output=True,
-                            text=True, check=True)
-    seconds, rss_kib = result.stdout.split()[-2:]
-    return float(seconds), int(rss_kib) // 1024
+                            text=True)
+    if result.returncode != 0:
+        raise SystemExit(f"{variant} run failed:\n{result.stderr[-3000:]}")
+    wall, cpu, rss_kib = json.loads(result.stdout.strip().splitlines()[-1])
+    return wall, cpu, int(rss_kib) // 1024
 
 
-def overhead(keypoints: int, rounds: int, tmp: Path) -> None:
+def _components(config: Path, out: Path) -> dict[str, float]:
+    """Seconds of the reliability steps, timed one by one on ``out``'s data.hdf5."""
+    import h5py
+
     from hybridgen.config.config_file import load_config
     from hybridgen.io.integrity import content_digest, verify
     from hybridgen.run.fingerprint import run_fingerprint
 
-    import h5py
-
-    config = tmp / "overhead.yaml"
-    config.write_text(config_text(1, 64, 48, keypoints))
-    runs, fingerprints, seals, verifies = [], [], [], []
-    for round_index in range(rounds):
-        out = tmp / f"overhead{round_index}"
-        runs.append(_run(config, out)[0])
-        loaded = load_config(config, [str(out)])
+    loaded = load_config(config, [str(out)])
+    times = {}
+    for name in ("fingerprint", "fingerprint (cached)"):
         start = time.perf_counter()
         run_fingerprint(loaded)
-        fingerprints.append(time.perf_counter() - start)
-        with h5py.File(out / "data.hdf5", "r") as h5:
-            start = time.perf_counter()
-            content_digest(h5)
-            seals.append(time.perf_counter() - start)
+        times[name] = time.perf_counter() - start
+    with h5py.File(out / "data.hdf5", "r") as h5:
         start = time.perf_counter()
-        assert verify(out / "data.hdf5") is None
-        verifies.append(time.perf_counter() - start)
-        shutil.rmtree(out)
-    run, fp, seal, ver = (statistics.median(v) for v in (runs, fingerprints, seals, verifies))
-    print(f"{keypoints} keypoints, 64x48 labels (depth, distance, normals, class, instance), gzip 1, "
-          f"median of {rounds}:")
-    print(f"  whole run (fingerprint and seal included) {run:.2f} s")
-    print(f"  fingerprint (config + knot.obj hash)      {fp * 1000:.1f} ms ({100 * fp / run:.2f} %)")
-    print(f"  seal (SHA-256 over stored chunks)         {seal * 1000:.1f} ms ({100 * seal / run:.2f} %)")
-    print(f"  verify on resume (open + digest)          {ver * 1000:.1f} ms ({100 * ver / run:.2f} % of a run)")
+        content_digest(h5)
+        times["seal"] = time.perf_counter() - start
+    start = time.perf_counter()
+    assert verify(out / "data.hdf5") is None
+    times["verify"] = time.perf_counter() - start
+    return times
+
+
+def overhead(keypoints: int, size: tuple[int, int], rounds: int, tmp: Path) -> None:
+    config = tmp / "overhead.yaml"
+    config.write_text(config_text(1, size[0], size[1], keypoints))
+    runs: dict[str, list[tuple[float, float, int]]] = {variant: [] for variant in VARIANTS}
+    steps: dict[str, list[float]] = {}
+    for _ in range(rounds):
+        for variant in VARIANTS:  # one output folder for all (a file records where it was written)
+            runs[variant].append(_run(config, tmp / "out", variant))
+            shutil.rmtree(tmp / variant, ignore_errors=True)
+            (tmp / "out").rename(tmp / variant)
+        if (tmp / "staged/data.hdf5").read_bytes() != (tmp / "direct/data.hdf5").read_bytes():
+            raise SystemExit("the staged run's data.hdf5 differs from the direct write's")
+        for name, seconds in _components(config, tmp / "direct").items():
+            steps.setdefault(name, []).append(seconds)
+    wall = {v: statistics.median(r[0] for r in runs[v]) for v in VARIANTS}
+    cpu = {v: statistics.median(r[1] for r in runs[v]) for v in VARIANTS}
+    print(f"{keypoints} keypoints, {size[0]}x{size[1]} labels (depth, distance, normals, class, instance), gzip 1, "
+          f"median of {rounds} interleaved rounds (wall / CPU seconds of `hybridgen run`, imports included):")
+    for variant in VARIANTS:
+        print(f"  {variant:<7} {wall[variant]:6.2f} s wall {cpu[variant]:6.2f} s CPU   "
+              f"(walls {', '.join(f'{r[0]:.2f}' for r in runs[variant])})")
+    print(f"  fingerprint + checksums (direct / bare): {wall['direct'] / wall['bare']:.3f}x wall, "
+          f"{cpu['direct'] / cpu['bare']:.3f}x CPU")
+    print(f"  staged / direct (same bytes):             {wall['staged'] / wall['direct']:.3f}x wall, "
+          f"{cpu['staged'] / cpu['direct']:.3f}x CPU")
+    print("  steps timed alone (median), share of the direct run's wall time:")
+    for name, values in steps.items():
+        seconds = statistics.median(values)
+        print(f"    {name:<22} {seconds * 1000:7.1f} ms ({100 * seconds / wall['direct']:.2f} %)")
 
 
 def memory(scene_counts: list[int], tmp: Path) -> None:
@@ -81,18 +129,19 @@ def memory(scene_counts: list[int], tmp: Path) -> None:
     for scenes in scene_counts:
         config = tmp / f"memory{scenes}.yaml"
         config.write_text(config_text(scenes, 16, 12, 2))
-        seconds, rss = _run(config, tmp / f"memory{scenes}")
+        seconds, _, rss = _run(config, tmp / f"memory{scenes}")
         print(f"  {scenes:5d} scenes: peak RSS {rss} MiB ({seconds:.1f} s)")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--keypoints", type=int, default=400)
-    parser.add_argument("--scenes", type=int, nargs="+", default=[12, 120])
-    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--size", type=int, nargs=2, default=[128, 96], metavar=("WIDTH", "HEIGHT"))
+    parser.add_argument("--scenes", type=int, nargs="*", default=[12, 120])
+    parser.add_argument("--rounds", type=int, default=5)
     ns = parser.parse_args()
     with tempfile.TemporaryDirectory() as folder:
-        overhead(ns.keypoints, ns.rounds, Path(folder))
+        overhead(ns.keypoints, tuple(ns.size), ns.rounds, Path(folder))
         memory(ns.scenes, Path(folder))
     print(f"(load average {open('/proc/loadavg').read().split()[0]}; other work on the machine adds noise)")
 

@@ -49,7 +49,7 @@ class SceneUnits:
 class SingleFile:
     """A writer's one output file: sharded runs write it as one file per work unit (then an index), resumable
     runs as verified parts merged into it. ``resume_chunk_keypoints``: keypoints per part of a non-sharded
-    run (0: direct write; -1: the default, parts only when a renderer path-traces)."""
+    run (0: direct write; -1: the default size, :func:`hybridgen.run.staged_output.part_keypoints`)."""
 
     path: Path
     resume_chunk_keypoints: int

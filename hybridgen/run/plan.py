@@ -105,18 +105,16 @@ def single_file_output(modules: list[Module]) -> Path | None:
 
 def staged_plan(modules: list[Module]) -> ShardingPlan | None:
     """The plan of a non-sharded run that renders in resumable parts (:mod:`hybridgen.run.staged_output`):
-    its only writer writes a single file with ``resume_chunk_keypoints`` > 0 (-1:
-    :data:`~hybridgen.run.staged_output.DEFAULT_CHUNK_KEYPOINTS` when a renderer path-traces)."""
-    from .staged_output import DEFAULT_CHUNK_KEYPOINTS, staging_folder_name
+    its only writer writes a single file and ``resume_chunk_keypoints`` is not 0 (-1: the default part size,
+    :func:`~hybridgen.run.staged_output.part_keypoints`)."""
+    from .staged_output import part_keypoints, staging_folder_name
 
     single = single_file_output(modules)
     writer = next((m for m in modules if m.writes_unit_files), None)
     output = writer.single_file() if writer is not None else None
     if single is None or output is None:
         return None
-    chunk = output.resume_chunk_keypoints
-    if chunk < 0:
-        chunk = DEFAULT_CHUNK_KEYPOINTS if any(m.path_traces for m in modules) else 0
+    chunk = part_keypoints(output.resume_chunk_keypoints, any(m.path_traces for m in modules))
     if chunk == 0:
         return None
     return ShardingPlan(1, chunk, single.parent, single.name, folder=staging_folder_name(single.name), staged=True)

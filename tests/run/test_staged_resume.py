@@ -18,7 +18,8 @@ import numpy as np
 import pytest
 
 from hybridgen.io.integrity import verify
-from hybridgen.run.staged_output import DEFAULT_CHUNK_KEYPOINTS, JOURNAL_ATTR, staging_folder_name
+from hybridgen.run.staged_output import (DEFAULT_CHUNK_KEYPOINTS, DEFAULT_LABEL_CHUNK_KEYPOINTS, JOURNAL_ATTR,
+                                         staging_folder_name)
 from tests.conftest import REPO
 from tests.run.test_resume_integrity import SINGLE
 
@@ -162,7 +163,8 @@ def test_parts_of_another_config_are_refused(reference, write_config, run_cli):
 
 
 @pytest.mark.parametrize(("renderers", "setting", "expected"), [
-    ("labels", "", None), ("color", "", DEFAULT_CHUNK_KEYPOINTS), ("color", "0", None), ("labels", "7", 7)])
+    ("labels", "", DEFAULT_LABEL_CHUNK_KEYPOINTS), ("color", "", DEFAULT_CHUNK_KEYPOINTS), ("color", "0", None),
+    ("labels", "0", None), ("labels", "7", 7)])
 def test_which_runs_are_staged_by_default(tmp_path, write_config, renderers, setting, expected):
     from hybridgen.config.config_file import load_config
     from hybridgen.run.pipeline import build_modules, staged_plan
