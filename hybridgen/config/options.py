@@ -42,7 +42,7 @@ def from_config(cls: type[T], config: Mapping[str, Any]) -> T:
 def checked_options(cls: type[T], **given: Any) -> T:
     """``cls`` with the options ``given`` by field name (others at their defaults), each validated by its
     declaration: ConfigError naming the option otherwise."""
-    params = {item.name: _param(item) for item in fields(cls)}  # type: ignore[arg-type]
+    params = {item.name: replace(_param(item), name=item.name) for item in fields(cls)}  # type: ignore[arg-type]
     for name, value in given.items():
         if name not in params:
             raise ConfigError(f"unknown option{closest(name, list(params))}; known: {', '.join(params)}", key=name)
