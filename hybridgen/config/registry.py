@@ -39,6 +39,8 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.bop_loader",
     "hybridgen.modules.material_library",
     "hybridgen.modules.haven_loaders",
+    "hybridgen.modules.shapenet_loader",
+    "hybridgen.modules.front3d_loader",
     "hybridgen.modules.material_randomizer",
     "hybridgen.modules.hide_objects",
 )

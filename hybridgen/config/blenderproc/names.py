@@ -27,10 +27,8 @@ UNAVAILABLE = {
                               "with a selector for the lamp objects",
     "camera.SuncgCameraSampler": "samples cameras inside SUNCG rooms (a withdrawn dataset); use "
                                  "camera.CameraSampler with proximity_checks",
-    "loader.ShapeNetLoader": f"ShapeNet's catalogue layout is not read by hybridgen; {_DATASET}",
     "writer.ShapeNetWriter": "writes ShapeNet ids of the loader hybridgen does not have; use attributes + map_by",
     "loader.SceneNetLoader": f"SceneNet's layout is not read by hybridgen; {_DATASET}",
-    "loader.Front3DLoader": f"3D-FRONT's JSON scenes are not read by hybridgen; {_DATASET}",
     "camera.Front3DCameraSampler": "samples inside 3D-FRONT rooms; use camera.CameraSampler with "
                                    "proximity_checks",
     "loader.Pix3DLoader": f"Pix3D's layout is not read by hybridgen; {_DATASET}",
