@@ -36,6 +36,7 @@ from ..render.passes import RECORDS, recognise
 from ..render.tonemap import to_srgb8
 from ..run.shard_index import check_index_sources
 from .atomic import prepare_output_dir
+from .depth_png import depth_png_values
 from .integrity import DIGEST_ATTR, verify
 from .label_encoding import decode_dataset
 from .image_files import json_bytes, npy_bytes, png_bytes, write_exr_file, write_file
@@ -111,12 +112,7 @@ def png_image(key: str, value: np.ndarray, *, encoded_normals: bool, depth_scale
     if value.dtype == np.uint8:
         return value, 0
     if _png(key) == "millimetres":
-        metres = value.astype(np.float64)
-        valid = np.isfinite(metres) & (metres > 0)
-        units = np.rint(np.where(valid, metres, 0.0) * (1000.0 / depth_scale))
-        too_far = valid & (units > 65535)
-        units[too_far] = 0
-        return units.astype(np.uint16), int(too_far.sum())
+        return depth_png_values(value, depth_scale)
     if np.issubdtype(value.dtype, np.integer) and value.ndim == 2:
         if value.size and (value.min() < 0 or value.max() > 65535):
             raise InputError(f"'{key}' has values outside 0..65535 that a 16-bit PNG cannot hold; use --format npy "
