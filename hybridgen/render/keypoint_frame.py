@@ -78,7 +78,8 @@ class KeypointFrame:
     def image_silhouette(self, obj: MeshObject) -> np.ndarray:
         """(H, W) bool: ``obj`` drawn alone on the image canvas."""
         return self.shared(("image", obj.instance_id),
-                           lambda: draw_alone(self.view, obj, self.cam2world, self.intrinsics))
+                           lambda: draw_alone(self.view, obj, self.cam2world, self.intrinsics,
+                                              self.placements()[obj.instance_id].corners))
 
     def silhouettes(self) -> dict[int, Silhouette]:
         """Every object's full silhouette (also counted outside the image), by instance id."""

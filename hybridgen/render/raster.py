@@ -141,16 +141,19 @@ class RasterView:
         return self.collect(slot)
 
     def submit(self, cam2world: np.ndarray, intrinsics: Intrinsics | None = None,
-               hidden: frozenset[int] = frozenset(), slot: Any = 0, normals_space: str | None = None) -> None:
+               hidden: frozenset[int] = frozenset(), slot: Any = 0, normals_space: str | None = None,
+               region: tuple[int, int, int, int] | None = None) -> None:
         """Issue the draws of one keypoint into framebuffer ``slot`` without waiting for them.
 
         The rasterizer (llvmpipe's threads, or the GPU) works on it while the caller goes on - e.g. turning
         the previous keypoint's readback into passes; :meth:`collect` then reads it back. Two slots give a
-        two-deep pipeline.
+        two-deep pipeline. ``region`` ``(x, y, width, height)`` in pixels limits clearing and drawing to that
+        rectangle (a scissor: pixels inside it get exactly the values of a full draw, the rest is stale).
         """
         intr = intrinsics or self.scene.camera.intrinsics
         width, height = intr.width, intr.height
         fbo = self._framebuffer(slot, width, height)
+        fbo.scissor = region
         fbo.use()
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         self.ctx.enable(self.ctx.DEPTH_TEST)
@@ -189,6 +192,22 @@ class RasterView:
         fbo.read_into(normal_depth, attachment=0, components=4, dtype="f4")
         fbo.read_into(instance, attachment=1, components=1, dtype="u4")
         return RasterOutput(normal_depth, instance, self._rays(intr), self._class_lut, self.depth_background)
+
+    def render_ids(self, cam2world: np.ndarray, intrinsics: Intrinsics | None = None,
+                   hidden: frozenset[int] = frozenset(), region: tuple[int, int, int, int] | None = None
+                   ) -> np.ndarray:
+        """Only the uint32 instance ids of one keypoint (as :meth:`render_raw`, a fifth of the readback) inside
+        ``region`` (x, y, width, height; default: the whole canvas): that rectangle alone is drawn and read."""
+        intr = intrinsics or self.scene.camera.intrinsics
+        slot = ("now", intr.width, intr.height)
+        self.submit(cam2world, intr, hidden, slot=slot, region=region)
+        self._submitted.pop(slot)
+        fbo = self._fbos[(slot, intr.width, intr.height)]
+        x, y, w, h = region if region is not None else (0, 0, intr.width, intr.height)
+        part = np.empty((h, w), dtype=np.uint32)
+        fbo.read_into(part, viewport=(x, y, w, h), attachment=1, components=1, dtype="u4")
+        fbo.scissor = None
+        return part
 
     def _object_uniforms(self, cam2world: np.ndarray, world2cam: np.ndarray, near_reach: float,
                          hidden: frozenset[int]) -> list[tuple[GpuObject, bytes, bytes, bool, str]]:

@@ -82,10 +82,37 @@ def wide_intrinsics(intr: Intrinsics) -> Intrinsics:
     return Intrinsics(K, 3 * intr.width, 3 * intr.height, intr.clip_start, intr.clip_end)
 
 
-def draw_alone(view: RasterView, obj: MeshObject, cam2world: np.ndarray, intr: Intrinsics) -> np.ndarray:
-    """Boolean silhouette of ``obj`` drawn alone at ``cam2world`` on a canvas of intrinsics ``intr``."""
+def region(corners: np.ndarray, intr: Intrinsics) -> tuple[int, int, int, int] | None:
+    """``(x, y, width, height)`` of the canvas pixels whose centres may lie in the projection of ``corners``
+    (camera coordinates, all in front of the near plane), with a pixel of margin; None: the whole canvas.
+    The silhouette of a body inside a box lies in the convex hull of the box's projected corners."""
+    z = corners[:, 2]
+    if (z <= intr.clip_start).any():
+        return None
+    u = intr.K[0, 0] * corners[:, 0] / z + intr.K[0, 2]
+    v = intr.K[1, 1] * corners[:, 1] / z + intr.K[1, 2]
+    x0, y0 = max(int(np.floor(u.min())) - 1, 0), max(int(np.floor(v.min())) - 1, 0)
+    x1, y1 = min(int(np.ceil(u.max())) + 2, intr.width), min(int(np.ceil(v.max())) + 2, intr.height)
+    return (x0, y0, max(x1 - x0, 1), max(y1 - y0, 1)) if x0 < intr.width and y0 < intr.height else (0, 0, 1, 1)
+
+
+def draw_part(view: RasterView, obj: MeshObject, cam2world: np.ndarray, intr: Intrinsics,
+              corners: np.ndarray) -> tuple[np.ndarray, int, int]:
+    """``(mask, x, y)``: the boolean silhouette of ``obj`` drawn alone at ``cam2world`` on a canvas of
+    intrinsics ``intr``, in the rectangle at column ``x``, row ``y`` where its box ``corners`` (camera
+    coordinates) project - the canvas outside it holds none of the silhouette."""
     others = frozenset(o.instance_id for o in view.scene.objects if o.instance_id != obj.instance_id)
-    return view.render_raw(cam2world, intr, hidden=others).instance == obj.instance_id
+    area = region(corners, intr) or (0, 0, intr.width, intr.height)
+    return view.render_ids(cam2world, intr, hidden=others, region=area) == obj.instance_id, area[0], area[1]
+
+
+def draw_alone(view: RasterView, obj: MeshObject, cam2world: np.ndarray, intr: Intrinsics,
+               corners: np.ndarray) -> np.ndarray:
+    """The (H, W) boolean silhouette of ``obj`` on the whole canvas (see :func:`draw_part`)."""
+    part, x, y = draw_part(view, obj, cam2world, intr, corners)
+    full = np.zeros((intr.height, intr.width), dtype=bool)
+    full[y:y + part.shape[0], x:x + part.shape[1]] = part
+    return full
 
 
 @dataclass(frozen=True)
@@ -108,10 +135,14 @@ def full_silhouette(view: RasterView, obj: MeshObject, cam2world: np.ndarray, wh
     if where.clipped:
         return Silhouette(np.zeros((height, width), dtype=bool), 0, list(NO_BOX))
     if where.inside or 3 * max(width, height) > MAX_CANVAS:
-        full = on_image()
-        mask, dx, dy = full, 0, 0
-    else:
-        full = draw_alone(view, obj, cam2world, wide_intrinsics(intr))
-        mask, dx, dy = full[height:2 * height, width:2 * width], width, height
-    ys, xs = np.nonzero(full)
-    return Silhouette(np.ascontiguousarray(mask), int(xs.size), toolkit_box(xs - dx, ys - dy))
+        mask = on_image()
+        ys, xs = np.nonzero(mask)
+        return Silhouette(np.ascontiguousarray(mask), int(xs.size), toolkit_box(xs, ys))
+    part, x, y = draw_part(view, obj, cam2world, wide_intrinsics(intr), where.corners)
+    ys, xs = np.nonzero(part)
+    mask = np.zeros((height, width), dtype=bool)  # the image is the centre of the wide canvas
+    x0, y0 = max(x, width), max(y, height)
+    x1, y1 = min(x + part.shape[1], 2 * width), min(y + part.shape[0], 2 * height)
+    if x1 > x0 and y1 > y0:
+        mask[y0 - height:y1 - height, x0 - width:x1 - width] = part[y0 - y:y1 - y, x0 - x:x1 - x]
+    return Silhouette(mask, int(xs.size), toolkit_box(xs + x - width, ys + y - height))

@@ -148,3 +148,29 @@ def test_a_new_catalogue_entry_is_a_renderer_option_and_a_delivered_pass(gl_cont
     np.testing.assert_array_equal(frame["hit_mask"], np.isfinite(frame["depth"]).astype(np.uint8))
     assert sink.layouts["hit_mask"].shape == (48, 64) and passes.hint("hit_mask") == "set render_hit_mask: true " \
         "on the renderer"
+
+
+def test_silhouettes_drawn_in_their_box_region_equal_full_canvas_draws(gl_context):
+    """Only the rectangle an object's box projects to is drawn (a scissor); every pixel equals a full draw."""
+    from hybridgen.render.silhouettes import draw_alone, placement, wide_intrinsics
+
+    rng = np.random.default_rng(5)
+    scene = hg.Scene()
+    scene.add(hg.make_primitive("plane", 8.0, name="floor", category_id=1))
+    for i in range(6):
+        scene.add(hg.make_primitive("sphere" if i % 2 else "cube", 0.5, name=f"o{i}", category_id=2,
+                                    local2world=hg.object_pose([*rng.uniform(-2, 2, 2), 0.3], rng.uniform(0, 3, 3))))
+    scene.camera.intrinsics = hg.Intrinsics(np.array([[50.0, 0, 31.5], [0, 50.0, 23.5], [0, 0, 1]]), 64, 48)
+    view = hg.RasterView(scene)
+    drawn = 0
+    for k in range(4):
+        pose = hg.look_at([3 * np.cos(k), 3 * np.sin(k), 1.5], [0.5, 0, 0])
+        for canvas in (scene.camera.intrinsics, wide_intrinsics(scene.camera.intrinsics)):
+            for obj in scene.objects:
+                where = placement(obj, np.linalg.inv(pose), canvas)
+                hidden = frozenset(o.instance_id for o in scene.objects if o is not obj)
+                full = view.render_raw(pose, canvas, hidden=hidden).instance == obj.instance_id
+                np.testing.assert_array_equal(draw_alone(view, obj, pose, canvas, where.corners), full)
+                drawn += int(full.any())
+    view.release()
+    assert drawn > 20  # most objects are seen on most canvases
