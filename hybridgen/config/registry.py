@@ -43,6 +43,7 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.front3d_loader",
     "hybridgen.modules.material_randomizer",
     "hybridgen.modules.hide_objects",
+    "hybridgen.modules.camera_object_sampler",
 )
 
 MODULES: dict[str, type["Module"]] = {}

@@ -14,6 +14,7 @@ import numpy as np
 from .._version import __version__
 from ..errors import InputError
 from ..io.frame_sink import FrameSink, PassLayout
+from ..scene.object_keyframes import keyframes_of
 from ..scene.scene import Scene
 from .passes import on_request
 
@@ -25,7 +26,8 @@ class Producer(Protocol):
 
     ``records`` are whole-run datasets (e.g. poses) it adds; ``eye`` is 0, or 1 for a stereo right eye
     (producers with randomness draw a different stream for it). A producer may also have
-    ``prefetch(index, cam2world)``, called one keypoint ahead so that its work can overlap.
+    ``prefetch(index, cam2world)``, called one keypoint ahead so that its work can overlap, and
+    ``poses_changed()``, called when the scene's objects moved between keypoints (object keyframes).
     """
 
     def layouts(self) -> list[PassLayout]: ...
@@ -62,6 +64,15 @@ def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Prod
             raise InputError("the camera has no keypoints: add poses (camera.CameraLoader) before rendering")
         chosen = list(range(total) if indices is None else indices)
         n = len(chosen)
+        keyframes = keyframes_of(scene)  # object poses that change between keypoints (None: they do not)
+
+        def pose_objects(index: int) -> None:
+            if keyframes is not None and keyframes.apply(scene, index):
+                for producer in producers:  # e.g. the path tracer rebuilds its scene
+                    getattr(producer, "poses_changed", lambda: None)()
+
+        if chosen:
+            pose_objects(chosen[0])
         layouts = [layout for p in producers for layout in p.layouts()]
         keys = [layout.key for layout in layouts]
         if len(set(keys)) != len(keys):
@@ -83,8 +94,11 @@ def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Prod
             for producer in prefetching:
                 producer.prefetch(chosen[0], keypoints[chosen[0]])  # type: ignore[attr-defined]
         for local, index in enumerate(chosen):
-            if local + 1 < n:  # the next keypoint draws while this one is read back and processed
-                ahead = chosen[local + 1]
+            pose_objects(index)
+            ahead = chosen[local + 1] if local + 1 < n else None
+            if ahead is not None and keyframes is not None and keyframes.group(ahead) != keyframes.group(index):
+                ahead = None  # its objects stand elsewhere: drawn once they are moved
+            if ahead is not None:  # the next keypoint draws while this one is read back and processed
                 for producer in prefetching:
                     producer.prefetch(ahead, keypoints[ahead])  # type: ignore[attr-defined]
             values: dict[str, Any] = {}
@@ -156,6 +170,11 @@ class StereoProducer:
             for key, value in left.items():
                 out[key] = np.stack([value, right[key]]) if isinstance(value, np.ndarray) else [value, right[key]]
         return out
+
+    def poses_changed(self) -> None:
+        """The scene's objects moved (object keyframes): tell the eyes' producers."""
+        for producer in self.producers:
+            getattr(producer, "poses_changed", lambda: None)()
 
     def close(self) -> None:
         for producer in self.producers:

@@ -80,6 +80,11 @@ class ColorProducer:
             values["colors_hdr"] = linear.astype(np.float16)
         return values
 
+    def poses_changed(self) -> None:
+        """The scene's objects moved between keypoints (object keyframes): Mitsuba's scene is built anew with
+        their poses (its meshes are stored in world coordinates)."""
+        self.view = PathTraceView(self.scene, self.settings, variant=self.view.variant)
+
     def close(self) -> None:
         """Release the denoising guides' GL resources (the Mitsuba scene goes with this producer)."""
         if self._guides is not None:

@@ -8,6 +8,7 @@ from ..errors import InputError
 from .camera import Camera
 from .light import Light
 from .mesh_object import MeshObject
+from .object_keyframes import ObjectKeyframes
 
 
 @dataclass
@@ -34,6 +35,9 @@ class Scene:
     camera: Camera = field(default_factory=Camera)
     world: World = field(default_factory=World)
     _next_id: int = 1
+    object_keyframes: ObjectKeyframes | None = None
+    """Object poses per keypoint when they change between keypoints (composite.CameraObjectSampler); None:
+    every keypoint shows the objects' ``local2world``."""
 
     def add(self, obj: MeshObject) -> MeshObject:
         """Add ``obj``, assigning its stable instance id; returns it."""

@@ -49,9 +49,6 @@ UNAVAILABLE = {
                                       "and place it with object.ObjectPoseSampler",
     "writer.StereoGlobalMatchingWriter": "stereo depth by SGM is not implemented; renderer.RgbRenderer with "
                                          "stereo: true writes exact per-eye depth instead",
-    "composite.CameraObjectSampler": "not implemented yet: it re-samples objects and cameras together per "
-                                     "scene; use main.Initializer number_of_scenes with object.ObjectPoseSampler "
-                                     "and camera.CameraSampler (each scene draws both anew)",
     "writer.MyWriter": "an example of a user plugin; write it as a hybridgen plugin (entry point "
                        "'hybridgen.modules')",
 }

@@ -47,13 +47,21 @@ _UNIFORM = ("sampler.Uniform3d", "Uniform3dSampler", "sampler.Value", "ValueSamp
 def samplers_as_blenderproc(value: Any, note: Note, key: str) -> Any:
     """Sampler specs drawn as BlenderProc draws them: ``min`` above ``max`` (numpy draws between the two, so
     BlenderProc's examples use it) becomes the same range ordered; PartSphere's ``part_sphere_vector`` is
-    hybridgen's ``part_sphere_dir_vector``."""
+    hybridgen's ``part_sphere_dir_vector``; a ``parameters`` mapping next to ``provider`` holds provider keys."""
     if isinstance(value, list):
         return [samplers_as_blenderproc(v, note, f"{key}[{i}]") for i, v in enumerate(value)]
     if not isinstance(value, dict):
         return value
     out = {k: samplers_as_blenderproc(v, note, f"{key}.{k}") for k, v in value.items()}
     provider = out.get("provider", out.get("name"))
+    if "provider" in out and isinstance(out.get("parameters"), dict):
+        # BlenderProc hands a provider its whole mapping and reads no 'parameters' key (the v1.0 form's):
+        # empty, it changes nothing; given, its keys are the provider's, as v1.0 meant
+        extra = out.pop("parameters")
+        clash = sorted(k for k in extra if k in out)
+        if clash:
+            raise ConfigError(f"{clash[0]!r} is given both here and in 'parameters'", key=f"{key}.parameters")
+        out.update(extra)
     if provider == "getter.Entity":  # a selector anywhere (getter.POI's, samplers' ...): type MESH always holds
         out["conditions"] = _conditions(out.get("conditions"), note, f"{key}.conditions")
         if out["conditions"] is None:

@@ -6,6 +6,7 @@ from typing import Any, Callable
 
 from ...errors import ConfigError
 from .common import Note
+from .composite import camera_object_sampler
 from .manipulators import entity, material
 from .names import ALIASES, unavailable_reason
 from .objects import (bop_loader, camera_loader, loader, mesh_initializer, passthrough, physics, pose_sampler,
@@ -65,6 +66,8 @@ def translate_module(name: str, config: dict[str, Any], note: Note,
     config = samplers_as_blenderproc(copy.deepcopy(config), note, "config")
     if name in WRITERS:
         return WRITERS[name](config, note, state)
+    if name == "composite.CameraObjectSampler":
+        return camera_object_sampler(config, note, state, translate_module)
     if name in TRANSLATORS:
         return TRANSLATORS[name](config, note)
     return [(ALIASES.get(name, name), config)]
