@@ -77,4 +77,6 @@ def apply_material_config(material: Material, config: dict[str, Any]) -> Materia
     for key in ("base_color", "roughness", "metallic", "alpha"):
         if key in values and f"{key}_texture" not in values:
             values[f"{key}_texture"] = None
+    if "base_color" in values or values.get("base_color_texture") is not None:
+        values["base_color_from_vertices"] = False
     return dataclasses.replace(material, **values)

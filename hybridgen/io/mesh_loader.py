@@ -70,6 +70,15 @@ def unique_blender_name(name: str, taken: Iterable[str]) -> str:
     return f"{base}.{number:03d}"
 
 
+def vertex_colors_linear(visual: Any) -> np.ndarray | None:
+    """(V, 3) linear RGB of per-vertex colors (8-bit sRGB in PLY/OBJ files, decoded as Blender decodes its
+    byte color attributes), or None when the visual has none."""
+    if getattr(visual, "kind", None) != "vertex":
+        return None
+    codes = np.asarray(visual.vertex_colors, dtype=np.float64)[:, :3] / 255.0
+    return np.where(codes <= 0.04045, codes / 12.92, ((codes + 0.055) / 1.055) ** 2.4)
+
+
 def _has_loaded_normals(geometry: Any) -> bool:
     # trimesh keeps normals read from the file in its cache; computed ones are only made on access.
     cache = getattr(getattr(geometry, "_cache", None), "cache", {})
@@ -197,6 +206,9 @@ def load_objects(path: str | Path, *, name: str | None = None, category_id: int 
             normals = (np.asarray(geometry.vertex_normals, dtype=np.float64) @ rotation.T
                        if _has_loaded_normals(geometry) else None)
         extra = {"material_part": _material_name(geometry)} if counts[part_name] > 1 else {}
+        colors = vertex_colors_linear(geometry.visual)
+        material = Material.from_trimesh_visual(geometry.visual, fallback_name=obj_name)
+        material.base_color_from_vertices = colors is not None
         try:
             obj = MeshObject(
                 name=obj_name,
@@ -204,10 +216,11 @@ def load_objects(path: str | Path, *, name: str | None = None, category_id: int 
                 faces=np.asarray(geometry.faces),
                 vertex_normals=normals,
                 uvs=None if uv is None else np.asarray(uv, dtype=np.float64),
-                material=Material.from_trimesh_visual(geometry.visual, fallback_name=obj_name),
+                material=material,
                 category_id=category_id,
                 attributes={"source_path": str(file), **extra, **(attributes or {})},
                 local2world=base @ turn @ transform @ turn.T,
+                vertex_colors=colors,
             )
         except InputError as exc:
             raise InputError(f"mesh '{file}': {exc}") from None

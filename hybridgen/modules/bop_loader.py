@@ -20,7 +20,8 @@ Objects are named as Blender's PLY importer names them (``obj_000001``, clashes 
 ``category_id`` = their BOP obj_id and the attribute ``bop_dataset_name`` (the folder's name), which
 writer.BopWriter uses. ``mm2m`` scales models and poses from millimetres to metres. A model's texture
 (ycbv-style ``comment TextureFile`` with ``texture_u``/``texture_v``) becomes its base-colour texture; vertex
-colours become one base colour (their mean: hybridgen materials have no per-vertex colour yet).
+colours are the base colour per vertex in color and albedo (decoded from sRGB, as Blender's colour attribute
+node that BlenderProc links to Base Color); ``base_color`` keeps their mean code / 255 as a single summary.
 """
 from __future__ import annotations
 

@@ -15,7 +15,8 @@ The BSDF is built inside out:
   instead: the two differ only where light grazes the geometric surface);
 - ``twosided`` for opaque materials (Mitsuba's BSDFs are one-sided; Blender's are not);
 - ``mask`` for alpha < 1 or an alpha texture (fractional opacity; CLIP materials get their alpha
-  thresholded at 0.5 per texel).
+  thresholded at 0.5 per texel). Camera and bounce rays pass masked parts; shadow rays of Mitsuba's
+  ``path`` integrator do not (no transparent shadows: a cut-out casts a full shadow, unlike Cycles).
 
 Color textures are sRGB encoded (``raw`` false), data maps are linear (``raw`` true), as Blender's
 "Non-Color" image nodes in BlenderProc's material loaders.
@@ -102,11 +103,21 @@ def check_material(material: Material, owner: str) -> None:
                          f"{sorted(material.extra)}")
 
 
-def bsdf_dict(material: Material, owner: str) -> dict[str, Any]:
-    """Mitsuba BSDF of ``material`` (see the module docstring for the nesting)."""
+VERTEX_COLOR_ATTRIBUTE = "vertex_color"
+"""Name of the mesh attribute holding per-vertex linear RGB (``vertex_`` prefix: interpolated over faces)."""
+
+
+def bsdf_dict(material: Material, owner: str, *, vertex_colors: bool = False) -> dict[str, Any]:
+    """Mitsuba BSDF of ``material`` (see the module docstring for the nesting); with ``vertex_colors`` (the
+    mesh carries :data:`VERTEX_COLOR_ATTRIBUTE`) and the material's ``base_color_from_vertices``, the base
+    color is that attribute (a base-color texture still wins, as a linked image in Blender)."""
     check_material(material, owner)
-    base = color_texture(material.base_color_texture, owner) if material.base_color_texture is not None \
-        else rgb(material.base_color)
+    if material.base_color_texture is not None:
+        base = color_texture(material.base_color_texture, owner)
+    elif vertex_colors and material.base_color_from_vertices:
+        base = {"type": "mesh_attribute", "name": VERTEX_COLOR_ATTRIBUTE}
+    else:
+        base = rgb(material.base_color)
     bsdf: dict[str, Any]
     plain = material.specular == 0 and material.metallic == 0 and material.metallic_texture is None
     if plain and material.transmission == 0:

@@ -29,7 +29,7 @@ from ..scene.light import Light
 from ..scene.mesh_object import MeshObject
 from ..scene.scene import Scene, World
 from . import light_selection
-from .mitsuba_materials import bsdf_dict
+from .mitsuba_materials import VERTEX_COLOR_ATTRIBUTE, bsdf_dict
 from .mitsuba_materials import rgb as _rgb
 
 ENVMAP_TO_WORLD = np.array([[0.0, 0, 1, 0], [1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 0, 1]])
@@ -66,7 +66,8 @@ def mesh_shape(obj: MeshObject, *, back_side: bool = False, sampling_weight: flo
     import mitsuba as mi
 
     props = mi.Properties()
-    props["bsdf"] = mi.load_dict(bsdf_dict(obj.material, obj.name))
+    colored = obj.vertex_colors is not None and obj.material.base_color_from_vertices
+    props["bsdf"] = mi.load_dict(bsdf_dict(obj.material, obj.name, vertex_colors=colored))
     radiance = emitted_radiance(obj)
     if np.any(radiance > 0):
         props["emitter"] = mi.load_dict({"type": "area", "radiance": _rgb(radiance),
@@ -95,6 +96,8 @@ def mesh_shape(obj: MeshObject, *, back_side: bool = False, sampling_weight: flo
         params["vertex_texcoords"] = uv.ravel()
     params.update()
     del params  # holding traversal wrappers slows later renders (measured in scalar mode)
+    if colored:
+        mesh.add_attribute(VERTEX_COLOR_ATTRIBUTE, 3, np.asarray(obj.vertex_colors, np.float32).ravel())
     return mesh
 
 

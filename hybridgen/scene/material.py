@@ -47,6 +47,7 @@ class Material:
     transmission: float = 0.0
     ior: float = 1.45
     alpha: float = 1.0
+    base_color_from_vertices: bool = False  # the object's vertex_colors are the base color (RGB)
     roughness_texture: Any = None
     metallic_texture: Any = None
     alpha_texture: Any = None

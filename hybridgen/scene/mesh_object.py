@@ -18,6 +18,8 @@ class MeshObject:
     """Geometry in the object's local frame (metres) plus a ``local2world`` pose.
 
     ``vertex_normals`` is None for flat-shaded meshes (labels then use exact face normals).
+    ``vertex_colors`` (linear RGB per vertex) replace the base color in color and albedo when the material's
+    ``base_color_from_vertices`` is set (Blender's color attribute linked to Base Color).
     ``instance_id`` is assigned by :class:`~hybridgen.scene.scene.Scene` when the object is added and
     stays the same for the whole scene (1..N; 0 is the background).
     """
@@ -32,6 +34,7 @@ class MeshObject:
     attributes: dict[str, Any] = field(default_factory=dict)
     local2world: np.ndarray = field(default_factory=lambda: np.eye(4))
     instance_id: int = 0
+    vertex_colors: np.ndarray | None = None  # (V, 3) linear RGB in 0..1, the base color where the material says so
 
     def __post_init__(self) -> None:
         self.vertices = np.ascontiguousarray(self.vertices, dtype=np.float64).reshape(-1, 3)
@@ -42,6 +45,12 @@ class MeshObject:
                 raise InputError(f"object '{self.name}': {len(self.vertex_normals)} vertex normals for "
                                  f"{len(self.vertices)} vertices")
         self.local2world = np.array(self.local2world, dtype=np.float64).reshape(4, 4)
+        if self.vertex_colors is not None:
+            colors = np.ascontiguousarray(self.vertex_colors, dtype=np.float64)
+            self.vertex_colors = colors[:, :3] if colors.ndim == 2 and colors.shape[1] >= 3 else colors.reshape(-1, 3)
+            if len(self.vertex_colors) != len(self.vertices) or not np.all(np.isfinite(self.vertex_colors)):
+                raise InputError(f"object '{self.name}': {len(self.vertex_colors)} vertex colors for "
+                                 f"{len(self.vertices)} vertices (or NaN/inf in them)")
         self.validate()
         if self.vertex_normals is not None:
             self._repair_zero_normals()
