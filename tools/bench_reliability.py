@@ -16,9 +16,10 @@ hits them alike), each timed around ``hybridgen run`` (wall and CPU seconds, int
 
 All three run the same config text (the part size is patched in the child, so the fingerprint and thus the
 bytes agree). The steps are also timed one by one on the outputs in this process: computing the fingerprint
-(config leaves and input file hashes; a second time with the hash cache warm), sealing (SHA-256 over the
-stored chunks) and verifying (what a resume does per existing file). Peak RSS is ``ru_maxrss`` of the run's
-process.
+(config leaves and input file hashes: every input read, and from the identity cache of
+:mod:`hybridgen.run.input_hashes` as every run after the first does), sealing (SHA-256 over the stored
+chunks) and verifying (what a resume does per existing file); and the fingerprint of a config naming a
+folder of 2000 files, hashed vs cached. Peak RSS is ``ru_maxrss`` of the run's process.
 """
 from __future__ import annotations
 
@@ -76,12 +77,13 @@ def _components(config: Path, out: Path) -> dict[str, float]:
     from hybridgen.config.config_file import load_config
     from hybridgen.io.integrity import content_digest, verify
     from hybridgen.run.fingerprint import run_fingerprint
+    from hybridgen.run.input_hashes import InputHashes
 
     loaded = load_config(config, [str(out)])
     times = {}
-    for name in ("fingerprint", "fingerprint (cached)"):
+    for name, hashes in (("fingerprint", InputHashes(None)), ("fingerprint (cached)", InputHashes.default())):
         start = time.perf_counter()
-        run_fingerprint(loaded)
+        run_fingerprint(loaded, hashes)
         times[name] = time.perf_counter() - start
     with h5py.File(out / "data.hdf5", "r") as h5:
         start = time.perf_counter()
@@ -124,6 +126,35 @@ def overhead(keypoints: int, size: tuple[int, int], rounds: int, tmp: Path) -> N
         print(f"    {name:<22} {seconds * 1000:7.1f} ms ({100 * seconds / wall['direct']:.2f} %)")
 
 
+def folder_fingerprint(files: int, kib: int, tmp: Path) -> None:
+    """The fingerprint of a config naming a folder of ``files`` files: hashing all of them (first run) vs
+    the identity cache of :mod:`hybridgen.run.input_hashes` (every later run)."""
+    import os
+
+    from hybridgen.config.config_file import load_config
+    from hybridgen.run.fingerprint import run_fingerprint
+    from hybridgen.run.input_hashes import SETTLE_NS, InputHashes
+
+    folder = tmp / "textures"
+    folder.mkdir()
+    for index in range(files):
+        (folder / f"{index:05d}.png").write_bytes(os.urandom(kib * 1024))
+    config = tmp / "folder.yaml"
+    config.write_text(f"modules:\n  - name: material.MaterialRandomizer\n    config: {{textures: {folder}}}\n")
+    loaded = load_config(config)
+    time.sleep(SETTLE_NS / 1e9 + 0.1)  # files written just now are hashed but not remembered
+    cache = tmp / "input_hashes.json"
+    times = []
+    for _ in range(3):
+        hashes = InputHashes(cache)
+        start = time.perf_counter()
+        run_fingerprint(loaded, hashes)
+        times.append((time.perf_counter() - start, hashes.hashed))
+    print(f"fingerprint of a named folder of {files} files x {kib} KiB (page cache warm):")
+    print(f"  every file hashed: {times[0][0] * 1000:.0f} ms; from the identity cache: "
+          f"{min(t for t, _ in times[1:]) * 1000:.0f} ms ({times[-1][1]} file(s) read)")
+
+
 def memory(scene_counts: list[int], tmp: Path) -> None:
     print("labels-only, 16x12, 2 keypoints per scene, one process (workers 1):")
     for scenes in scene_counts:
@@ -139,9 +170,11 @@ def main() -> None:
     parser.add_argument("--size", type=int, nargs=2, default=[128, 96], metavar=("WIDTH", "HEIGHT"))
     parser.add_argument("--scenes", type=int, nargs="*", default=[12, 120])
     parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--folder-files", type=int, default=2000)
     ns = parser.parse_args()
     with tempfile.TemporaryDirectory() as folder:
         overhead(ns.keypoints, tuple(ns.size), ns.rounds, Path(folder))
+        folder_fingerprint(ns.folder_files, 64, Path(folder))
         memory(ns.scenes, Path(folder))
     print(f"(load average {open('/proc/loadavg').read().split()[0]}; other work on the machine adds noise)")
 

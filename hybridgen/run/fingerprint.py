@@ -11,7 +11,8 @@ writes. Its keys are
   glob that matches files, or the files directly in a named folder (relative to the working directory,
   else to the config's folder, as modules read them), plus the MTL files an OBJ names and the texture
   files an MTL names. ``<path>`` is relative to the config's folder when the file lies below it, so a
-  moved checkout gives the same fingerprint.
+  moved checkout gives the same fingerprint. Hashes are remembered by file identity
+  (:mod:`hybridgen.run.input_hashes`), so a rerun reads only inputs that changed.
 
 :func:`differing_keys` names what changed between two fingerprints, so a refused resume says which
 config keys or input files differ.
@@ -21,12 +22,14 @@ from __future__ import annotations
 import glob
 import hashlib
 import json
+import os
 from pathlib import Path
 from typing import Any, Iterator
 
 from .._version import __version__
 from ..config.config_file import ConfigFile
 from ..io.mesh_references import referenced_files
+from .input_hashes import InputHashes
 
 FINGERPRINT_ATTR = "fingerprint"
 IGNORED_KEYS = ("output_dir",)
@@ -52,12 +55,6 @@ def _leaf_text(value: Any) -> str:
     return text if len(text) <= _LONG_VALUE else "sha256:" + hashlib.sha256(text.encode()).hexdigest()
 
 
-def file_sha256(path: Path) -> str:
-    """Hex SHA-256 of a file's bytes."""
-    with open(path, "rb") as handle:
-        return hashlib.file_digest(handle, "sha256").hexdigest()
-
-
 def _candidate_files(text: str, folder: Path) -> list[Path]:
     if "\0" in text or len(text) > 4096:
         return []
@@ -68,8 +65,9 @@ def _candidate_files(text: str, folder: Path) -> list[Path]:
         if path.is_file():
             return [path]
         if path.is_dir():
-            files = sorted(p for p in path.iterdir() if p.is_file() and not p.name.startswith("."))
-            return files[:MAX_FOLDER_FILES]
+            with os.scandir(path) as entries:  # file types from the listing: no stat per file
+                names = sorted(e.name for e in entries if e.is_file() and not e.name.startswith("."))
+            return [path / name for name in names[:MAX_FOLDER_FILES]]
     except (OSError, ValueError):
         return []
     if any(c in text for c in "*?["):
@@ -77,11 +75,19 @@ def _candidate_files(text: str, folder: Path) -> list[Path]:
     return []
 
 
-def _input_key(path: Path, folder: Path) -> str:
+def _input_key(path: Path, folder: Path, resolved_folders: dict[Path, Path]) -> str:
     """``path`` relative to the config's folder when it lies below it (so a moved checkout or dataset
-    folder gives the same fingerprint, and the same bytes), else as the config names it."""
+    folder gives the same fingerprint, and the same bytes), else as the config names it. The files of one
+    folder resolve it once (``resolved_folders``); a file that is a symlink resolves to its target."""
     try:
-        return str(path.resolve().relative_to(folder))
+        if path.is_symlink():
+            resolved = path.resolve()
+        else:
+            parent = resolved_folders.get(path.parent)
+            if parent is None:
+                parent = resolved_folders[path.parent] = path.parent.resolve()
+            resolved = parent / path.name
+        return str(resolved.relative_to(folder))
     except (OSError, ValueError):
         return str(path)
 
@@ -116,17 +122,21 @@ def _config_leaves(config: ConfigFile) -> Iterator[tuple[str, Any]]:
             yield from _leaves(value, str(key))
 
 
-def run_fingerprint(config: ConfigFile) -> dict[str, str]:
-    """The fingerprint of a run of ``config`` (see the module documentation)."""
+def run_fingerprint(config: ConfigFile, hashes: InputHashes | None = None) -> dict[str, str]:
+    """The fingerprint of a run of ``config`` (see the module documentation); input files are hashed through
+    ``hashes`` (default: the cache in hybridgen's cache folder), which is saved afterwards."""
+    hashes = InputHashes.default() if hashes is None else hashes
     fingerprint = {"hybridgen_version": __version__}
     for key, value in _config_leaves(config):
         fingerprint[f"config:{key}"] = _leaf_text(value)
     folder = Path(config.path).resolve().parent
+    resolved_folders: dict[Path, Path] = {}
     for path in input_files(config):
         try:
-            fingerprint[f"input:{_input_key(path, folder)}"] = file_sha256(path)
+            fingerprint[f"input:{_input_key(path, folder, resolved_folders)}"] = hashes.sha256(path)
         except OSError:
             continue  # the module that reads it reports the problem
+    hashes.save()
     return fingerprint
 
 
