@@ -41,6 +41,8 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.haven_loaders",
     "hybridgen.modules.shapenet_loader",
     "hybridgen.modules.front3d_loader",
+    "hybridgen.modules.object_dataset_loaders",
+    "hybridgen.modules.scenenet_loader",
     "hybridgen.modules.material_randomizer",
     "hybridgen.modules.hide_objects",
     "hybridgen.modules.camera_object_sampler",
@@ -83,7 +85,7 @@ def _load_all() -> None:
 
 def module_aliases() -> dict[str, str]:
     """BlenderProc module names hybridgen reads as one of its own modules: alias -> module name."""
-    from .blenderproc import ALIASES
+    from .blenderproc.names import ALIASES
 
     return dict(sorted(ALIASES.items()))
 
@@ -94,12 +96,22 @@ def all_modules() -> dict[str, type["Module"]]:
     return dict(sorted(MODULES.items()))
 
 
+def unavailable_reason(name: str) -> str | None:
+    """Why the BlenderProc module ``name`` is not available in hybridgen, or None: a registered module of that
+    name (a loader added since, a plugin) wins over its ``UNAVAILABLE`` entry."""
+    from .blenderproc.names import UNAVAILABLE
+
+    if name not in UNAVAILABLE:
+        return None
+    return None if name in all_modules() else UNAVAILABLE[name]
+
+
 def get_module(name: object) -> type["Module"]:
     """The module class registered as ``name``; a ConfigError with the closest names otherwise."""
     _load_all()
     if not isinstance(name, str) or not name:
         raise ConfigError(f"module 'name' must be a non-empty string, got {name!r}", key="name")
-    from .blenderproc import ALIASES, unavailable_reason
+    from .blenderproc.names import ALIASES
 
     reason = unavailable_reason(name)
     if reason is not None:

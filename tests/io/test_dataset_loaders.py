@@ -226,3 +226,121 @@ def test_front3d_unknown_label_and_broken_json(tmp_path, front):
     front["json_path"].write_text('{"mesh": []}')
     with pytest.raises(ConfigError, match="has no 'scene'"):
         _run(tmp_path, "loader.Front3DLoader", _front_config(front))
+
+
+# ---------------------------------------------------------------------------------------------- Replica
+def test_replica_mesh_with_vertex_colors_as_stored(tmp_path):
+    import trimesh
+
+    mesh = trimesh.Trimesh([[0, 0, 0], [2, 0, 0], [0, 3, 0], [0, 0, 1.5]], [[0, 1, 2], [0, 1, 3]], process=False)
+    mesh.visual.vertex_colors = [[255, 0, 0, 255]] * 2 + [[0, 0, 255, 255]] * 2
+    (tmp_path / "replica" / "office_1").mkdir(parents=True)
+    mesh.export(tmp_path / "replica" / "office_1" / "mesh.ply")
+    context = _run(tmp_path, "loader.ReplicaLoader", {"data_path": str(tmp_path / "replica"),
+                                                      "data_set_name": "office_1",
+                                                      "add_properties": {"cp_category_id": 3}})
+    [obj] = context.scene.objects
+    np.testing.assert_allclose(obj.world_vertices(), mesh.vertices)  # z up as stored, metres
+    assert obj.category_id == 3 and obj.material.base_color_from_vertices
+    np.testing.assert_allclose(obj.vertex_colors, [[1, 0, 0]] * 2 + [[0, 0, 1]] * 2)
+    with pytest.raises(ConfigError, match="Replica mesh not found") as info:
+        _run(tmp_path, "loader.ReplicaLoader", {"data_path": str(tmp_path / "replica"), "data_set_name": "room_0"})
+    assert info.value.key == "data_set_name"
+
+
+# ---------------------------------------------------------------------------------------------- Pix3D
+def test_pix3d_model_of_a_category(tmp_path):
+    root = tmp_path / "pix3d"
+    _box_obj(root / "model" / "chair" / "IKEA_A" / "model.obj", (-0.3, 0.0, -0.2), (0.3, 0.9, 0.2))
+    _box_obj(root / "model" / "chair" / "IKEA_B" / "model.obj", (0.0, 1.0, 0.0), (0.4, 1.5, 0.4))
+    _box_obj(root / "model" / "bed" / "X" / "model.obj", (0, 0, 0), (2, 1, 1))
+    annotations = [{"img": f"img/chair/{i}.jpg", "category": "chair", "model": f"model/chair/IKEA_{m}/model.obj"}
+                   for i, m in enumerate("AAB")] + [{"category": "bed", "model": "model/bed/X/model.obj"}]
+    (root / "pix3d.json").write_text(json.dumps(annotations))
+    drawn = set()
+    for seed in range(8):
+        [obj] = _run(tmp_path, "loader.Pix3DLoader", {"data_path": str(root), "used_category": "chair"},
+                     seed=seed).scene.objects
+        drawn.add(obj.attributes["source_path"])
+        size = obj.world_vertices().max(axis=0) - obj.world_vertices().min(axis=0)
+        # Blender's OBJ axes (file y up -> z), origin at the bottom centre
+        np.testing.assert_allclose(obj.world_vertices().min(axis=0), -size * [0.5, 0.5, 0])
+    assert {Path(p).parent.name for p in drawn} == {"IKEA_A", "IKEA_B"}
+    assert not list(root.glob("category_*"))  # nothing written into the dataset
+    with pytest.raises(ConfigError, match="no model of category 'lamp'.*bed, chair") as info:
+        _run(tmp_path, "loader.Pix3DLoader", {"data_path": str(root), "used_category": "lamp"})
+    assert info.value.key == "used_category"
+
+
+# ---------------------------------------------------------------------------------------------- IKEA
+def test_ikea_units_names_and_selection(tmp_path):
+    root = tmp_path / "ikea"
+    chair = _box_obj(root / "IKEA" / "IKEA_chair_POANG" / "poang.obj", (0, 0, 0), (20, 30, 10), mtl="poang.mtl")
+    chair.write_text("# File units = inches\n" + chair.read_text())
+    (chair.parent / "poang.mtl").write_text("newmtl body\nKd 0.5 0.4 0.3\n")
+    bed = _box_obj(root / "IKEA" / "IKEA_bed_MALM" / "malm.obj", (0, 0, 0), (200, 50, 100), mtl="malm.mtl")
+    bed.write_text("# File units: centimeters\n" + bed.read_text())
+    (bed.parent / "malm.mtl").write_text("newmtl body\nKd 0.5 0.4 0.3\n")
+    _box_obj(root / "IKEA" / "IKEA_bed_HEMNES" / "no_mtl.obj", (0, 0, 0), (1, 1, 1))  # no .mtl: not a candidate
+    [obj] = _run(tmp_path, "loader.IKEALoader", {"data_dir": str(root), "category": "chair"}).scene.objects
+    assert obj.name == "IKEA_chair_POANG"
+    size = obj.world_vertices().max(axis=0) - obj.world_vertices().min(axis=0)
+    np.testing.assert_allclose(size, np.array([20, 10, 30]) * 0.0254)  # inches -> m, y up -> z
+    np.testing.assert_allclose(obj.world_vertices().min(axis=0), -size * [0.5, 0.5, 0], atol=1e-12)
+    [obj] = _run(tmp_path, "loader.IKEALoader", {"data_dir": str(root), "style": "malm"}).scene.objects
+    assert obj.name == "IKEA_bed_MALM"
+    np.testing.assert_allclose(obj.world_vertices().max(axis=0) - obj.world_vertices().min(axis=0), [2, 1, 0.5])
+    lines: list[str] = []
+    set_sink(lines.append)
+    try:
+        [obj] = _run(tmp_path, "loader.IKEALoader", {"data_dir": str(root), "category": "sofa",
+                                                     "style": "poang"}).scene.objects
+    finally:
+        set_sink(None)
+    assert obj.name in ("IKEA_chair_POANG", "IKEA_bed_MALM") and any("a random model" in line for line in lines)
+    with pytest.raises(ConfigError, match="no IKEA/IKEA_") as info:
+        _run(tmp_path, "loader.IKEALoader", {"data_dir": str(tmp_path)})
+    assert info.value.key == "data_dir"
+
+
+# ---------------------------------------------------------------------------------------------- SceneNet
+def test_scenenet_room_textures_and_nyu_categories(tmp_path):
+    room = tmp_path / "scenenet" / "1Bedroom" / "bedroom1.obj"
+    room.parent.mkdir(parents=True)
+    (room.parent / "bedroom1.mtl").write_text("".join(f"newmtl {m}\nKd 0.5 0.5 0.5\n"
+                                                      for m in ("bed_01", "Wood_2.001", "ground_mat", "misc")))
+    parts = [("Bed.003", "bed_01", 0), ("Nightstand", "Wood_2.001", 2), ("ground", "ground_mat", 4),
+             ("Paintings_1", "misc", 6), ("Chairs", "misc", 8), ("Thing", "misc", 10), ("Wall.002", "misc", 12)]
+    lines = ["mtllib bedroom1.mtl", "vt 0 0", "vt 1 0", "vt 1 1"]
+    for index, (name, material, x) in enumerate(parts):
+        lines += [f"o {name}", f"usemtl {material}", f"v {x} 0 0", f"v {x + 1} 0 0", f"v {x} 1 0", "vn 0 0 1",
+                  f"f {3 * index + 1}/1/1 {3 * index + 2}/2/1 {3 * index + 3}/3/1"]
+    room.write_text("\n".join(lines) + "\n")
+    textures = tmp_path / "textures"
+    for folder, count in (("bed", 2), ("Wood", 1), ("unknown", 1)):
+        for i in range(count):
+            _image_file(textures / folder / f"{folder}_{i}.jpg")
+    (tmp_path / "nyu.csv").write_text("id,name\n0,void\n1,wall\n2,floor\n3,bed\n4,night_stand\n5,picture\n"
+                                      "6,chair\n7,ceiling\n8,otherstructure\n")
+    context = _run(tmp_path, "loader.SceneNetLoader", {"file_path": str(room), "texture_folder": str(textures),
+                                                       "mapping_file": str(tmp_path / "nyu.csv")})
+    by_name = {o.name: o for o in context.scene.objects}
+    assert sorted(by_name) == ["Bed.003", "Chairs", "Nightstand", "Paintings_1", "Thing", "Wall.002", "floor"]
+    expected = {"Bed.003": 3, "Chairs": 6, "Nightstand": 4, "Paintings_1": 5, "Thing": 8, "Wall.002": 1, "floor": 2}
+    assert {n: o.category_id for n, o in by_name.items()} == expected  # plural 'chairs' -> chair
+    assert Path(by_name["Bed.003"].material.base_color_texture).parent.name == "bed"
+    assert Path(by_name["Nightstand"].material.base_color_texture).name == "Wood_0.jpg"  # 'Wood_2.001' -> Wood
+    assert Path(by_name["Thing"].material.base_color_texture).parent.name == "unknown"
+    # flat shading by the file's name (as BlenderProc, before 'ground' is renamed floor)
+    assert by_name["Wall.002"].vertex_normals is None and by_name["floor"].vertex_normals is not None
+    assert all(o.attributes["is_scene_net_obj"] for o in by_name.values())
+    with pytest.raises(ConfigError, match="unknown texture folder") as info:
+        _run(tmp_path, "loader.SceneNetLoader", {"file_path": str(room), "texture_folder": str(textures),
+                                                 "unknown_texture_folder": str(tmp_path / "none"),
+                                                 "mapping_file": str(tmp_path / "nyu.csv")})
+    assert info.value.key == "unknown_texture_folder"
+
+
+def _image_file(path: Path) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    Image.new("RGB", (2, 2), (90, 90, 90)).save(path)

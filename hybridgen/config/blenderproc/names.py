@@ -28,12 +28,8 @@ UNAVAILABLE = {
     "camera.SuncgCameraSampler": "samples cameras inside SUNCG rooms (a withdrawn dataset); use "
                                  "camera.CameraSampler with proximity_checks",
     "writer.ShapeNetWriter": "writes ShapeNet ids of the loader hybridgen does not have; use attributes + map_by",
-    "loader.SceneNetLoader": f"SceneNet's layout is not read by hybridgen; {_DATASET}",
     "camera.Front3DCameraSampler": "samples inside 3D-FRONT rooms; use camera.CameraSampler with "
                                    "proximity_checks",
-    "loader.Pix3DLoader": f"Pix3D's layout is not read by hybridgen; {_DATASET}",
-    "loader.IKEALoader": f"the IKEA dataset's layout is not read by hybridgen; {_DATASET}",
-    "loader.ReplicaLoader": f"Replica's layout is not read by hybridgen; its mesh.ply loads with loader.ObjLoader",
     "camera.ReplicaCameraSampler": "samples inside Replica scenes; use camera.CameraSampler with proximity_checks",
     "loader.AMASSLoader": "posing SMPL bodies needs the AMASS data and the SMPL body model (licensed, not "
                           "distributable); export posed bodies to OBJ and load them with loader.ObjLoader",
@@ -53,13 +49,3 @@ UNAVAILABLE = {
                        "'hybridgen.modules')",
 }
 """Modules hybridgen cannot provide: one line why, and what to do instead."""
-
-
-def unavailable_reason(name: str) -> str | None:
-    """Why ``name`` is not available, or None: a registered module of that name (a loader added since, a
-    plugin) wins over its :data:`UNAVAILABLE` entry."""
-    if name not in UNAVAILABLE:
-        return None
-    from ..registry import all_modules
-
-    return None if name in all_modules() else UNAVAILABLE[name]
