@@ -13,8 +13,9 @@ documentation, to hybridgen's own modules.
 """
 from __future__ import annotations
 
+from ..registry import unavailable_reason
 from .common import Note, custom_properties
-from .names import ALIASES, UNAVAILABLE, unavailable_reason
+from .names import ALIASES, UNAVAILABLE
 from .selectors import samplers_as_blenderproc, selector
 from .setup_keys import BLENDER_PYTHON_PACKAGES, BLENDER_SETUP_KEYS, GLOBAL_IGNORED
 from .translate import KEYS_ONLY_BLENDERPROC, TRANSLATORS, WRITERS, translate_module

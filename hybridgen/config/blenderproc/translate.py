@@ -5,10 +5,11 @@ import copy
 from typing import Any, Callable
 
 from ...errors import ConfigError
+from ..registry import unavailable_reason
 from .common import Note
 from .composite import camera_object_sampler
 from .manipulators import entity, material
-from .names import ALIASES, unavailable_reason
+from .names import ALIASES
 from .objects import (bop_loader, camera_loader, loader, mesh_initializer, passthrough, physics, pose_sampler,
                       replacer)
 from .renderers import rgb, segmap, single_pass
