@@ -41,6 +41,8 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.haven_loaders",
     "hybridgen.modules.shapenet_loader",
     "hybridgen.modules.front3d_loader",
+    "hybridgen.modules.object_dataset_loaders",
+    "hybridgen.modules.scenenet_loader",
     "hybridgen.modules.material_randomizer",
     "hybridgen.modules.hide_objects",
     "hybridgen.modules.camera_object_sampler",

@@ -28,12 +28,8 @@ UNAVAILABLE = {
     "camera.SuncgCameraSampler": "samples cameras inside SUNCG rooms (a withdrawn dataset); use "
                                  "camera.CameraSampler with proximity_checks",
     "writer.ShapeNetWriter": "writes ShapeNet ids of the loader hybridgen does not have; use attributes + map_by",
-    "loader.SceneNetLoader": f"SceneNet's layout is not read by hybridgen; {_DATASET}",
     "camera.Front3DCameraSampler": "samples inside 3D-FRONT rooms; use camera.CameraSampler with "
                                    "proximity_checks",
-    "loader.Pix3DLoader": f"Pix3D's layout is not read by hybridgen; {_DATASET}",
-    "loader.IKEALoader": f"the IKEA dataset's layout is not read by hybridgen; {_DATASET}",
-    "loader.ReplicaLoader": f"Replica's layout is not read by hybridgen; its mesh.ply loads with loader.ObjLoader",
     "camera.ReplicaCameraSampler": "samples inside Replica scenes; use camera.CameraSampler with proximity_checks",
     "loader.AMASSLoader": "posing SMPL bodies needs the AMASS data and the SMPL body model (licensed, not "
                           "distributable); export posed bodies to OBJ and load them with loader.ObjLoader",
