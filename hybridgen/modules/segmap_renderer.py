@@ -1,12 +1,26 @@
 """``renderer.SegMapRenderer``: the labels-only renderer (depth, distance, normals, segmentation)."""
 from __future__ import annotations
 
+from typing import Any
+
 from ..config.registry import register_module
+from ..config.schema import Param
+from ..io.blenderproc_segmap import SegmapSink, apply_default_values, segmap_plan
 from ..io.renamed_sink import renamed_sinks
+from ..render.label_request import parse_map_by
 from ..render.render_labels import render_labels
 from ..run.context import RunContext
 from .base import Module, Role
 from .label_params import label_params, label_request, stored_keys
+
+
+def _segmap_check(value: Any) -> str | None:
+    if value is None:
+        return None
+    if not isinstance(value, dict) or set(value) - {"key", "default_values"} or \
+            not isinstance(value.get("key", "segmap"), str) or not isinstance(value.get("default_values", {}), dict):
+        return f"must be {{key: name, default_values: {{attribute: value}}}}, got {value!r}"
+    return None
 
 
 @register_module("renderer.SegMapRenderer")
@@ -15,14 +29,25 @@ class SegMapRenderer(Module):
 
     role = Role.RENDERER
 
-    params = label_params(depth=True, normals=True, map_by=["class", "instance"])
+    params = (*label_params(depth=True, normals=True, map_by=["class", "instance"]),
+              Param("blenderproc_segmap", "dict|null", None, check=_segmap_check,
+                    doc="also store BlenderProc's one segmap, {key, default_values}: a channel per numeric map_by "
+                    "attribute in order (text attributes only in instance_attribute_maps); objects lacking an "
+                    "attribute get its default value (set by BlenderProc configs)"))
 
     def produces(self) -> frozenset[str] | None:
-        return stored_keys(self.config)
+        segmap = self.config["blenderproc_segmap"]
+        return stored_keys(self.config, [segmap.get("key", "segmap")] if segmap is not None else [])
 
     def run(self, context: RunContext) -> None:
-        sinks = renamed_sinks(context.sinks, self.config["output_keys"])
-        context.frames_rendered += render_labels(context.scene, sinks, label_request(self.config),
+        config, segmap = self.config, self.config["blenderproc_segmap"]
+        sinks = renamed_sinks(context.sinks, config["output_keys"])
+        if segmap is not None and config["map_by"] is not None:
+            apply_default_values(context.scene, segmap.get("default_values", {}))
+            plan = segmap_plan(context.scene, parse_map_by(config["map_by"]))
+            config = {**config, "map_by": plan.map_by or None}
+            sinks = [SegmapSink(sink, plan.channels, segmap.get("key", "segmap")) for sink in sinks]
+        context.frames_rendered += render_labels(context.scene, sinks, label_request(config),
                                                  default_category_id=context.default_category_id,
                                                  progress=context.progress,
                                                  indices=context.keypoint_indices())

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
+from ...errors import ConfigError
 from .common import Note, pop_ignored
 from .setup_keys import GLOBAL_IGNORED
 
@@ -65,13 +66,15 @@ _LABEL_ONLY = {"render_depth": False, "render_distance": False, "render_normals"
 
 
 def segmap(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]]]:
+    """BlenderProc's SegMapRenderer: one ``segmap`` dataset (``output_key``) with a channel per numeric map_by
+    attribute, ``default_values`` for objects lacking one (:mod:`hybridgen.io.blenderproc_segmap`)."""
     cfg = dict(config)
+    defaults = cfg.pop("default_values", None) or {}
+    if not isinstance(defaults, dict):
+        raise ConfigError("must map map_by attributes to values, e.g. {class: 0}", key="default_values")
+    cfg["blenderproc_segmap"] = {"key": str(cfg.pop("output_key", "segmap")), "default_values": defaults}
     _output_keys(cfg, note, None)
     _renderer_common(cfg, note)
-    defaults = cfg.pop("default_values", None)
-    if defaults:
-        note("objects lacking a map_by attribute get 0 (background) in hybridgen unless main.Initializer's "
-             "default_category_id is set", "default_values")
     cfg["map_by"] = _map_by(cfg.get("map_by", "class"), note)  # "class": BlenderProc's default
     # BlenderProc's SegMapRenderer writes only segmentation; hybridgen's would add depth and normals
     cfg.setdefault("render_depth", False)
