@@ -54,6 +54,10 @@ class FrameSink(Protocol):
     leave nothing under a final name. ``records`` and ``attributes`` of ``finalize`` are scene-level JSON
     records (``object_states``, ...) and run attributes (seed, resolved config, ...) for writers that store
     them; others ignore them.
+
+    A sink may also have ``wanted_passes() -> tuple[str, ...]``: the on-request passes (``amodal_masks``,
+    ``visible_fractions``, ``object_boxes``; :mod:`hybridgen.render.passes`) renderers then hand to it, and
+    only to it, with ``instance_segmaps``.
     """
 
     def begin(self, n_keypoints: int, layouts: list[PassLayout], camera_records: dict[str, np.ndarray],

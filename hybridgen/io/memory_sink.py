@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable
 
 import numpy as np
 
@@ -10,13 +10,18 @@ from .frame_sink import PassLayout
 
 
 class MemorySink:
-    """Collects ``frames[i][key]`` for every keypoint i; ``records`` and ``attributes`` as given by renderers."""
+    """Collects ``frames[i][key]`` for every keypoint i; ``records`` and ``attributes`` as given by renderers.
+    ``wanted``: on-request passes to receive too (e.g. ``amodal_masks``; :mod:`hybridgen.render.passes`)."""
 
-    def __init__(self) -> None:
+    def __init__(self, wanted: Iterable[str] = ()) -> None:
+        self.wanted = tuple(wanted)
         self.frames: list[dict[str, Any]] = []
         self.layouts: dict[str, PassLayout] = {}
         self.records: dict[str, np.ndarray] = {}
         self.attributes: dict[str, Any] = {}
+
+    def wanted_passes(self) -> tuple[str, ...]:
+        return self.wanted
 
     def begin(self, n_keypoints: int, layouts: list[PassLayout], camera_records: dict[str, np.ndarray],
               attributes: dict[str, Any]) -> None:

@@ -126,3 +126,23 @@ def test_bop_writer_takes_masks_counts_and_boxes_from_the_passes(tmp_path):
     assert gt["obj_id"] == 5 and gt["cam_t_m2c"] == [0.0, 0.0, 2000.0]
     coco = json.loads((chunk / "scene_gt_coco.json").read_text())
     assert coco["annotations"][0]["bbox"] == [1, 0, 2, 2] and coco["annotations"][0]["area"] == 2
+
+
+def test_on_request_passes_reach_a_memory_sink_through_a_renamed_sink(gl_context):
+    scene = hg.Scene()
+    cube = scene.add(hg.make_primitive("cube", 1.0, name="cube", category_id=3))
+    scene.camera.intrinsics = hg.Intrinsics(np.array([[20.0, 0, 15.5], [0, 20.0, 11.5], [0, 0, 1]]), 32, 24)
+    scene.camera.add_keypoint(hg.look_at([0, -6, 0], [0, 0, 0]))
+    asking, plain = hg.MemorySink(wanted=["amodal_masks", "visible_fractions"]), hg.MemorySink()
+    sinks = [RenamedSink(asking, {"instance_segmaps": "ids"}), plain]
+    hg.render_labels(scene, sinks, hg.LabelRequest(map_by=["instance"], depth=False, normals=False))
+    frame = asking.frames[0]
+    visible = frame["ids"] == cube.instance_id  # nothing hides the cube: amodal = visible
+    # front face 5.5 m away, 1 m wide: u, v = 15.5 / 11.5 +- 20 * 0.5 / 5.5 -> pixel centres 14..17 and 10..13
+    expected = np.zeros((24, 32), bool)
+    expected[10:14, 14:18] = True
+    np.testing.assert_array_equal(visible, expected)
+    np.testing.assert_array_equal(frame["amodal_masks"][cube.instance_id], visible)
+    assert frame["visible_fractions"][cube.instance_id] == {"px_count_all": 16, "px_count_visib": 16,
+                                                             "visib_fract": 1.0}
+    assert "amodal_masks" not in plain.frames[0] and "object_boxes" not in frame
