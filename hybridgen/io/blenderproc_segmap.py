@@ -14,14 +14,13 @@ hybridgen renders each attribute as its own ``<attr>_segmaps`` pass; :class:`Seg
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 
 from ..errors import InputError
 from ..scene.scene import Scene
-from .frame_sink import FrameSink, PassLayout
+from .frame_sink import FrameSink, PassLayout, SinkFilter
 
 _ATTRIBUTE = {"class": "category_id", "category_id": "category_id"}
 
@@ -82,12 +81,13 @@ def segmap_plan(scene: Scene, map_by: list[str]) -> SegmapPlan:
     return SegmapPlan(rendered, channels)
 
 
-class SegmapSink:
+class SegmapSink(SinkFilter):
     """Hands ``sink`` the renderer's passes plus ``key``: the ``channels`` passes stacked on a last axis
     (H x W with one channel), stored in the smallest integer range that holds them all."""
 
     def __init__(self, sink: FrameSink, channels: list[str], key: str) -> None:
-        self.sink, self.channels, self.key = sink, list(channels), key
+        super().__init__(sink)
+        self.channels, self.key = list(channels), key
 
     def begin(self, n_keypoints: int, layouts: list[PassLayout], camera_records: dict[str, np.ndarray],
               attributes: dict[str, Any]) -> None:
@@ -105,17 +105,3 @@ class SegmapSink:
             stacked = np.stack([np.asarray(values[c]) for c in self.channels], axis=-1)
             values = {**values, self.key: stacked[..., 0] if len(self.channels) == 1 else stacked}
         self.sink.write(index, values)
-
-    def end(self) -> None:
-        self.sink.end()
-
-    def wanted_passes(self) -> tuple[str, ...]:
-        wanted = getattr(self.sink, "wanted_passes", None)
-        return tuple(wanted()) if wanted is not None else ()
-
-    def finalize(self, records: dict[str, Any] | None = None,
-                 attributes: dict[str, Any] | None = None) -> list[Path]:
-        return self.sink.finalize(records, attributes)
-
-    def abort(self) -> None:
-        self.sink.abort()

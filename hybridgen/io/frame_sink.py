@@ -72,3 +72,33 @@ class FrameSink(Protocol):
 
     def abort(self) -> None: ...
 
+
+
+class SinkFilter:
+    """A sink in front of another (``sink``): every call goes on to it unchanged; subclasses change what
+    ``begin`` and ``write`` hand on (renamed keys, derived passes, ...)."""
+
+    def __init__(self, sink: FrameSink) -> None:
+        self.sink = sink
+
+    def begin(self, n_keypoints: int, layouts: list[PassLayout], camera_records: dict[str, np.ndarray],
+              attributes: dict[str, Any]) -> None:
+        self.sink.begin(n_keypoints, layouts, camera_records, attributes)
+
+    def write(self, index: int, values: dict[str, Any]) -> None:
+        self.sink.write(index, values)
+
+    def end(self) -> None:
+        self.sink.end()
+
+    def wanted_passes(self) -> tuple[str, ...]:
+        """The on-request passes the sink behind asks for."""
+        wanted = getattr(self.sink, "wanted_passes", None)
+        return tuple(wanted()) if wanted is not None else ()
+
+    def finalize(self, records: dict[str, Any] | None = None,
+                 attributes: dict[str, Any] | None = None) -> list[Path]:
+        return self.sink.finalize(records, attributes)
+
+    def abort(self) -> None:
+        self.sink.abort()

@@ -4,13 +4,12 @@ writer of the run sees the pass under the new name, as BlenderProc's writers do.
 from __future__ import annotations
 
 from dataclasses import replace
-from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 
 from ..errors import ConfigError
-from .frame_sink import FrameSink, PassLayout
+from .frame_sink import FrameSink, PassLayout, SinkFilter
 
 
 def check_output_keys(value: Any) -> str | None:
@@ -37,12 +36,12 @@ def renamed_layouts(layouts: list[PassLayout], names: Mapping[str, str]) -> list
     return out
 
 
-class RenamedSink:
+class RenamedSink(SinkFilter):
     """A :class:`~hybridgen.io.frame_sink.FrameSink` that hands ``sink`` every pass under ``names[pass]``
     (passes not named keep their name); anything else is the wrapped sink's."""
 
     def __init__(self, sink: FrameSink, names: Mapping[str, str]) -> None:
-        self.sink = sink
+        super().__init__(sink)
         self.names = dict(names)
 
     def begin(self, n_keypoints: int, layouts: list[PassLayout], camera_records: dict[str, np.ndarray],
@@ -51,21 +50,6 @@ class RenamedSink:
 
     def write(self, index: int, values: dict[str, Any]) -> None:
         self.sink.write(index, {self.names.get(k, k): v for k, v in values.items()})
-
-    def end(self) -> None:
-        self.sink.end()
-
-    def wanted_passes(self) -> tuple[str, ...]:
-        """The on-request passes the wrapped sink asks for (:mod:`hybridgen.render.passes`)."""
-        wanted = getattr(self.sink, "wanted_passes", None)
-        return tuple(wanted()) if wanted is not None else ()
-
-    def finalize(self, records: dict[str, Any] | None = None,
-                 attributes: dict[str, Any] | None = None) -> list[Path]:
-        return self.sink.finalize(records, attributes)
-
-    def abort(self) -> None:
-        self.sink.abort()
 
 
 def renamed_sinks(sinks: list[FrameSink], names: Mapping[str, str] | None) -> list[FrameSink]:
