@@ -34,8 +34,6 @@ def _output_keys(cfg: dict[str, Any], note: Note, default: str | None) -> None:
 
 
 def _renderer_common(cfg: dict[str, Any], note: Note) -> None:
-    pop_ignored(cfg, "use_alpha", note, "hybridgen images carry no alpha channel")
-    pop_ignored(cfg, "image_type", note, "image file formats are the writers' choice (color_file_format)")
     pop_ignored(cfg, "output_file_prefix", note, "hybridgen names its own files")
     pop_ignored(cfg, "output_is_temp", note, GLOBAL_IGNORED["output_is_temp"])
 

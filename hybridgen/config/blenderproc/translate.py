@@ -8,6 +8,7 @@ from ...errors import ConfigError
 from ..registry import unavailable_reason
 from .common import Note
 from .composite import camera_object_sampler
+from .image_options import alpha_entries, take_image_type
 from .manipulators import entity, material
 from .names import ALIASES
 from .objects import (bop_loader, camera_loader, loader, mesh_initializer, passthrough, physics, pose_sampler,
@@ -70,5 +71,14 @@ def translate_module(name: str, config: dict[str, Any], note: Note,
     if name == "composite.CameraObjectSampler":
         return camera_object_sampler(config, note, state, translate_module)
     if name in TRANSLATORS:
-        return TRANSLATORS[name](config, note)
+        if not name.startswith("renderer."):
+            return TRANSLATORS[name](config, note)
+        image_type = take_image_type(config, note)
+        before = alpha_entries(config, note)
+        out = TRANSLATORS[name](config, note)
+        if image_type is not None:
+            for target, target_config in out:
+                if target.startswith("renderer."):
+                    state.setdefault("image_types", {})[id(target_config)] = image_type
+        return [*before, *out]
     return [(ALIASES.get(name, name), config)]

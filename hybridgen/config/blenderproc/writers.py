@@ -6,6 +6,7 @@ from typing import Any, Callable
 
 from ...errors import ConfigError
 from .common import Note, pop_ignored
+from .image_options import apply_image_types
 
 
 def postprocessing(cfg: dict[str, Any], note: Note, state: dict[str, Any]) -> None:
@@ -96,6 +97,7 @@ def finish(entries: list[Any], state: dict[str, Any], output_dir: Any) -> None:
             last["map_by"] = [*_as_list(last.get("map_by")), "instance"]
         if entry.name == "writer.BopWriter" and not any(e.config.get("render_depth") for e in renderers):
             last["render_depth"] = True
+    apply_image_types(entries, state.get("image_types", {}))
     subdirs = state.get("subdirs", {})
     if subdirs and isinstance(output_dir, str):
         for entry in entries:
