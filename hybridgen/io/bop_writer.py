@@ -62,6 +62,11 @@ OBJECT_PASSES = ("amodal_masks", "visible_fractions", "object_boxes")
 NO_BOX = [-1, -1, -1, -1]
 
 
+def needed_keys(with_masks: bool) -> dict[str, str]:
+    """The keys a BOP dataset needs, with how to make them (instance maps only ``with_masks``)."""
+    return {key: how for key, how in NEEDED_KEYS.items() if key != "instance_segmaps" or with_masks}
+
+
 @dataclass(frozen=True)
 class BopOptions:
     """The options of a BOP dataset, declared once (writer.BopWriter's parameters; :mod:`hybridgen.config.options`)."""
@@ -253,16 +258,12 @@ class BopWriter:
         frame.full_masks, frame.masks_done = masks, True
 
     # ------------------------------------------------------------------ commit
-    def needed_keys(self) -> dict[str, str]:
-        """The keys this writer needs, with how to make them."""
-        return {k: v for k, v in NEEDED_KEYS.items() if k != "instance_segmaps" or self.calc_mask_info_coco}
-
     def missing_keys(self) -> list[str]:
         """Needed keys some keypoint never received."""
         frames = [self.frames.get(i, _Frame()) for i in range(self.count)]
         received = {"colors": all(f.colors for f in frames), "depth": all(f.depth for f in frames),
                     "instance_segmaps": all(f.masks_done for f in frames)}
-        return [key for key in self.needed_keys() if not received[key]]
+        return [key for key in needed_keys(self.calc_mask_info_coco) if not received[key]]
 
     def finalize(self, records: dict[str, Any] | None = None,
                  attributes: dict[str, Any] | None = None) -> list[Path]:
@@ -273,7 +274,7 @@ class BopWriter:
         missing = self.missing_keys()
         if missing:
             raise InputError(f"a BOP dataset needs {missing} for every keypoint: "
-                             + "; ".join(self.needed_keys()[k] for k in missing))
+                             + "; ".join(NEEDED_KEYS[k] for k in missing))
         if self.too_far:
             self.log(f"BOP: {self.too_far} depth pixel(s) beyond {65535 * self.depth_scale:.0f} mm were written as 0 "
                      "(no depth); raise depth_scale to keep them")

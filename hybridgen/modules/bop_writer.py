@@ -4,7 +4,7 @@ from __future__ import annotations
 from ..config.options import from_config, option_params
 from ..config.registry import register_module
 from ..config.schema import Param
-from ..io.bop_writer import NEEDED_KEYS, BopOptions, BopWriter as BopSink
+from ..io.bop_writer import BopOptions, BopWriter as BopSink, needed_keys
 from ..io.renamed_sink import check_output_keys, renamed_sinks
 from ..run.context import RunContext
 from ..sampling.getters import parse_selector
@@ -31,8 +31,7 @@ class BopWriter(Module):
 
     def consumes(self) -> dict[str, str]:
         stored = self.config["input_keys"] or {}  # instance maps are needed only for masks and COCO info
-        return {stored.get(key, key): how for key, how in NEEDED_KEYS.items()
-                if key != "instance_segmaps" or self.config["calc_mask_info_coco"]}
+        return {stored.get(key, key): how for key, how in needed_keys(self.config["calc_mask_info_coco"]).items()}
 
     def prepare(self, context: RunContext) -> None:
         cfg = self.config
