@@ -15,6 +15,7 @@ import numpy as np
 from ..errors import InputError
 from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
+from .alpha_cutout import Cutout, set_cutout_uniforms, upload_cutout
 from .gl_context import shared_context
 from .raster_passes import RASTER_PASSES
 from .readback import RasterOutput
@@ -36,6 +37,7 @@ class GpuObject:
     vertex_order: np.ndarray | None  # mesh vertex of each GPU vertex (flat meshes), None: the same order
     closed: bool
     bounds: np.ndarray  # (2, 3) local box
+    cutout: Cutout | None = None  # alpha cut-out of a CLIP material (render/alpha_cutout.py)
 
 
 class RasterView:
@@ -84,10 +86,15 @@ class RasterView:
         positions = ctx.buffer(vertices.astype(np.float32).tobytes())
         normal_buffer = ctx.buffer(normals.astype(np.float32).tobytes())
         indices = ctx.buffer(faces.astype(np.uint32).tobytes())
-        vao = ctx.vertex_array(self.program, [(positions, "3f", "in_position"), (normal_buffer, "3f", "in_normal")],
-                               index_buffer=indices, index_element_size=4)
-        return GpuObject(obj.instance_id, vao, positions, indices, [positions, normal_buffer, indices],
-                         vertex_order, obj.is_closed, obj.bounds_local)
+        cutout = upload_cutout(ctx, obj, vertex_order)
+        content = [(positions, "3f", "in_position"), (normal_buffer, "3f", "in_normal")]
+        if cutout is not None and cutout.uv_buffer is not None:
+            content.append((cutout.uv_buffer, "2f", "in_uv"))
+        vao = ctx.vertex_array(self.program, content, index_buffer=indices, index_element_size=4)
+        extra = cutout.resources() if cutout is not None else []
+        # a cut-out volume shows its inside through its holes: never culled
+        return GpuObject(obj.instance_id, vao, positions, indices, [positions, normal_buffer, indices, *extra],
+                         vertex_order, obj.is_closed and cutout is None, obj.bounds_local, cutout)
 
     def _framebuffer(self, slot: Any, width: int, height: int) -> Any:
         key = (slot, width, height)
@@ -172,6 +179,7 @@ class RasterView:
             prog["u_modelview"].write(modelview)
             prog["u_normal_to_cam"].write(normal_to_cam)
             prog["u_instance_id"].value = gpu.instance_id
+            set_cutout_uniforms(prog, gpu.cutout)
             # The projection mirrors handedness (and so may the object's transform): front_face is set so
             # that gl_FrontFacing means "the side the normal points to faces the camera".
             self.ctx.front_face = front_face

@@ -126,3 +126,29 @@ def test_constant_alpha_clip_is_all_or_nothing(gl_context, alpha, drawn):
     quad.material.alpha, quad.material.alpha_mode = alpha, "CLIP"
     albedo = AlbedoPass(hg.RasterView(_scene(quad))).render(TOP_DOWN, background=(0, 0, 0))
     assert (albedo[WIDTH // 2, WIDTH // 2].sum() > 0) == drawn
+
+
+def test_alpha_clip_cuts_labels_blend_does_not(gl_context):
+    """Labels of the half-cut quad over the floor: depth and instance ids show the floor through the cut
+    (alpha below 0.5), the quad elsewhere; a BLEND material with the same map keeps the whole quad."""
+    floor = hg.MeshObject("floor", [[-3, -3, 0], [3, -3, 0], [3, 3, 0], [-3, 3, 0]], [[0, 1, 2], [0, 2, 3]])
+    alpha = np.zeros((4, 8), np.uint8)
+    alpha[:, :4] = 200
+    cut = hg.MeshObject("cut", [[-1, -1, 0.5], [1, -1, 0.5], [1, 1, 0.5], [-1, 1, 0.5]], [[0, 1, 2], [0, 2, 3]],
+                        uvs=np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float),
+                        material=hg.Material(alpha_texture=alpha, alpha_mode="CLIP"))
+    scene = _scene(floor, cut)
+    x = _pixel_x(2.5)
+    rows = np.flatnonzero(np.abs(x) < 0.75)
+    left, right = (x > -0.75) & (x < -0.25), (x > 0.25) & (x < 0.75)
+    labels = hg.RasterView(scene).render(TOP_DOWN, passes=("depth", "instance_segmaps"))
+    ids, depth = labels["instance_segmaps"][rows], labels["depth"][rows]
+    assert np.all(ids[:, left] == cut.instance_id) and np.all(ids[:, right] == floor.instance_id)
+    np.testing.assert_allclose(depth[:, left], 2.5, atol=1e-5)
+    np.testing.assert_allclose(depth[:, right], 3.0, atol=1e-5)
+    cut.material = hg.Material(alpha_texture=alpha)  # BLEND: labels see the surface
+    labels = hg.RasterView(scene).render(TOP_DOWN, passes=("instance_segmaps",))
+    assert np.all(labels["instance_segmaps"][rows][:, left | right] == cut.instance_id)
+    cut.material = hg.Material(alpha=0.3, alpha_mode="CLIP")  # a constant below 0.5: gone from labels
+    labels = hg.RasterView(scene).render(TOP_DOWN, passes=("instance_segmaps",))
+    assert not np.any(labels["instance_segmaps"] == cut.instance_id)
