@@ -10,6 +10,7 @@ from ..config.schema import Param
 from ..errors import InputError
 from ..scene.frames import object_pose
 from ..run.context import RunContext
+from ..scene.material import TEXTURE_SLOTS
 from ..scene.frames import matrix_to_euler_xyz
 from .base import Role
 from .selecting import SelectingModule
@@ -23,8 +24,10 @@ class MaterialManipulator(SelectingModule):
 
     params = (
         Param("selector", "dict|list", doc="which objects (getter.Entity conditions, random_samples)"),
-        Param("material", "dict", sampleable=True, doc="principled values: base_color, base_color_texture "
-              "(path), roughness, metallic, specular, transmission, ior, alpha, emission, emission_strength"),
+        Param("material", "dict", sampleable=True, doc="principled values: base_color, roughness, metallic, "
+              "specular, transmission, ior, alpha, alpha_mode, emission, emission_strength, and maps (paths): "
+              "base_color_texture, roughness_texture, metallic_texture, alpha_texture, normal_texture "
+              "(normal_y_down), displacement_texture (displacement_scale)"),
         Param("randomize_color", "bool", False, doc="a uniform random base color per object"),
     )
 
@@ -33,8 +36,9 @@ class MaterialManipulator(SelectingModule):
             values = dict(self.value(context, "material"))
             if self.config["randomize_color"]:
                 values["base_color"] = [*context.rng.uniform(0, 1, 3).tolist(), 1.0]
-            if "base_color_texture" in values and obj.uvs is None:
-                raise InputError(f"object '{obj.name}' has no UVs to map base_color_texture with")
+            mapped = [key for key in TEXTURE_SLOTS if values.get(key) is not None]
+            if mapped and obj.uvs is None:
+                raise InputError(f"object '{obj.name}' has no UVs to map {mapped[0]} with")
             obj.material = apply_material_config(obj.material, values)
 
 

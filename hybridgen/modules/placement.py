@@ -31,8 +31,10 @@ PLACEMENT_PARAMS: tuple[Param, ...] = (
     Param("rotation", "vec3", [0.0, 0.0, 0.0], "rad", "Euler XYZ angles, as in Blender", sampleable=True),
     Param("scale", "float|list", 1.0, "", "uniform scale or [sx, sy, sz]", check=_scale_check, sampleable=True),
     Param("material", "dict", {}, sampleable=True,
-          doc="principled values replacing the file's: base_color, base_color_texture (path), roughness, metallic, "
-              "specular, transmission, ior, alpha, emission, emission_strength"),
+          doc="principled values replacing the file's: base_color, roughness, metallic, specular, transmission, ior, "
+              "alpha, alpha_mode, emission, emission_strength, and maps (paths): base_color_texture, "
+              "roughness_texture, metallic_texture, alpha_texture, normal_texture (normal_y_down), "
+              "displacement_texture (displacement_scale)"),
 )
 
 
