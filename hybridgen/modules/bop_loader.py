@@ -14,7 +14,9 @@ plain name when that folder or file is absent (a type the config names has no fa
 - With ``scene_id``: replicates the scene as BlenderProc does. The world is the first image's camera frame
   (OpenCV axes); every object gets its ``cam_R_m2c``/``cam_t_m2c`` of that image; every image of the scene
   becomes a keypoint whose cam2world is ``m2w_ref @ inv(m2c_ref)`` (ref: the image's first object), read in
-  the ``source_frame`` (default ``[X, -Y, -Z]``: an OpenCV camera, see docs/conventions.md section 1).
+  the ``source_frame`` (default ``[X, -Y, -Z]``: an OpenCV camera, see docs/conventions.md section 1). Each
+  image renders with its own ``cam_K`` of ``scene_camera.json`` (``Camera.intrinsics_per_keypoint`` when they
+  differ; BlenderProc keyframes the principal point per frame).
 
 Objects are named as Blender's PLY importer names them (``obj_000001``, clashes ``.001``), get
 ``category_id`` = their BOP obj_id and the attribute ``bop_dataset_name`` (the folder's name), which
@@ -33,7 +35,6 @@ import numpy as np
 
 from ..config.blenderproc import custom_properties
 from ..config.camera_poses import source_frame_axes
-from ..config.notices import notice
 from ..config.registry import register_module
 from ..config.schema import Param
 from ..errors import ConfigError
@@ -218,10 +219,13 @@ class BopLoader(Module):
             cam2world = first @ np.linalg.inv(ref)  # the given (source-frame) camera
             context.scene.camera.add_keypoint(cam2world @ axes @ BLENDER_TO_OPENCV)
             ks.append(np.asarray(cams[str(image_id)]["cam_K"], dtype=np.float64).reshape(3, 3))
-        if any(not np.allclose(k, ks[0]) for k in ks):
-            notice("the scene's images have different cam_K; hybridgen cameras have one K, the first image's",
-                   module=self.module_name, index=self.index, key="scene_id")
-        context.scene.camera.intrinsics = Intrinsics(ks[0], int(camera["width"]), int(camera["height"]))
+        intrinsics = [Intrinsics(k, int(camera["width"]), int(camera["height"])) for k in ks]
+        cameras = context.scene.camera
+        if any(not np.array_equal(k, ks[0]) for k in ks):  # each image renders with its own cam_K
+            earlier = len(cameras) - len(ks)
+            cameras.intrinsics_per_keypoint = [
+                *(cameras.intrinsics_per_keypoint or [cameras.intrinsics] * earlier)[:earlier], *intrinsics]
+        cameras.intrinsics = intrinsics[0]
         return ids, poses
 
     @staticmethod

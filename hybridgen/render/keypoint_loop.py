@@ -14,7 +14,7 @@ import numpy as np
 from .._version import __version__
 from ..errors import InputError
 from ..io.frame_sink import FrameSink, PassLayout
-from ..scene.object_keyframes import keyframes_of
+from ..scene.object_keyframes import apply_keypoint, keypoint_intrinsics, same_view, varies_per_keypoint
 from ..scene.scene import Scene
 from .passes import on_request
 
@@ -27,7 +27,8 @@ class Producer(Protocol):
     ``records`` are whole-run datasets (e.g. poses) it adds; ``eye`` is 0, or 1 for a stereo right eye
     (producers with randomness draw a different stream for it). A producer may also have
     ``prefetch(index, cam2world)``, called one keypoint ahead so that its work can overlap, and
-    ``poses_changed()``, called when the scene's objects moved between keypoints (object keyframes).
+    ``view_changed()``, called when the scene's objects moved or the camera's intrinsics changed between
+    keypoints (:mod:`hybridgen.scene.object_keyframes`).
     """
 
     def layouts(self) -> list[PassLayout]: ...
@@ -42,9 +43,9 @@ class Producer(Protocol):
 
 
 def camera_records(scene: Scene) -> dict[str, np.ndarray]:
-    """``cam_K`` (N,3,3) and ``cam2world`` (N,4,4, OpenCV axes) of every keypoint, float64."""
+    """``cam_K`` (N,3,3, each keypoint's) and ``cam2world`` (N,4,4, OpenCV axes) of every keypoint, float64."""
     n = len(scene.camera)
-    return {"cam_K": np.repeat(scene.camera.intrinsics.K[None], n, axis=0),
+    return {"cam_K": np.stack([keypoint_intrinsics(scene, i).K for i in range(n)]) if n else np.zeros((0, 3, 3)),
             "cam2world": np.stack(scene.camera.keypoints) if n else np.zeros((0, 4, 4))}
 
 
@@ -64,12 +65,12 @@ def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Prod
             raise InputError("the camera has no keypoints: add poses (camera.CameraLoader) before rendering")
         chosen = list(range(total) if indices is None else indices)
         n = len(chosen)
-        keyframes = keyframes_of(scene)  # object poses that change between keypoints (None: they do not)
+        varies = varies_per_keypoint(scene)  # object poses or intrinsics change between keypoints
 
         def pose_objects(index: int) -> None:
-            if keyframes is not None and keyframes.apply(scene, index):
+            if varies and apply_keypoint(scene, index):
                 for producer in producers:  # e.g. the path tracer rebuilds its scene
-                    getattr(producer, "poses_changed", lambda: None)()
+                    getattr(producer, "view_changed", lambda: None)()
 
         if chosen:
             pose_objects(chosen[0])
@@ -96,8 +97,8 @@ def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Prod
         for local, index in enumerate(chosen):
             pose_objects(index)
             ahead = chosen[local + 1] if local + 1 < n else None
-            if ahead is not None and keyframes is not None and keyframes.group(ahead) != keyframes.group(index):
-                ahead = None  # its objects stand elsewhere: drawn once they are moved
+            if ahead is not None and varies and not same_view(scene, index, ahead):
+                ahead = None  # its objects stand elsewhere (or its K differs): drawn once they are moved
             if ahead is not None:  # the next keypoint draws while this one is read back and processed
                 for producer in prefetching:
                     producer.prefetch(ahead, keypoints[ahead])  # type: ignore[attr-defined]
@@ -171,10 +172,10 @@ class StereoProducer:
                 out[key] = np.stack([value, right[key]]) if isinstance(value, np.ndarray) else [value, right[key]]
         return out
 
-    def poses_changed(self) -> None:
-        """The scene's objects moved (object keyframes): tell the eyes' producers."""
+    def view_changed(self) -> None:
+        """The scene's objects moved or the intrinsics changed: tell the eyes' producers."""
         for producer in self.producers:
-            getattr(producer, "poses_changed", lambda: None)()
+            getattr(producer, "view_changed", lambda: None)()
 
     def close(self) -> None:
         for producer in self.producers:

@@ -80,9 +80,9 @@ class ColorProducer:
             values["colors_hdr"] = linear.astype(np.float16)
         return values
 
-    def poses_changed(self) -> None:
-        """The scene's objects moved between keypoints (object keyframes): Mitsuba's scene is built anew with
-        their poses (its meshes are stored in world coordinates)."""
+    def view_changed(self) -> None:
+        """The scene's objects moved or the intrinsics changed between keypoints: Mitsuba's scene is built anew
+        (its meshes are stored in world coordinates, its sensor holds the intrinsics)."""
         self.view = PathTraceView(self.scene, self.settings, variant=self.view.variant)
 
     def close(self) -> None:

@@ -101,6 +101,9 @@ class Camera:
 
     intrinsics: Intrinsics = field(default_factory=Intrinsics.default)
     keypoints: list[np.ndarray] = field(default_factory=list)
+    intrinsics_per_keypoint: list[Intrinsics] | None = None
+    """One Intrinsics per keypoint where they differ between keypoints (BOP scene replication); renderers give
+    ``intrinsics`` each keypoint's before rendering it (:func:`hybridgen.scene.object_keyframes.apply_keypoint`)."""
 
     def add_keypoint(self, cam2world: np.ndarray) -> int:
         """Append a pose (OpenCV axes) and return its keypoint index."""

@@ -1,4 +1,4 @@
-"""Object poses that change between camera keypoints, as BlenderProc keyframes objects together with cameras.
+"""Object poses and camera intrinsics that change between keypoints, as BlenderProc keyframes them.
 
 BlenderProc's ``composite.CameraObjectSampler`` samples object poses, then some cameras, then new object poses
 and more cameras: every frame shows the objects where they were when its camera was sampled. hybridgen keeps
@@ -8,6 +8,11 @@ largest start ``<= i`` (keypoints before the first snapshot show the first one, 
 last one, as Blender holds a property's first/last keyframe). Renderers call :meth:`ObjectKeyframes.apply`
 before each keypoint, so labels, color and writers that read poses from the live scene all see the same
 poses. Poses are ``local2world`` 4x4 matrices (metres), keyed by the objects' instance ids.
+
+Intrinsics can change per keypoint too (BOP scene replication: each image's ``cam_K`` from
+``scene_camera.json``): ``Camera.intrinsics_per_keypoint`` holds one :class:`~hybridgen.scene.camera.Intrinsics`
+per keypoint, scaled to the camera's image size when a renderer sets another resolution.
+:func:`apply_keypoint` sets both before a keypoint renders.
 """
 from __future__ import annotations
 
@@ -18,6 +23,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
+    from .camera import Intrinsics
     from .scene import Scene
 
 
@@ -67,3 +73,40 @@ def keyframes_of(scene: "Scene") -> ObjectKeyframes | None:
     """The scene's per-keypoint object poses, or None when every keypoint shows the objects as they are."""
     keyframes = getattr(scene, "object_keyframes", None)
     return keyframes if keyframes is not None and keyframes.poses else None
+
+
+def keypoint_intrinsics(scene: "Scene", index: int) -> "Intrinsics":
+    """The intrinsics keypoint ``index`` renders with (the camera's, unless set per keypoint)."""
+    camera = scene.camera
+    per_keypoint = camera.intrinsics_per_keypoint
+    if not per_keypoint or index >= len(per_keypoint):
+        return camera.intrinsics
+    own, size = per_keypoint[index], (camera.intrinsics.width, camera.intrinsics.height)
+    # a renderer's resolution applies to every keypoint's intrinsics (scaled as Intrinsics.resized does)
+    return own if (own.width, own.height) == size else own.resized(*size)
+
+
+def varies_per_keypoint(scene: "Scene") -> bool:
+    """Whether objects or intrinsics change between this scene's keypoints."""
+    return keyframes_of(scene) is not None or bool(scene.camera.intrinsics_per_keypoint)
+
+
+def same_view(scene: "Scene", a: int, b: int) -> bool:
+    """Whether keypoints ``a`` and ``b`` show the objects at the same poses through the same intrinsics."""
+    keyframes = keyframes_of(scene)
+    if keyframes is not None and keyframes.group(a) != keyframes.group(b):
+        return False
+    first, second = keypoint_intrinsics(scene, a), keypoint_intrinsics(scene, b)
+    return first is second or np.array_equal(first.K, second.K)
+
+
+def apply_keypoint(scene: "Scene", index: int) -> bool:
+    """Move the objects to their poses at keypoint ``index`` and give the camera that keypoint's intrinsics;
+    True if anything changed (renderers that built the scene then rebuild it)."""
+    keyframes = keyframes_of(scene)
+    changed = keyframes.apply(scene, index) if keyframes is not None else False
+    wanted = keypoint_intrinsics(scene, index)
+    if wanted is not scene.camera.intrinsics:
+        changed = changed or not np.array_equal(wanted.K, scene.camera.intrinsics.K)
+        scene.camera.intrinsics = wanted
+    return changed
