@@ -29,6 +29,7 @@ from ..scene.light import Light
 from ..scene.mesh_object import MeshObject
 from ..scene.scene import Scene, World
 from . import light_selection
+from .mitsuba_instances import instanced_entries
 from .mitsuba_materials import VERTEX_COLOR_ATTRIBUTE, bsdf_dict
 from .mitsuba_materials import rgb as _rgb
 
@@ -180,8 +181,12 @@ def scene_dict(scene: Scene) -> dict[str, Any]:
     weights = light_selection.normalised(powers)
     if world is not None:
         out["world"] = {**world, "sampling_weight": weights["world"]}
+    shared, instanced = instanced_entries(scene.objects, mesh_shape, lambda o: f"object_{o.instance_id}" in weights)
+    out.update(shared)
     for obj in scene.objects:
         key = f"object_{obj.instance_id}"
+        if obj.instance_id in instanced:  # one shapegroup per shared geometry (render/mitsuba_instances.py)
+            continue
         out[key] = mesh_shape(obj, sampling_weight=weights.get(key, 1.0))
         if key in weights:
             out[f"{key}_back"] = mesh_shape(obj, back_side=True, sampling_weight=weights[key])

@@ -7,6 +7,7 @@ front face.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any, Iterable
 
@@ -17,6 +18,7 @@ from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
 from .alpha_cutout import Cutout, set_cutout_uniforms, upload_cutout
 from .gl_context import shared_context
+from .shared_geometry import geometry_key
 from .raster_passes import RASTER_PASSES
 from .readback import RasterOutput
 from .projection import near_plane_corner_distance, projection_from_K
@@ -58,7 +60,7 @@ class RasterView:
         self.ctx = ctx if ctx is not None else shared_context(device_index)
         self.program = self.ctx.program(vertex_shader=shader_source("labels.vert"),
                                         fragment_shader=shader_source("labels.frag"))
-        self.gpu_objects = [self._upload(obj) for obj in scene.objects]
+        self.gpu_objects = self._upload_all(scene.objects)
         try:  # instance id -> category_id, for the category_id_segmaps pass (0 where an object has none)
             self._class_lut = self.category_lut()
         except InputError:
@@ -71,6 +73,21 @@ class RasterView:
         self._cached_pose: dict[str, Any] = {}
 
     # ----------------------------------------------------------------- resources
+    def _upload_all(self, objects: list[Any]) -> list[GpuObject]:
+        """GPU objects of ``objects``; placements of shared geometry (render/shared_geometry.py) draw from the
+        buffers of its first placement."""
+        uploaded: list[GpuObject] = []
+        first: dict[Any, GpuObject] = {}
+        for obj in objects:
+            key = geometry_key(obj)
+            if key in first:
+                uploaded.append(dataclasses.replace(first[key], instance_id=obj.instance_id, buffers=[]))
+                continue
+            uploaded.append(self._upload(obj))
+            if key is not None:
+                first[key] = uploaded[-1]
+        return uploaded
+
     def _upload(self, obj: Any) -> GpuObject:
         """GPU buffers of ``obj``: smooth meshes as they are; flat ones with a vertex per face corner that
         carries the face normal (``vertex_order`` maps GPU vertices back to mesh vertices)."""
@@ -272,7 +289,8 @@ class RasterView:
     def release(self) -> None:
         """Free the GL resources of this view (the context stays)."""
         for gpu in self.gpu_objects:
-            gpu.vao.release()
+            if gpu.buffers:  # shared placements own no buffers and share the first placement's vao
+                gpu.vao.release()
             for buf in gpu.buffers:
                 buf.release()
         self.gpu_objects = []
