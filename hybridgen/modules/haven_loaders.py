@@ -13,7 +13,7 @@ from pathlib import Path
 
 from ..config.registry import register_module
 from ..config.schema import Param
-from ..errors import InputError
+from ..errors import ConfigError
 from ..io.texture_sets import haven_material
 from ..run.context import RunContext
 from .base import Module, Role
@@ -25,14 +25,14 @@ HDRI_SUFFIXES = (".hdr", ".exr")
 def haven_hdris(data_path: Path) -> list[Path]:
     """The HDRI files of a Poly Haven download folder, sorted; a one-line error for a wrong folder."""
     if not data_path.is_dir():
-        raise InputError(f"Haven data folder not found: '{data_path}'")
+        raise ConfigError(f"Haven data folder not found: '{data_path}'", key="data_path")
     hdris = data_path / "hdris"
     if not hdris.is_dir():
-        raise InputError(f"'{data_path}' has no 'hdris' folder (expected <data_path>/hdris/<name>/<name>.hdr, "
-                         "BlenderProc's download layout)")
+        raise ConfigError(f"'{data_path}' has no 'hdris' folder (expected <data_path>/hdris/<name>/<name>.hdr, "
+                          "BlenderProc's download layout)", key="data_path")
     files = sorted(p for p in hdris.glob("*/*") if p.is_file() and p.suffix.lower() in HDRI_SUFFIXES)
     if not files:
-        raise InputError(f"no .hdr/.exr file in the sub-folders of '{hdris}'")
+        raise ConfigError(f"no .hdr/.exr file in the sub-folders of '{hdris}'", key="data_path")
     return files
 
 
@@ -52,7 +52,7 @@ class HavenEnvironmentLoader(Module):
         files = haven_hdris(Path(self.config["data_path"]))
         strength = float(self.value(context, "strength"))
         if strength < 0:
-            raise InputError(f"{self.module_name}: strength must be >= 0, got {strength}")
+            raise ConfigError(f"must be >= 0, got {strength}", key="strength")
         world = context.scene.world
         world.hdri_path = str(files[int(context.rng.integers(len(files)))])
         world.strength = strength
@@ -81,5 +81,6 @@ class HavenMaterialLoader(Module):
         materials = asset_materials(Path(self.config["folder_path"]), [str(a) for a in self.config["used_assets"]],
                                     haven_material, {"is_haven_texture": True, **extra})
         if not materials:
-            raise InputError(f"no texture asset (<asset>/<asset>_diff_2k.jpg) in '{self.config['folder_path']}'")
+            raise ConfigError(f"no texture asset (<asset>/<asset>_diff_2k.jpg) in '{self.config['folder_path']}'",
+                              key="folder_path")
         material_library(context).extend(materials)

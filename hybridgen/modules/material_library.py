@@ -17,7 +17,7 @@ from typing import Any, Callable
 
 from ..config.registry import register_module
 from ..config.schema import Param
-from ..errors import InputError
+from ..errors import ConfigError
 from ..io.texture_sets import cc_material
 from ..run.context import RunContext
 from ..scene.material import Material
@@ -63,7 +63,7 @@ def asset_materials(folder: Path, used_assets: list[str], read: Callable[[Path],
     names start with one of ``used_assets`` (all if empty; compared as BlenderProc does: case and spaces
     ignored)."""
     if not folder.is_dir():
-        raise InputError(f"texture folder not found: '{folder}'")
+        raise ConfigError(f"texture folder not found: '{folder}'", key="folder_path")
     wanted = [a.lower().replace(" ", "") for a in used_assets]
     materials = []
     for asset in sorted(p for p in folder.iterdir() if p.is_dir()):
@@ -99,7 +99,8 @@ class CCMaterialLoader(Module):
     def run(self, context: RunContext) -> None:
         materials = cc_materials(Path(self.config["folder_path"]), [str(a) for a in self.config["used_assets"]])
         if not materials:
-            raise InputError(f"no texture asset (<asset>/<asset>_2K_Color.jpg) in '{self.config['folder_path']}'")
+            raise ConfigError(f"no texture asset (<asset>/<asset>_2K_Color.jpg) in '{self.config['folder_path']}'",
+                              key="folder_path")
         for entry in materials:
             for key, value in self.config["add_custom_properties"].items():
                 entry.properties[key[3:] if key.startswith("cp_") else key] = value

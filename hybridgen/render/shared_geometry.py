@@ -1,5 +1,6 @@
 """Objects that share their geometry: the same vertex, face, normal, UV and vertex-color arrays (the same
-Python objects, as a loader that places one parsed model many times hands them out) and the same material.
+Python objects, as a loader that places one parsed model many times hands them out) and equal materials
+(field by field; image arrays by identity), so a material copied per object still shares.
 
 The raster view uploads such geometry once and draws every placement from the same GPU buffers; the Mitsuba
 scene holds it once in a ``shapegroup`` with one ``instance`` per placement. ``ENABLED`` is the switch
@@ -8,8 +9,12 @@ float rounding of the transforms in Mitsuba).
 """
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
+import numpy as np
+
+from ..scene.material import Material
 from ..scene.mesh_object import MeshObject
 
 ENABLED = True
@@ -20,7 +25,22 @@ def geometry_key(obj: MeshObject) -> tuple[Any, ...] | None:
     if not ENABLED:
         return None
     return (id(obj.vertices), id(obj.faces), id(obj.vertex_normals), id(obj.uvs), id(obj.vertex_colors),
-            id(obj.material))
+            material_key(obj.material))
+
+
+def material_key(material: Material) -> tuple[Any, ...]:
+    """A hashable value equal for materials with equal fields (arrays compared by identity)."""
+    values = []
+    for field in dataclasses.fields(material):
+        value = getattr(material, field.name)
+        if isinstance(value, np.ndarray):
+            value = ("array", id(value))
+        elif isinstance(value, dict):
+            value = ("dict", id(value)) if value else ()
+        elif isinstance(value, list):
+            value = tuple(value)
+        values.append(value)
+    return tuple(values)
 
 
 def shared_groups(objects: list[MeshObject]) -> list[list[MeshObject]]:

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from hybridgen.errors import InputError
+from hybridgen.errors import ConfigError
 from hybridgen.io.texture_sets import cc_material, haven_material
 from hybridgen.modules.haven_loaders import haven_hdris
 from hybridgen.modules.material_library import cc_materials, material_library
@@ -50,7 +50,7 @@ def test_ambientcg_set_fills_every_map_with_its_convention(tmp_path):
     assert cc_material(tmp_path / "NoColor") is None
     # used_assets as BlenderProc compares them: case and spaces ignored
     assert [m.material.name for m in cc_materials(tmp_path, ["metal", "TILES 004"])] == ["Metal012", "Tiles004"]
-    with pytest.raises(InputError, match="texture folder not found.*missing"):
+    with pytest.raises(ConfigError, match="texture folder not found.*missing"):
         cc_materials(tmp_path / "missing", [])
 
 
@@ -109,7 +109,7 @@ def test_haven_environment_loader_draws_an_hdri_of_the_layout(tmp_path):
         assert Path(world.hdri_path) in files and world.strength == 2.5 and world.hdri_rotation == 0.5
         picked.add(world.hdri_path)
     assert len(picked) > 1  # a random pick, not always the first
-    with pytest.raises(InputError, match="no 'hdris' folder"):
+    with pytest.raises(ConfigError, match="no 'hdris' folder"):
         haven_hdris(tmp_path / "haven" / "hdris")
-    with pytest.raises(InputError, match="Haven data folder not found"):
+    with pytest.raises(ConfigError, match="Haven data folder not found"):
         haven_hdris(tmp_path / "nothing")
