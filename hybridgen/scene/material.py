@@ -97,4 +97,29 @@ class Material:
             value = getattr(material, attr, None)
             if value is not None:
                 setattr(mat, key, float(value))
+        _gltf_maps(material, mat)
         return mat
+
+
+def _gltf_maps(material: Any, mat: Material) -> None:
+    """glTF PBR maps of a trimesh PBRMaterial: metallicRoughnessTexture (G roughness, B metallic, each
+    multiplied by its factor only when the factor is 1 - other factors keep the value and drop the map),
+    normalTexture (OpenGL convention, glTF's), alphaMode MASK -> CLIP with the base color's alpha channel as
+    alpha map (BLEND likewise with BLEND), as Blender's glTF importer wires them."""
+    packed = getattr(material, "metallicRoughnessTexture", None)
+    if packed is not None:
+        channels = np.asarray(packed.convert("RGB"))
+        if mat.roughness == 1.0:
+            mat.roughness_texture = np.ascontiguousarray(channels[..., 1])
+        if mat.metallic == 1.0:
+            mat.metallic_texture = np.ascontiguousarray(channels[..., 2])
+    normal = getattr(material, "normalTexture", None)
+    if normal is not None:
+        mat.normal_texture = np.asarray(normal.convert("RGB"))
+    mode = str(getattr(material, "alphaMode", None) or "OPAQUE").upper()
+    if mode in ("MASK", "BLEND"):
+        mat.alpha_mode = "CLIP" if mode == "MASK" else "BLEND"
+        base = mat.base_color_texture
+        if isinstance(base, np.ndarray) and base.ndim == 3 and base.shape[-1] == 4 and base[..., 3].min() < 255:
+            mat.alpha_texture = np.ascontiguousarray(base[..., 3])
+        mat.alpha = float(mat.base_color[3])

@@ -113,3 +113,29 @@ def test_haven_environment_loader_draws_an_hdri_of_the_layout(tmp_path):
         haven_hdris(tmp_path / "haven" / "hdris")
     with pytest.raises(ConfigError, match="Haven data folder not found"):
         haven_hdris(tmp_path / "nothing")
+
+
+def test_gltf_pbr_maps_land_in_their_slots(tmp_path):
+    """A glTF's metallicRoughness texture (G roughness, B metallic), normal texture and alphaMode MASK with the
+    base color's alpha, as Blender's glTF importer wires them."""
+    import trimesh
+
+    import hybridgen as hg
+
+    mesh = trimesh.Trimesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2], [0, 2, 3]], process=False)
+    base = np.zeros((4, 4, 4), np.uint8)
+    base[..., 0], base[..., 3] = 200, 255
+    base[:, 2:, 3] = 0
+    packed = np.zeros((4, 4, 3), np.uint8)
+    packed[..., 1], packed[..., 2] = 77, 200
+    normal = np.tile(np.array([128, 150, 240], np.uint8), (4, 4, 1))
+    material = trimesh.visual.material.PBRMaterial(
+        baseColorTexture=Image.fromarray(base), metallicRoughnessTexture=Image.fromarray(packed),
+        normalTexture=Image.fromarray(normal), alphaMode="MASK", metallicFactor=1.0, roughnessFactor=1.0)
+    mesh.visual = trimesh.visual.TextureVisuals(uv=[[0, 0], [1, 0], [1, 1], [0, 1]], material=material)
+    mesh.export(tmp_path / "quad.glb")
+    [obj] = hg.load_objects(tmp_path / "quad.glb")
+    loaded = obj.material
+    assert np.all(loaded.roughness_texture == 77) and np.all(loaded.metallic_texture == 200)
+    assert np.all(loaded.normal_texture == [128, 150, 240]) and not loaded.normal_y_down
+    assert loaded.alpha_mode == "CLIP" and loaded.alpha_texture.tolist() == [[255, 255, 0, 0]] * 4
