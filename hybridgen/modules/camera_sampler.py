@@ -12,13 +12,15 @@ from ..run.context import RunContext
 from ..sampling.camera_checks import NoveltyCheck, ProximityChecks
 from ..sampling.camera_sampling import PoseChecks, SamplingReport, sample_camera_poses
 from ..sampling.getters import parse_selector
+from ..sampling.interest_score import InterestScore
 from ..sampling.registry import DrawContext, draw
 from .base import Module, Role
 
 ENTRY_KEYS = ("number_of_samples", "location", "rotation", "cam2world_matrix", "source_frame",
               "proximity_checks", "excluded_objs_in_proximity_check", "check_if_objects_visible",
               "min_coverage", "check_pose_novelty_rot", "check_pose_novelty_translation",
-              "min_var_diff_rot", "min_var_diff_translation")
+              "min_var_diff_rot", "min_var_diff_translation", "min_interest_score", "special_objects", "special_objects_weight", "sqrt_number_of_rays",
+              "check_if_pose_above_object_list")
 POSE_ONLY = ("location", "rotation", "cam2world_matrix", "source_frame")
 
 
@@ -32,7 +34,10 @@ class CameraSampler(Module):
         Param("intrinsics", "dict", {}, doc="as camera.CameraLoader; omitted: keep the camera's"),
         Param("cam_poses", "list", sampleable=True, doc=f"entries with keys {', '.join(ENTRY_KEYS)}; "
               "proximity_checks: {min, max [m], avg: {min, max}, var: {min, max}, no_background}; "
-              "min_coverage: {selector, fraction} (image fraction the selected objects must cover)"),
+              "min_coverage: {selector, fraction} (image fraction the selected objects must cover); "
+              "min_interest_score (BlenderProc's scene coverage score, hybridgen.sampling.interest_score) with "
+              "special_objects, special_objects_weight, sqrt_number_of_rays; check_if_pose_above_object_list: "
+              "a selector, one of whose objects must be straight below the camera"),
         Param("source_frame", "list", ["X", "Y", "Z"], doc="axes the poses are given in, named in Blender's "
               "axes (BlenderProc's meaning; [X, -Y, -Z]: OpenCV cam2world matrices), see hybridgen.config.camera_poses"),
         Param("max_tries", "int", 10000, doc="candidate poses per entry before giving up", check=positive),
@@ -101,4 +106,11 @@ class CameraSampler(Module):
             if "excluded_objs_in_proximity_check" in entry else frozenset(),
             must_see=self._ids(entry["check_if_objects_visible"], context, where)
             if "check_if_objects_visible" in entry else frozenset(),
-            coverage_of=coverage_of, min_coverage=fraction, novelty=novelty)
+            coverage_of=coverage_of, min_coverage=fraction, novelty=novelty,
+            interest=InterestScore.for_objects(
+                context.scene.objects, entry["min_interest_score"], entry.get("special_objects", []),
+                entry.get("special_objects_weight", 2.0), entry.get("sqrt_number_of_rays", 10))
+            if entry.get("min_interest_score", 0) > 0 else None,
+            above=self._ids(entry["check_if_pose_above_object_list"], context,
+                            f"{where}.check_if_pose_above_object_list")
+            if "check_if_pose_above_object_list" in entry else frozenset())

@@ -11,6 +11,7 @@ from ..render.raster import RasterView
 from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
 from .camera_checks import NoveltyCheck, ProximityChecks
+from .interest_score import InterestScore, above_pose
 
 
 @dataclass
@@ -23,6 +24,8 @@ class PoseChecks:
     coverage_of: frozenset[int] = frozenset()  # ids whose joint image coverage is checked
     min_coverage: float = 0.0  # fraction of the check image those objects must cover
     novelty: NoveltyCheck = field(default_factory=NoveltyCheck)
+    interest: InterestScore | None = None  # BlenderProc's min_interest_score on the view's objects
+    above: frozenset[int] = frozenset()  # ids one of which must be straight below the camera (empty: no check)
 
     def failures(self, cam2world: np.ndarray, distance: np.ndarray, hit: np.ndarray,
                  instance_ids: Callable[[], np.ndarray]) -> list[str]:
@@ -30,13 +33,15 @@ class PoseChecks:
         distance (m, rays passing through ``excluded`` objects), hit mask and - asked only when a visibility
         or coverage check needs them - instance ids with every object drawn."""
         failed = self.proximity.failures(distance, hit)
-        if self.must_see or self.coverage_of:
+        if self.must_see or self.coverage_of or self.interest is not None:
             ids = instance_ids()
             present = set(np.unique(ids).tolist())
             if not self.must_see <= present:
                 failed.append("visible")
             if self.coverage_of and np.isin(ids, list(self.coverage_of)).mean() < self.min_coverage:
                 failed.append("coverage")
+            if self.interest is not None and not self.interest.passes(ids):
+                failed.append("interest")
         failed += self.novelty.failures(cam2world)
         return failed
 
@@ -68,7 +73,16 @@ def pose_failures(view: RasterView, cam2world: np.ndarray, intr: Intrinsics, che
     def instance_ids() -> np.ndarray:
         return raw.instance if not checks.excluded else view.render_raw(cam2world, intr).instance
 
-    return checks.failures(cam2world, distance, raw.hit, instance_ids)
+    failed = checks.failures(cam2world, distance, raw.hit, instance_ids)
+    if checks.above and not failed:  # one ray straight down from the camera must hit one of them
+        below = view.render_raw(above_pose(cam2world), _DOWN).instance[1, 1]
+        if int(below) not in checks.above:
+            failed.append("above")
+    return failed
+
+
+_DOWN = Intrinsics(np.array([[1.0, 0.0, 1.0], [0.0, 1.0, 1.0], [0.0, 0.0, 1.0]]), 3, 3)
+"""A 3 x 3 pixel camera whose centre pixel is its optical axis."""
 
 
 def sample_camera_poses(scene: Scene, propose: Callable[[], np.ndarray], count: int, max_tries: int,

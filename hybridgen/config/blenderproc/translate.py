@@ -11,7 +11,7 @@ from .composite import camera_object_sampler
 from .image_options import alpha_entries, take_image_type
 from .manipulators import entity, material
 from .names import ALIASES
-from .objects import (bop_loader, camera_loader, loader, mesh_initializer, passthrough, physics, pose_sampler,
+from .objects import (bop_loader, camera_loader, camera_sampler, loader, mesh_initializer, passthrough, physics, pose_sampler,
                       replacer)
 from .renderers import rgb, segmap, single_pass
 from .selectors import samplers_as_blenderproc
@@ -33,6 +33,7 @@ TRANSLATORS: dict[str, Callable[..., list[tuple[str, dict[str, Any]]]]] = {
     "manipulators.MaterialManipulator": material,
     "object.PhysicsPositioning": physics,
     "camera.CameraLoader": camera_loader,
+    "camera.CameraSampler": camera_sampler,
     "object.ObjectPoseSampler": pose_sampler,
     "object.PositionSampler": pose_sampler,
     "object.OnSurfaceSampler": passthrough("object.OnSurfaceSampler", "objects_to_sample", "surface"),
