@@ -1,6 +1,7 @@
 """Validate (and run) every example config of a BlenderProc checkout with hybridgen, unchanged.
 
     .venv/bin/python tools/check_blenderproc_configs.py PATH [--tag v1.12.0] [--run] [--only SUBSTRING]
+        [--example-inputs]
 
 PATH is a BlenderProc working tree (its ``examples/`` is read) or a bare git mirror, read at ``--tag``
 (``git ls-tree`` + ``git show`` into a temporary folder; nothing of BlenderProc is stored in this
@@ -12,6 +13,10 @@ folder ...), then
 - validates: hybridgen reads the config and every module's keys (``load_config`` + ``build_modules``);
 - with ``--run``, runs the valid ones end to end on the stand-ins, each in its own process stopped after
   ``--timeout`` seconds.
+
+With ``--example-inputs`` an argument the example's README passes (``python run.py <config> <args>``) is that
+file of the checkout where the checkout has it (its scene.obj, camera_positions ...): the run then builds the
+example's own scene; stand-ins fill in the rest (datasets to download, outputs).
 
 Each config gets one line: ``valid``/``ran``, ``unavailable: <why>`` (a module needing Blender or a withdrawn
 dataset) or ``invalid: <the error line>``. Notices are counted, not printed. Exit status 0 always; the
@@ -26,6 +31,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import traceback
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -154,6 +160,20 @@ def standin_args(config: Path, work: Path, output: Path) -> list[str]:
     return args
 
 
+def example_inputs(config: Path, root: Path) -> list[str | None]:
+    """The inputs the example's README runs ``config`` with (``python run.py <config> <args>``): each argument
+    that names a file or folder of the checkout, None for the others (outputs, datasets to download)."""
+    readme = config.parent / "README.md"
+    if not readme.is_file():
+        return []
+    relative = str(config.relative_to(root))
+    for line in readme.read_text(errors="replace").splitlines():
+        words = line.strip().split()
+        if len(words) > 2 and words[:3] == ["python", "run.py", relative]:
+            return [w if "output" not in w and (root / w).exists() else None for w in words[3:]]
+    return []
+
+
 BOP_NAME = "lm"
 BOP_MODELS = 30
 """Models per stand-in BOP dataset: enough for the BOP challenge configs' samples with instance limits."""
@@ -217,7 +237,7 @@ def make_standins(work: Path) -> None:
     (work / "camera_positions").write_text("0 -6 3 1.1 0 0\n4 -4 3 1.1 0 0.785\n")
 
 
-def check(config: Path, root: Path, run: bool, work: Path, output: Path) -> Outcome:
+def check(config: Path, root: Path, run: bool, work: Path, output: Path, use_example_inputs: bool = False) -> Outcome:
     """Validate (and run) one config on stand-ins."""
     from hybridgen.config.config_file import load_config
     from hybridgen.config.notices import set_sink
@@ -228,6 +248,10 @@ def check(config: Path, root: Path, run: bool, work: Path, output: Path) -> Outc
     set_sink(lines.append)
     name = str(config.relative_to(root))
     args = standin_args(config, work, output)
+    if use_example_inputs:  # the example's own files where the checkout has them
+        for index, given in enumerate(example_inputs(config, root)[:len(args)]):
+            if given is not None:
+                args[index] = str(root / given)
     try:
         try:
             loaded = load_config(config, args)
@@ -244,18 +268,23 @@ def check(config: Path, root: Path, run: bool, work: Path, output: Path) -> Outc
             summary = run_config(config, args)
         except HybridgenError as exc:
             return Outcome(name, "failed", str(exc).replace(str(root) + "/", ""), len(lines))
+        except Exception as exc:  # a bug, not a config problem: one line naming it and where it was raised
+            where = traceback.extract_tb(exc.__traceback__)[-1]
+            return Outcome(name, "failed", f"crashed: {type(exc).__name__}: {exc} "
+                           f"({Path(where.filename).name}:{where.lineno})", len(lines))
         return Outcome(name, "ran", f"{summary.frames} frames in {time.perf_counter() - start:.1f} s", len(lines))
     finally:
         set_sink(None)
 
 
-def check_in_process(config: Path, root: Path, run: bool, work: Path, output: Path, timeout: float) -> Outcome:
+def check_in_process(config: Path, root: Path, run: bool, work: Path, output: Path, timeout: float,
+                     use_example_inputs: bool = False) -> Outcome:
     """:func:`check` in a child process, stopped after ``timeout`` seconds (then status ``timeout``)."""
     import multiprocessing
 
     context = multiprocessing.get_context("fork")
     queue = context.Queue()
-    child = context.Process(target=lambda: queue.put(check(config, root, run, work, output)))
+    child = context.Process(target=lambda: queue.put(check(config, root, run, work, output, use_example_inputs)))
     child.start()
     child.join(timeout)
     if child.is_alive():
@@ -275,6 +304,9 @@ def main() -> None:
     parser.add_argument("--only", default="", help="only configs whose path contains this")
     parser.add_argument("--timeout", type=float, default=900.0,
                         help="with --run: seconds one config may run before it counts as 'timeout' (default 900)")
+    parser.add_argument("--example-inputs", action="store_true",
+                        help="use the input files the example's README names where the checkout has them "
+                        "(stand-ins for the rest)")
     ns = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="bp-configs-") as tmp:
         root = Path(tmp) / "checkout"
@@ -289,8 +321,8 @@ def main() -> None:
             if ns.only not in str(config):
                 continue
             output = Path(tempfile.mkdtemp(prefix="output-", dir=tmp))
-            outcome = check_in_process(config, base, ns.run, work, output, ns.timeout) if ns.run else \
-                check(config, base, ns.run, work, output)
+            outcome = check_in_process(config, base, ns.run, work, output, ns.timeout, ns.example_inputs) \
+                if ns.run else check(config, base, ns.run, work, output, ns.example_inputs)
             outcomes.append(outcome)
             print(f"{outcome.status:11s} {outcome.config}  [{outcome.notices} notices] {outcome.detail}", flush=True)
     statuses = ("valid", "ran", "timeout", "unavailable", "invalid", "failed")

@@ -4,8 +4,8 @@
 Interest score, as BlenderProc defines it: ``n x n`` rays (``sqrt_number_of_rays``) through a grid spanning the
 image corner to corner; each ray that hits an object counts for its group - the ``category_id`` (or, for
 3D-FRONT/SUNCG furniture (``type: Object``), ``coarse_grained_class``, and furniture without one adds to the
-score only; an object without a category is its own group) - with weight ``special_objects_weight`` for the groups listed in
-``special_objects``, else 1. With ``k`` groups hit and ``h_g`` hits of group ``g``::
+score only; an object without a category is its own group) - with weight ``special_objects_weight`` for the
+groups listed in ``special_objects``, else 1. With ``k`` groups hit and ``h_g`` hits of group ``g``::
 
     score = (k / 3) * prod_g (1 - h_g / n^2) * (sum of weights / n^2)
 

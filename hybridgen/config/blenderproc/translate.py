@@ -11,8 +11,8 @@ from .composite import camera_object_sampler
 from .image_options import alpha_entries, take_image_type
 from .manipulators import entity, material
 from .names import ALIASES
-from .objects import (bop_loader, camera_loader, camera_sampler, loader, mesh_initializer, passthrough, physics, pose_sampler,
-                      replacer)
+from .objects import (bop_loader, camera_loader, camera_sampler, loader, mesh_initializer, passthrough, physics,
+                      pose_sampler, replacer)
 from .renderers import rgb, segmap, single_pass
 from .selectors import samplers_as_blenderproc
 from .writers import writer
