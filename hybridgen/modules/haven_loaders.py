@@ -16,8 +16,9 @@ from ..config.schema import Param
 from ..errors import ConfigError
 from ..io.texture_sets import haven_material
 from ..run.context import RunContext
+from ..scene.material import Material
 from .base import Module, Role
-from .material_library import asset_materials, material_library
+from .material_library import TextureSetLoader
 
 HDRI_SUFFIXES = (".hdr", ".exr")
 
@@ -60,27 +61,13 @@ class HavenEnvironmentLoader(Module):
 
 
 @register_module("loader.HavenMaterialLoader")
-class HavenMaterialLoader(Module):
+class HavenMaterialLoader(TextureSetLoader):
     """Loads Poly Haven texture sets (``<asset>/<asset>_diff_2k.jpg`` + maps, see
     :mod:`hybridgen.io.texture_sets`) into the run's material library, with ``is_haven_texture: true``."""
 
-    role = Role.LOADER
+    marker = "is_haven_texture"
+    layout = "<asset>/<asset>_diff_2k.jpg"
+    params = TextureSetLoader.params_with_folder("resources/haven/textures")
 
-    params = (
-        Param("folder_path", "path", "resources/haven/textures", doc="folder with one sub-folder per texture asset"),
-        Param("used_assets", "list", [], doc="only assets whose names start with one of these"),
-        Param("preload", "bool", False, doc="BlenderProc's lazy loading switch; hybridgen reads images when "
-              "rendering either way"),
-        Param("fill_used_empty_materials", "bool", False, doc="BlenderProc's two-phase loading switch; hybridgen "
-              "loads everything at once"),
-        Param("add_custom_properties", "dict", {}, doc="extra properties of every loaded material (cp_* keys)"),
-    )
-
-    def run(self, context: RunContext) -> None:
-        extra = {k[3:] if k.startswith("cp_") else k: v for k, v in self.config["add_custom_properties"].items()}
-        materials = asset_materials(Path(self.config["folder_path"]), [str(a) for a in self.config["used_assets"]],
-                                    haven_material, {"is_haven_texture": True, **extra})
-        if not materials:
-            raise ConfigError(f"no texture asset (<asset>/<asset>_diff_2k.jpg) in '{self.config['folder_path']}'",
-                              key="folder_path")
-        material_library(context).extend(materials)
+    def read(self, asset: Path) -> Material | None:
+        return haven_material(asset)

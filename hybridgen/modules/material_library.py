@@ -13,7 +13,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, ClassVar
 
 from ..config.registry import register_module
 from ..config.schema import Param
@@ -80,28 +80,49 @@ def cc_materials(folder: Path, used_assets: list[str]) -> list[LibraryMaterial]:
     return asset_materials(folder, used_assets, cc_material, {"is_cc_texture": True})
 
 
-@register_module("loader.CCMaterialLoader")
-class CCMaterialLoader(Module):
-    """Loads cc0textures assets as materials into the run's material library (see the module doc)."""
+class TextureSetLoader(Module):
+    """Loads one sub-folder per texture asset into the run's material library (BlenderProc's material loader
+    keys); subclasses say how an asset folder reads (``read``), what marks their materials (``marker``) and
+    how an asset is laid out (``layout``, for the error)."""
 
     role = Role.LOADER
+    marker: ClassVar[str] = ""
+    layout: ClassVar[str] = ""
 
-    params = (
-        Param("folder_path", "path", doc="folder with one sub-folder per texture asset"),
-        Param("used_assets", "list", [], doc="only assets whose names start with one of these"),
-        Param("preload", "bool", False, doc="BlenderProc's lazy loading switch; hybridgen reads images when "
-              "rendering either way"),
-        Param("fill_used_empty_materials", "bool", False, doc="BlenderProc's two-phase loading switch; hybridgen "
-              "loads everything at once"),
-        Param("add_custom_properties", "dict", {}, doc="extra properties of every loaded material (cp_* keys)"),
-    )
+    @staticmethod
+    def params_with_folder(default: str | None) -> tuple[Param, ...]:
+        """The loader keys, ``folder_path`` defaulting to ``default`` (None: required)."""
+        folder = Param("folder_path", "path", doc="folder with one sub-folder per texture asset") if default is None \
+            else Param("folder_path", "path", default, doc="folder with one sub-folder per texture asset")
+        return (
+            folder,
+            Param("used_assets", "list", [], doc="only assets whose names start with one of these"),
+            Param("preload", "bool", False, doc="BlenderProc's lazy loading switch; hybridgen reads images when "
+                  "rendering either way"),
+            Param("fill_used_empty_materials", "bool", False, doc="BlenderProc's two-phase loading switch; "
+                  "hybridgen loads everything at once"),
+            Param("add_custom_properties", "dict", {}, doc="extra properties of every loaded material (cp_* keys)"),
+        )
+
+    def read(self, asset: Path) -> Material | None:
+        raise NotImplementedError
 
     def run(self, context: RunContext) -> None:
-        materials = cc_materials(Path(self.config["folder_path"]), [str(a) for a in self.config["used_assets"]])
+        extra = {k[3:] if k.startswith("cp_") else k: v for k, v in self.config["add_custom_properties"].items()}
+        materials = asset_materials(Path(self.config["folder_path"]), [str(a) for a in self.config["used_assets"]],
+                                    self.read, {self.marker: True, **extra})
         if not materials:
-            raise ConfigError(f"no texture asset (<asset>/<asset>_2K_Color.jpg) in '{self.config['folder_path']}'",
-                              key="folder_path")
-        for entry in materials:
-            for key, value in self.config["add_custom_properties"].items():
-                entry.properties[key[3:] if key.startswith("cp_") else key] = value
+            raise ConfigError(f"no texture asset ({self.layout}) in '{self.config['folder_path']}'", key="folder_path")
         material_library(context).extend(materials)
+
+
+@register_module("loader.CCMaterialLoader")
+class CCMaterialLoader(TextureSetLoader):
+    """Loads cc0textures assets as materials into the run's material library (see the module doc)."""
+
+    marker = "is_cc_texture"
+    layout = "<asset>/<asset>_2K_Color.jpg"
+    params = TextureSetLoader.params_with_folder(None)
+
+    def read(self, asset: Path) -> Material | None:
+        return cc_material(asset)
