@@ -2,10 +2,10 @@
 
 Knobs (Cycles' and BlenderProc's names and meaning):
 
-- ``noise_threshold``: a pixel stops receiving samples once its error estimate is below it (Cycles'
-  "Noise Threshold", BlenderProc's ``set_noise_threshold`` / 1.x ``use_adaptive_sampling``; 0.01 is
-  BlenderProc's default, smaller is cleaner and slower). 0 disables adaptivity: every pixel gets
-  ``max_samples``.
+- ``noise_threshold``: a pixel stops receiving samples once its error estimate is below five times it
+  (Cycles' "Noise Threshold" with Cycles' factor, see below; BlenderProc's ``set_noise_threshold`` / 1.x
+  ``use_adaptive_sampling``; 0.01 is BlenderProc's default, smaller is cleaner and slower). 0 disables
+  adaptivity: every pixel gets ``max_samples``.
 - ``max_samples``: samples per pixel a pixel never exceeds (Cycles' ``samples`` when adaptive).
 - ``min_samples``: samples every pixel gets before the first error estimate (Cycles' "Min Samples").
 
@@ -16,7 +16,10 @@ of equal count; with ``I = (A + B) / 2`` the pixel mean and ``A`` the first half
     error = (|I_r - A_r| + |I_g - A_g| + |I_b - A_b|) / (1e-4 + sqrt(I_r + I_g + I_b)),
 
 a relative error that tolerates more absolute noise in bright pixels, as the eye (and a tone curve) does.
-A pixel is still active when its error, or that of one of its 8 neighbours, is at least the threshold
+Cycles compares it with five times the ``noise_threshold`` it is given (its "arbitrary factor" that kept
+old thresholds meaningful; Blender's ``integrator.cpp``), and so does hybridgen
+(:data:`CYCLES_THRESHOLD_SCALE`): a BlenderProc config's ``noise_threshold: 0.01`` stops pixels where Cycles
+would. A pixel is still active when its error, or that of one of its 8 neighbours, is at least that
 (the neighbourhood keeps isolated noisy pixels from stopping next to noisy regions). Rounds double the
 sample count of the active pixels (``min_samples``, then +``min_samples``, +2x, ... up to ``max_samples``),
 so a pixel's count is ``min_samples * 2^k`` or ``max_samples``; converged pixels stay converged.
@@ -36,7 +39,10 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from . import pixel_filter
 
+CYCLES_THRESHOLD_SCALE = 5.0
+"""The error estimate is compared with ``noise_threshold`` times this (Cycles' own factor)."""
 MAX_WAVEFRONT = 1 << 22
 """Samples per kernel launch at most (bounds the per-sample output arrays to ~50 MB)."""
 
@@ -105,20 +111,40 @@ def round_seed(seed: int, round_index: int, chunk: int) -> int:
 class PixelTracer:
     """Traces chosen pixels of the loaded Mitsuba scene (JIT variants only)."""
 
-    def __init__(self, mi_scene: Any, sensor: Any, integrator: Any) -> None:
+    def __init__(self, mi_scene: Any, sensor: Any, integrator: Any,
+                 filter_width: float = pixel_filter.DEFAULT_WIDTH) -> None:
+        import mitsuba as mi
+
         self.mi_scene, self.sensor, self.integrator = mi_scene, sensor, integrator
         size = sensor.film().crop_size()
         self.width, self.height = int(size[0]), int(size[1])
+        table = pixel_filter.inverse_cdf_table(filter_width)
+        # offsets from the pixel's corner (the centre is at +0.5), as the sample warp's lookup table
+        self._filter_table = mi.Float((table + 0.5).astype(np.float32))
 
     def trace(self, pixels: np.ndarray, spp: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
         """Sums of linear RGB over the first and the second half of ``spp`` samples of every pixel in
-        ``pixels`` (flat indices ``v * width + u``): two float64 arrays of shape (len(pixels), 3)."""
+        ``pixels`` (flat indices ``v * width + u``): two float64 arrays of shape (len(pixels), 3).
+
+        The sensor's sampler may only accept some sample counts (stratified patterns: powers of two for
+        ``ldsampler``), so ``spp`` is traced in launches of counts it accepts (:func:`launch_counts`, each
+        with its own seed derived from ``seed``); each launch's first half of samples goes to the first sum.
+        An odd ``spp`` (fixed-count rendering only) leaves the odd sample in the first sum."""
+        sum_a, sum_b = np.zeros((len(pixels), 3)), np.zeros((len(pixels), 3))
+        for index, count in enumerate(launch_counts(spp, self.sensor.sampler().class_name())):
+            a, b = self._launch(pixels, count, seed if index == 0 else round_seed(seed, -1, index))
+            sum_a += a
+            sum_b += b
+        return sum_a, sum_b
+
+    def _launch(self, pixels: np.ndarray, spp: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+        """One wavefront of ``len(pixels) x spp`` samples, pixel-major; the halves' sums as :meth:`trace`."""
         import drjit as dr
         import mitsuba as mi
 
         n = len(pixels)
         sampler = self.sensor.sampler().fork()
-        sampler.set_sample_count(spp)
+        sampler.set_sample_count(pattern_size(spp, sampler.class_name()))
         sampler.set_samples_per_wavefront(spp)
         sampler.seed(dr.opaque(mi.UInt32, seed % 2**32), n * spp)
         spp_o, width_o = dr.opaque(mi.UInt32, spp), dr.opaque(mi.UInt32, self.width)
@@ -127,13 +153,12 @@ class PixelTracer:
         pixel = dr.gather(mi.UInt32, mi.UInt32(np.ascontiguousarray(pixels, np.uint32)), local)
         v = pixel // width_o
         u = pixel - v * width_o
-        offset = sampler.next_2d()
+        offset = self._filter_offset(sampler.next_2d())
         position = mi.Point2f((mi.Float(u) + offset.x) / self.width, (mi.Float(v) + offset.y) / self.height)
         ray, weight = self.sensor.sample_ray(0.0, sampler.next_1d(), position, sampler.next_2d())
         value, _, _ = self.integrator.sample(self.mi_scene, sampler, ray, None, True)
         rgb = mi.Color3f(value) * weight
-        # Deterministic block sums (evaluated mode: no atomics) over each half of each pixel's samples;
-        # an odd spp (fixed-count rendering only) goes into the first sum whole.
+        # Deterministic block sums (evaluated mode: no atomics) over each half of each pixel's samples.
         block = spp // 2 if spp % 2 == 0 else spp
         dr.eval(rgb)  # one kernel for all three channels
         sums = dr.block_sum(rgb, block, mode="evaluated")
@@ -142,6 +167,41 @@ class PixelTracer:
             return sums, np.zeros_like(sums)
         sums = sums.reshape(n, 2, 3)
         return sums[:, 0], sums[:, 1]
+
+    def _filter_offset(self, sample: Any) -> Any:
+        """Sample offsets from the pixel's corner (px) drawn from the pixel filter, separably in x and y
+        (:func:`hybridgen.render.pixel_filter.warp`, in Dr.Jit)."""
+        import drjit as dr
+        import mitsuba as mi
+
+        last = len(self._filter_table) - 1
+
+        def axis(value: Any) -> Any:
+            position = value * last
+            index = mi.UInt32(dr.clip(dr.floor(position), 0, last - 1))
+            low = dr.gather(mi.Float, self._filter_table, index)
+            high = dr.gather(mi.Float, self._filter_table, index + 1)
+            return dr.lerp(low, high, position - mi.Float(index))
+
+        return mi.Point2f(axis(sample.x), axis(sample.y))
+
+
+def pattern_size(spp: int, sampler: str) -> int:
+    """The sample count to give ``sampler`` for a launch of ``spp`` samples per pixel: the low-discrepancy
+    sampler's patterns have 4^k points (it warns and rounds up otherwise); a launch of 2^k of them uses the
+    first half of the 4^(k+1/2)-point pattern, itself a stratified (0, k, 2)-net."""
+    if sampler != "LowDiscrepancySampler" or spp & (spp - 1):
+        return spp
+    return spp if spp.bit_length() % 2 == 1 else spp * 2
+
+
+def launch_counts(spp: int, sampler: str) -> list[int]:
+    """``spp`` as a sum of sample counts ``sampler`` (a Mitsuba sampler's class name) takes exactly, largest
+    first: powers of two for the low-discrepancy sampler (``LowDiscrepancySampler``), ``spp`` itself for
+    samplers that take any count (``IndependentSampler``)."""
+    if sampler != "LowDiscrepancySampler":
+        return [spp]
+    return [1 << bit for bit in reversed(range(spp.bit_length())) if spp >> bit & 1]
 
 
 def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int) -> tuple[np.ndarray, np.ndarray]:
@@ -154,7 +214,7 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int) -> tuple
         if round_index > 0:
             error = pixel_error(sum_a, sum_b, count)
             unconverged = np.zeros(h * w, dtype=bool)
-            unconverged[active] = error[active] >= plan.noise_threshold
+            unconverged[active] = error[active] >= plan.noise_threshold * CYCLES_THRESHOLD_SCALE
             keep = dilate(unconverged.reshape(h, w)).ravel()
             active = active[keep[active]]
             if len(active) == 0:

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..scene.scene import Scene
+from .pixel_filter import DEFAULT_WIDTH, filter_supersampled
 from .scene_raster import SceneRaster
 
 DEFAULT_FACTOR = 3
@@ -23,16 +24,21 @@ class DenoiseGuides:
     """Box-filtered linear albedo and camera-space normals (float32 H x W x 3 each) of ``scene``'s camera,
     drawn with ``raster`` (the scene's shared raster view, left open) or a view built here."""
 
-    def __init__(self, scene: Scene, factor: int = DEFAULT_FACTOR, raster: SceneRaster | None = None) -> None:
+    def __init__(self, scene: Scene, factor: int = DEFAULT_FACTOR, raster: SceneRaster | None = None,
+                 filter_width: float = DEFAULT_WIDTH) -> None:
         intr = scene.camera.intrinsics
         self.factor, self.width, self.height = int(factor), intr.width, intr.height
+        self.filter_width = float(filter_width)  # the color's pixel filter (0: box), render/pixel_filter.py
         self.fine = intr.resized(intr.width * self.factor, intr.height * self.factor)
         self._own = raster is None
         self.raster = raster or SceneRaster(scene)
 
     def _box(self, image: np.ndarray) -> np.ndarray:
         f = self.factor
-        blocks = np.nan_to_num(image, nan=0.0, posinf=0.0, neginf=0.0).reshape(self.height, f, self.width, f, -1)
+        image = np.nan_to_num(image, nan=0.0, posinf=0.0, neginf=0.0)
+        if self.filter_width > 0:
+            return filter_supersampled(image, f, self.filter_width)
+        blocks = image.reshape(self.height, f, self.width, f, -1)
         return np.ascontiguousarray(blocks.mean(axis=(1, 3), dtype=np.float32))
 
     def render(self, cam2world: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -2,8 +2,9 @@
 
 The scene (geometry, BSDFs, lights, integrator) is loaded once; a keypoint only changes the sensor's
 ``to_world`` through ``mi.traverse``, which rebuilds nothing. The sensor is made from the same K and clip
-range as the raster view, with a one-pixel box filter: color pixel (u, v) integrates the pixel footprint
-``[u - 0.5, u + 0.5] x [v - 0.5, v + 0.5]`` around the centre where the label sample (u, v) is taken.
+range as the raster view; color pixel (u, v) is the pixel filter's weighted mean of the radiance around the
+centre where the label sample (u, v) is taken (Cycles' Blackman-Harris, :mod:`hybridgen.render.pixel_filter`;
+``filter_width: 0``: the one-pixel box ``[u - 0.5, u + 0.5] x [v - 0.5, v + 0.5]``).
 """
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ import numpy as np
 from ..errors import InputError
 from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
-from . import clamped_path, pinhole_sensor
+from . import clamped_path, pinhole_sensor, pixel_filter
 from .adaptive_sampling import PixelTracer, SamplingPlan, render_adaptive
 from .mitsuba_scene import scene_dict
 from .mitsuba_variant import activate, choose_variant, is_jit
@@ -24,6 +25,15 @@ from .mitsuba_variant import activate, choose_variant, is_jit
 OPENCV_TO_MITSUBA = np.diag([-1.0, -1.0, 1.0, 1.0])
 """Mitsuba's camera looks along +z with +y up and +x to the image's left; OpenCV's x is right, y down."""
 
+
+SAMPLER = "ldsampler"
+"""Mitsuba's sample generator: its low-discrepancy sampler (a scrambled (0, 2)-sequence per pair of
+dimensions), stratified like Cycles' Sobol pattern; the first and second half of a pixel's 2^k samples are
+each stratified too, so adaptive sampling's half-buffer error estimate measures this estimator's error.
+Against Mitsuba's default ``independent`` random numbers it lowers the noise of the tabletop scene of
+tools/color_quality.py at 16 / 64 / 256 spp from 28.5 / 34.3 / 40.1 dB to 35.3 / 40.7 / 45.5 dB (PSNR
+against a 4096-spp reference): as clean as 8-16x the samples, for ~15 % more CPU time per sample. Sample
+counts are traced in power-of-two launches (:func:`hybridgen.render.adaptive_sampling.launch_counts`)."""
 
 DEFAULT_MAX_SAMPLES = 1024
 """Samples per pixel at most when ``samples`` is not given (BlenderProc 2.8's default maximum)."""
@@ -52,6 +62,10 @@ class PathTraceSettings:
     :mod:`hybridgen.render.clamped_path`, Cycles' ``sample_clamp_indirect`` (default 10, Cycles' default):
     indirect contributions are clamped per sample, direct light never. It needs a JIT variant
     (``llvm_ad_rgb``/``cuda_ad_rgb``); ``scalar_rgb`` renders unclamped.
+
+    ``filter_width`` (px): the pixel filter, Cycles' Blackman-Harris of that ``filter_width`` (default 1.5,
+    Cycles'), importance-sampled (:mod:`hybridgen.render.pixel_filter`); 0 is the one-pixel box. JIT variants
+    only; ``scalar_rgb`` renders through Mitsuba's film with the box filter.
     """
 
     samples: int | None = None
@@ -63,6 +77,7 @@ class PathTraceSettings:
     clamp_indirect: float = 10.0
     diffuse_bounces: int | None = None
     transmission_bounces: int | None = None
+    filter_width: float = pixel_filter.DEFAULT_WIDTH
 
     def __post_init__(self) -> None:
         if self.samples is not None and self.samples < 1:
@@ -74,6 +89,8 @@ class PathTraceSettings:
                 raise InputError(f"{name} must be >= 0, got {value}")
         if not (math.isfinite(self.clamp_indirect) and self.clamp_indirect >= 0):
             raise InputError(f"clamp_indirect must be >= 0 (0 = off), got {self.clamp_indirect}")
+        if not (math.isfinite(self.filter_width) and 0 <= self.filter_width <= 10):
+            raise InputError(f"filter_width must be in 0..10 px (0 = one-pixel box), got {self.filter_width}")
         self.plan()  # validates the sampling knobs
 
     def plan(self) -> SamplingPlan:
@@ -132,7 +149,7 @@ def sensor_dict(intr: Intrinsics, cam2world: np.ndarray, variant: str) -> dict[s
             "rfilter": {"type": "box"}, "sample_border": False}
     fx, fy, cx, cy = intr.K[0, 0], intr.K[1, 1], intr.K[0, 2], intr.K[1, 2]
     common = {"near_clip": intr.clip_start, "far_clip": intr.clip_end, "film": film,
-              "sampler": {"type": "independent"}}
+              "sampler": {"type": SAMPLER}}
     if is_jit(variant):
         pinhole_sensor.register(variant)
         return {"type": pinhole_sensor.PLUGIN_NAME, "fx": fx, "fy": fy, "cx": cx, "cy": cy, **common}
@@ -174,8 +191,8 @@ class PathTraceView:
         self.sensor = self.mi_scene.sensors()[0]
         self._sensor_params = None if is_jit(self.variant) else mi.traverse(self.sensor)
         self._tracer: PixelTracer | FullFrameTracer = (
-            PixelTracer(self.mi_scene, self.sensor, self.mi_scene.integrator()) if is_jit(self.variant)
-            else FullFrameTracer(self))
+            PixelTracer(self.mi_scene, self.sensor, self.mi_scene.integrator(), self.settings.filter_width)
+            if is_jit(self.variant) else FullFrameTracer(self))
         self.clamped = description["integrator"]["type"] == clamped_path.PLUGIN_NAME
 
     def set_pose(self, cam2world: np.ndarray) -> None:
@@ -187,6 +204,11 @@ class PathTraceView:
             return
         self._sensor_params["to_world"] = mi.ScalarTransform4f((np.asarray(cam2world) @ OPENCV_TO_MITSUBA).tolist())
         self._sensor_params.update()
+
+    @property
+    def filter_width(self) -> float:
+        """The pixel filter's width (px) this view renders with (0: one-pixel box)."""
+        return self.settings.filter_width if isinstance(self._tracer, PixelTracer) and not self._own_film else 0.0
 
     def render(self, cam2world: np.ndarray, seed: int, spp: int | None = None) -> np.ndarray:
         """Linear RGB of one keypoint; ``seed`` fixes the sample pattern (same seed -> same bytes). ``spp``

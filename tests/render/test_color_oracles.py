@@ -172,12 +172,13 @@ def test_spot_light_analytic_intensity_and_cut_off(variant):
                              local2world=hg.object_pose([0, 0, light_height])))
     scene.camera.intrinsics = hg.Intrinsics(K, width, height)
     scene.camera.add_keypoint(np.array([[1.0, 0, 0, 0], [0, -1, 0, 0], [0, 0, -1, camera_height], [0, 0, 0, 1]]))
-    image = PathTraceView(scene, PathTraceSettings(samples=16, max_bounces=0), variant=variant).render(
-        scene.camera.keypoints[0], seed=1)
+    settings = PathTraceSettings(samples=16, max_bounces=0)
+    image = PathTraceView(scene, settings, variant=variant).render(scene.camera.keypoints[0], seed=1)
     hits = _floor_hits(K, width, height, camera_height)
     theta = np.arctan2(np.linalg.norm(hits, axis=-1), light_height)
-    # the pixel footprint is 3/40 m on the floor: keep pixels whose whole footprint is on one side of a limit
-    margin = 0.06 / light_height
+    # a pixel's samples lie within max(0.5, filter_width) px of its centre (the pixel filter), 3/40 m per px on
+    # the floor: keep pixels whose whole footprint (to its corners) is on one side of a limit
+    margin = max(0.5, settings.filter_width) * math.sqrt(2) * 3 / 40 / light_height
     full = theta < spot_size / 2 * (1 - blend) - margin
     dark = theta > spot_size / 2 + margin
     assert full.sum() > 40 and dark.sum() > 400
