@@ -26,6 +26,7 @@ from ..scene.frames import opencv_to_blender
 from .atomic import commit, discard, prepare_output_dir, temporary_path
 from .output_lock import hold_output_lock
 from .frame_sink import PassLayout
+from .hdf5_single import Hdf5Options
 
 
 def next_index(directory: Path) -> int:
@@ -55,8 +56,11 @@ def encode_normals(normals: np.ndarray, cam2world_cv: np.ndarray, space: str) ->
 class BlenderProcHdf5Writer:
     """A :class:`~hybridgen.io.frame_sink.FrameSink` writing BlenderProc's per-keypoint layout into ``directory``."""
 
-    def __init__(self, directory: str | Path, *, append: bool = False, compression: str = "gzip",
-                 compression_level: int = 1) -> None:
+    def __init__(self, directory: str | Path, options: Hdf5Options | None = None, *, append: bool = False) -> None:
+        """``options``: compression and level as for ``data.hdf5`` (its ``encoding`` does not apply: this layout
+        stores BlenderProc's encodings)."""
+        opts = options if options is not None else Hdf5Options()
+        compression, compression_level = opts.compression, opts.compression_level
         self.directory = prepare_output_dir(Path(directory))
         self._unlock = hold_output_lock(self.directory)  # file numbers stay ours until finalize/abort
         self.offset = next_index(self.directory) if append else 0

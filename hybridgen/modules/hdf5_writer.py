@@ -66,9 +66,7 @@ class Hdf5Writer(Module):
         options = from_config(Hdf5Options, cfg)
         self.writer: Hdf5SingleFileWriter | BlenderProcHdf5Writer
         if cfg["layout"] == "blenderproc":
-            self.writer = BlenderProcHdf5Writer(cfg["output_dir"], append=cfg["append_to_existing_output"],
-                                                compression=cfg["compression"],
-                                                compression_level=cfg["compression_level"])
+            self.writer = BlenderProcHdf5Writer(cfg["output_dir"], options, append=cfg["append_to_existing_output"])
         elif context.unit is not None:  # one work unit of a sharded run (or part of a staged one): its own file
             writer_class = JournalingWriter if context.unit.folder != SHARD_FOLDER else Hdf5SingleFileWriter
             self.writer = writer_class(context.unit.shard_path(cfg["output_dir"]), options)
