@@ -47,8 +47,8 @@ def writer(kind: str) -> Callable[[dict[str, Any], Note, dict[str, Any]], list[t
                 state.setdefault("subdirs", {})[id(cfg)] = "coco_data"
             cfg.setdefault("image_names", "blenderproc")  # rgb_%04d.png next to the JSON, as BlenderProc
             if cfg.pop("segmap_output_key", "segmap") != "segmap":
-                note("hybridgen's COCO writer reads the renderer's instance_segmaps (segmentation is stored per "
-                     "attribute, not as one BlenderProc segmap)", "segmap_output_key")
+                note("hybridgen's COCO writer reads the instance segmentation of the renderers before it "
+                     "(instance_segmaps: the instance channel of the segmap, whatever its name)", "segmap_output_key")
         return [(kind, cfg)]
 
     return translate
