@@ -12,6 +12,7 @@ an intended change of output: ``HYBRIDGEN_PIN_DIGESTS=1 pytest tests/run/test_pi
 """
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import json
 import os
@@ -142,7 +143,13 @@ def output_digests(folder: Path) -> dict[str, str]:
 def _run(text: str, name: str) -> dict[str, str]:
     """Runs the config from a fixed folder: the files store the resolved config and its path, so the same
     bytes need the same paths (the test's own tmp_path changes from run to run)."""
-    folder = FIXED_FOLDER / name
+    FIXED_FOLDER.mkdir(parents=True, exist_ok=True)
+    with open(FIXED_FOLDER / ".lock", "w") as lock:  # two test processes at once would share the folder
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        return _run_locked(text, FIXED_FOLDER / name)
+
+
+def _run_locked(text: str, folder: Path) -> dict[str, str]:
     shutil.rmtree(folder, ignore_errors=True)
     shutil.copytree(REPO / "configs/assets", folder / "assets")
     config = folder / "config.yaml"
