@@ -101,7 +101,7 @@ def _labels_only(renderer: Module) -> Module:
     if cfg.get("stereo"):
         raise ConfigError("color=False cannot render stereo labels; use color=True", module=renderer.module_name,
                           index=renderer.index, key="stereo")
-    labels = SegMapRenderer({p.name: cfg[p.name] for p in SegMapRenderer.params}, renderer.index)
+    labels = SegMapRenderer({p.name: cfg.get(p.name, p.default) for p in SegMapRenderer.params}, renderer.index)
     resize = (cfg.get("resolution_x"), cfg.get("resolution_y"))
     if resize == (None, None):
         return labels
