@@ -2,8 +2,8 @@
 
 An entry says what the key holds (dtype, per-keypoint shape, units, axes, background), how it is made from
 one keypoint's readback (``compute(frame, key)`` on a :class:`~hybridgen.render.keypoint_frame.KeypointFrame`,
-and which readbacks that needs), how it is asked for (``request``: the renderer option, the hint writers
-print), how each output format stores it (``hdf5``: the compact encoding of ``data.hdf5``; ``blenderproc``:
+and which readbacks that needs), how it is asked for (``option``: the renderer parameter, which the renderer
+modules declare from here; :func:`hint`: the line writers print), how each output format stores it (``hdf5``: the compact encoding of ``data.hdf5``; ``blenderproc``:
 BlenderProc's per-keypoint files; ``png``/``exr_channels``: ``hybridgen extract``) and how ``vis`` shows it
 (``show``). Adding a pass = one entry here + its test. The renderer options select keys
 (:class:`~hybridgen.render.label_request.LabelRequest`); readers recognise stored keys with :func:`recognise`
