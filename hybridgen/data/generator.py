@@ -150,13 +150,16 @@ class GeneratorDataset:
     def _modules(self, config: ConfigFile) -> list[Module]:
         from ..modules.main_initializer import Initializer
         from ..modules.rgb_renderer import RgbRenderer
+        from ..run.plan import check_splittable
         from ..run.steps import build_modules
 
         modules = build_modules(config)
         if not any(m.role is Role.RENDERER for m in modules):
             raise ConfigError("the config has no renderer module: nothing to generate", file=config.path,
                               key="modules")
-        if not self.write:
+        if self.write:  # every scene is a work unit writing its own files
+            check_splittable(modules, config.path)
+        else:
             modules = [m for m in modules if m.role is not Role.WRITER]
         if not self.color:
             modules = [_labels_only(m) if isinstance(m, RgbRenderer) else m for m in modules]

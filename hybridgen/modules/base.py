@@ -4,7 +4,8 @@ Python API.
 run/ plans a run from these declarations alone (never from module names): which modules build the scene
 (run once per scene, before the first renderer), which render keypoints and which write them; the keys
 renderers produce and writers consume (checked before anything renders); how many scenes and keypoint
-chunks a run has; and which writer's single file sharded and resumable runs write unit by unit.
+chunks a run has; which writer's single file sharded and resumable runs write unit by unit, and which
+writers cannot be split into units.
 """
 from __future__ import annotations
 
@@ -74,6 +75,8 @@ class Module:
     writes_unit_files: ClassVar[bool] = False
     """Writers: in a sharded run every work unit writes its own file through this writer (see
     :meth:`single_file`); a sharded run needs exactly one such writer."""
+    shares_files_across_units: ClassVar[bool] = False
+    """Writers whose files (dataset index files) all units would share: a sharded run refuses them."""
 
     def __init__(self, config: dict[str, Any], index: int) -> None:
         self.config = config

@@ -10,7 +10,6 @@ from ..run.context import RunContext
 from ..sampling.getters import parse_selector
 from ..scene.mesh_object import MeshObject
 from .base import Module, Role
-from .writer_support import refuse_work_units
 
 
 @register_module("writer.BopWriter")
@@ -18,6 +17,7 @@ class BopWriter(Module):
     """Writes train_pbr chunks (rgb, depth, exact full/visible masks, scene_gt*, camera.json); obj_id = category_id."""
 
     role = Role.WRITER
+    shares_files_across_units = True
 
     params = (
         Param("output_dir", "path", doc="folder of the dataset (usually from global.all)"),
@@ -35,7 +35,6 @@ class BopWriter(Module):
 
     def prepare(self, context: RunContext) -> None:
         cfg = self.config
-        refuse_work_units(context, self.module_name)
         self.selector = parse_selector(cfg["selector"], "selector") if cfg["selector"] is not None else None
         self.writer = BopSink(cfg["output_dir"], context.scene, lambda: self._selected(context),
                               from_config(BopOptions, cfg), log=context.log)

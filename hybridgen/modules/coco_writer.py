@@ -8,7 +8,6 @@ from ..io.coco_writer import NEEDED_KEYS, CocoOptions, CocoWriter, image_key_hin
 from ..io.renamed_sink import renamed_sinks
 from ..run.context import RunContext
 from .base import Module, Role
-from .writer_support import refuse_work_units
 
 
 @register_module("writer.CocoAnnotationsWriter")
@@ -16,6 +15,7 @@ class CocoAnnotationsWriter(Module):
     """Writes images/ and coco_annotations.json (RLE or polygon masks from the exact instance map)."""
 
     role = Role.WRITER
+    shares_files_across_units = True
 
     params = (
         Param("output_dir", "path", doc="dataset folder (usually from global.all)"),
@@ -37,7 +37,6 @@ class CocoAnnotationsWriter(Module):
 
     def prepare(self, context: RunContext) -> None:
         cfg = self.config
-        refuse_work_units(context, self.module_name)
         renamed = {key: own for key, own in self._stored().items() if key != own}
         self.writer = CocoWriter(cfg["output_dir"], from_config(CocoOptions, cfg))
         context.sinks += renamed_sinks([self.writer], renamed)  # reads the renamed passes by their roles

@@ -77,6 +77,16 @@ def scene_stage(modules: list[Module]) -> int | None:
     return first
 
 
+def check_splittable(modules: list[Module], file: str) -> None:
+    """The modules can run as separate work units: no writer whose files every unit would share."""
+    shared = next((m for m in modules if m.shares_files_across_units), None)
+    if shared is not None:
+        raise ConfigError("cannot be used in a sharded run (several scenes, keypoint chunks, --workers or --shard): "
+                          "its index files would be shared by all work units; run without --workers/--shard and "
+                          f"with one scene, or use {unit_file_writer_names()}", file=file, module=shared.module_name,
+                          index=shared.index)
+
+
 def sharding_plan(config: ConfigFile, modules: list[Module], force: bool = False) -> ShardingPlan | None:
     """The plan of a config that runs as units (several scenes, chunks, or ``force``); None otherwise."""
     units = next((u for u in (m.scene_units() for m in modules) if u is not None), None)
@@ -84,6 +94,7 @@ def sharding_plan(config: ConfigFile, modules: list[Module], force: bool = False
     chunk_size = units.keypoints_per_chunk if units else 0
     if scenes == 1 and chunk_size == 0 and not force:
         return None
+    check_splittable(modules, config.path)
     writers = [m for m in modules if m.writes_unit_files]
     output = writers[0].single_file() if len(writers) == 1 else None
     if output is None:

@@ -137,3 +137,44 @@ def test_one_small_executor_interface():
     with pytest.raises(ValueError, match="scene 1 fails"):
         failed.result()
     local.shutdown()
+
+
+class IndexWriter(Writer):
+    shares_files_across_units = True
+
+
+def test_writers_sharing_index_files_refuse_sharding_before_any_unit_runs(tmp_path):
+    config = ConfigFile(path="c.yaml", text="", modules=[], global_all={})
+    modules = _modules((Setup, {"scenes": 2, "chunk": 0}), (Renderer, {}), (UnitWriter, {"single": True}),
+                       (IndexWriter, {}))
+    with pytest.raises(ConfigError, match="cannot be used in a sharded run") as err:
+        sharding_plan(config, modules)
+    assert (err.value.module, err.value.index) == ("any.Name3", 3)
+    assert sharding_plan(config, modules[:3]).scenes == 2
+    one_scene = _modules((Setup, {"scenes": 1, "chunk": 0}), (Renderer, {}), (IndexWriter, {}))
+    assert sharding_plan(config, one_scene) is None  # not sharded: the index writer is fine
+
+
+def test_a_sharded_coco_run_is_refused_in_one_line_before_rendering(tmp_path, run_cli, write_config):
+    out = tmp_path / "out"
+    config = write_config("""
+global: {all: {output_dir: "<args:0>"}}
+modules:
+  - name: main.Initializer
+    config: {number_of_scenes: 2}
+  - name: loader.PrimitiveLoader
+    config: {shape: cube, size: 1, name: box, category_id: 2}
+  - name: camera.CameraLoader
+    config:
+      intrinsics: {resolution_x: 16, resolution_y: 12}
+      cam_poses: [{location: [3, -3, 2], rotation: {format: look_at, value: [0, 0, 0]}}]
+  - name: renderer.SegMapRenderer
+    config: {map_by: instance}
+  - name: writer.Hdf5Writer
+  - name: writer.CocoAnnotationsWriter
+    config: {rgb_output_key: instance_segmaps}
+""")
+    code, _, err = run_cli("run", "-q", str(config), str(out))
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert "writer.CocoAnnotationsWriter" in err and "(#5)" in err and "cannot be used in a sharded run" in err
+    assert not (out / "shards").exists() and not (out / "coco_annotations.json").exists()
