@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, Mapping
 
 from ..config.schema import Param
+from ..errors import ConfigError
 
 if TYPE_CHECKING:
     from ..run.context import RunContext
@@ -107,7 +108,6 @@ class Module:
 
     def value(self, context: "RunContext", key: str) -> Any:
         """The config value ``key`` with its samplers drawn afresh, checked against its declared type."""
-        from ..config.schema import ConfigError
         from ..sampling.registry import DrawContext, contains_sampled, draw
 
         raw = self.config[key]
