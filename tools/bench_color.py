@@ -445,6 +445,8 @@ def main() -> None:
                         "threshold (default: its default)")
     parser.add_argument("--try-thresholds", type=lambda v: [float(x) for x in v.split(",")], default=[],
                         help="quality mode: also time hybridgen at these noise thresholds (tuning)")
+    parser.add_argument("--blenderproc-lobes", action="store_true", help="quality mode: hybridgen with "
+                        "BlenderProc's glossy_bounces 0 / transmission_bounces 0, the light paths Cycles renders")
     parser.add_argument("--scenes", default="", help="quality mode: comma-separated scene names (default all)")
     parser.add_argument("--out", default=str(REPO / "output" / "bench_color_quality"),
                         help="quality mode: folder for side-by-side PNGs")

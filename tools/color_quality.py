@@ -12,9 +12,11 @@ Scenes (built here from pybullet_data meshes, primitives and generated textures;
 - ``hdri_tabletop``: objects on a floor under a generated HDRI (sky gradient with a small, bright sun).
 
 For each scene: hybridgen's defaults (``PathTraceSettings()`` + denoising, as ``renderer.RgbRenderer``
-with no color options: adaptive 16..1024 spp at noise threshold 0.01, indirect clamp 10, 3 bounces,
-OIDN) timed from scene load to the finished sRGB frame (scene translation, kernel compilation with a warm
-cache, raster guides, render, denoise) in this process; its reference is the same estimator at a fixed
+with no color options: stratified samples, Blackman-Harris 1.5 px pixel filter, adaptive 16..1024 spp at
+noise threshold 0.01 in Cycles' meaning, indirect clamp 10, 3 bounces for every lobe, OIDN; with
+``--blenderproc-lobes`` glossy and transmission bounces 0 as Cycles renders at BlenderProc's defaults)
+timed from scene load to the finished sRGB frame (scene translation, kernel compilation with a warm cache,
+raster guides, render, denoise) in this process; its reference is the same estimator at a fixed
 ``--reference-spp`` without denoising (and once more without the clamp, to measure the clamp's bias).
 Cycles (pip ``bpy`` in ``.venv-bpy``) renders with BlenderProc's defaults (``mode: blenderproc`` in
 tools/cycles_render.py; its render time only, scene sync excluded) and its reference at the same spp
@@ -216,19 +218,27 @@ def psnr(image: np.ndarray, reference: np.ndarray) -> float:
     return float("inf") if mse == 0 else 10 * math.log10(255.0 ** 2 / mse)
 
 
-def hybridgen_default(scene: Any, seed: int, threshold: float | None = None) -> tuple[np.ndarray, float, float]:
+BLENDERPROC_LOBES = {"glossy_bounces": 0, "transmission_bounces": 0}
+"""``--blenderproc-lobes``: BlenderProc's per-lobe limits (hybridgen's default is max_bounces for every lobe),
+so that hybridgen estimates the same light paths as Cycles at BlenderProc's defaults."""
+LOBES: dict[str, int] = {}
+
+
+def hybridgen_default(scene: Any, seed: int,
+                      threshold: float | None = None) -> tuple[np.ndarray, float, float, float]:
     """sRGB frame with hybridgen's defaults (``threshold`` overrides the noise threshold, for tuning), seconds
-    from scene load to the frame, mean samples per pixel."""
+    from scene load to the frame (wall clock, and CPU time of this process's threads), mean samples per
+    pixel."""
     from hybridgen.render.path_trace import PathTraceSettings
     from hybridgen.render.render_color import ColorProducer
 
-    start = time.perf_counter()
-    producer = ColorProducer(scene, PathTraceSettings(noise_threshold=threshold), seed=seed, denoise=True,
+    start, cpu = time.perf_counter(), time.process_time()
+    producer = ColorProducer(scene, PathTraceSettings(noise_threshold=threshold, **LOBES), seed=seed, denoise=True,
                              sample_counts=True)
     frame = producer.produce(0, scene.camera.keypoints[0])
-    seconds = time.perf_counter() - start
+    seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
     producer.close()
-    return frame["colors"], seconds, float(frame["sample_counts"].mean())
+    return frame["colors"], seconds, float(frame["sample_counts"].mean()), cpu
 
 
 def hybridgen_reference(scene: Any, spp: int, clamp: float) -> tuple[np.ndarray, float]:
@@ -236,7 +246,7 @@ def hybridgen_reference(scene: Any, spp: int, clamp: float) -> tuple[np.ndarray,
     from hybridgen.render.tonemap import to_srgb8
 
     start = time.perf_counter()
-    view = PathTraceView(scene, PathTraceSettings(samples=spp, clamp_indirect=clamp))
+    view = PathTraceView(scene, PathTraceSettings(samples=spp, clamp_indirect=clamp, **LOBES))
     image = view.render(scene.camera.keypoints[0], seed=12345)
     return to_srgb8(image), time.perf_counter() - start
 
@@ -253,6 +263,8 @@ def run_quality(args: Any, bpy_python: Path | None) -> list[dict[str, Any]]:
     from bench_color import CyclesWorker, export_for_cycles
 
     width, height = (int(v) for v in args.res.split("x"))
+    LOBES.clear()
+    LOBES.update(BLENDERPROC_LOBES if args.blenderproc_lobes else {})
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     rows = []
@@ -262,11 +274,12 @@ def run_quality(args: Any, bpy_python: Path | None) -> list[dict[str, Any]]:
         row: dict[str, Any] = {"scene": name}
         ref, row["hg_ref_s"] = hybridgen_reference(scene, args.reference_spp, 10.0)
         ref_unclamped, _ = hybridgen_reference(scene, args.reference_spp, 0.0)
-        image, row["hg_s"], row["hg_mean_spp"] = hybridgen_default(scene, seed=1, threshold=args.hg_threshold)
+        image, row["hg_s"], row["hg_mean_spp"], row["hg_cpu_s"] = hybridgen_default(scene, seed=1,
+                                                                                    threshold=args.hg_threshold)
         row["hg_psnr"] = psnr(image, ref)
         for threshold in args.try_thresholds:  # tuning: other thresholds, same reference
-            other, seconds, spp = hybridgen_default(scene, seed=1, threshold=threshold)
-            row[f"hg_{threshold}"] = {"psnr": psnr(other, ref), "s": seconds, "spp": spp}
+            other, seconds, spp, cpu = hybridgen_default(scene, seed=1, threshold=threshold)
+            row[f"hg_{threshold}"] = {"psnr": psnr(other, ref), "s": seconds, "spp": spp, "cpu_s": cpu}
         row["hg_psnr_vs_unclamped_ref"] = psnr(image, ref_unclamped)
         row["clamp_bias_psnr"] = psnr(ref, ref_unclamped)
         row["clamp_bias_mean"] = float(ref.astype(float).mean() - ref_unclamped.astype(float).mean())
@@ -278,7 +291,7 @@ def run_quality(args: Any, bpy_python: Path | None) -> list[dict[str, Any]]:
             try:
                 cycles_png, cycles_ref_png = out / f"{name}_cycles.png", out / f"{name}_cycles_ref.png"
                 answer = worker.render(0, False, 1, cycles_png, mode="blenderproc")
-                row["cycles_s"] = answer["seconds"]
+                row["cycles_s"], row["cycles_cpu_s"] = answer["seconds"], answer["cpu_s"]
                 answer = worker.render(0, False, 12345, cycles_ref_png, mode="reference", spp=args.reference_spp)
                 row["cycles_ref_s"] = answer["seconds"]
             finally:
@@ -293,12 +306,15 @@ def run_quality(args: Any, bpy_python: Path | None) -> list[dict[str, Any]]:
 
 
 def print_table(rows: list[dict[str, Any]], reference_spp: int) -> None:
-    print(f"\nPSNR (dB, 8-bit sRGB) against each engine's own {reference_spp}-spp reference; time in s")
-    print(f"{'scene':15} {'hybridgen':>10} {'time':>7} {'spp':>6} {'Cycles BP':>10} {'time':>7} {'time ratio':>10} "
-          f"{'clamp bias':>10}")
+    print(f"\nPSNR (dB, 8-bit sRGB) against each engine's own {reference_spp}-spp reference; time in s (wall; "
+          "CPU = CPU time of the engine's threads, steadier on a loaded machine)")
+    print(f"{'scene':15} {'hybridgen':>10} {'time':>7} {'CPU':>6} {'spp':>6} {'Cycles BP':>10} {'time':>7} {'CPU':>6} "
+          f"{'wall ratio':>10} {'CPU ratio':>9} {'clamp bias':>10}")
+    nan = float("nan")
     for r in rows:
-        ratio = r["hg_s"] / r["cycles_s"] if r.get("cycles_s") else float("nan")
-        print(f"{r['scene']:15} {r['hg_psnr']:10.1f} {r['hg_s']:7.2f} {r['hg_mean_spp']:6.0f} "
-              f"{r.get('cycles_psnr', float('nan')):10.1f} {r.get('cycles_s', float('nan')):7.2f} {ratio:10.2f} "
-              f"{r['clamp_bias_psnr']:10.1f}")
+        ratio = r["hg_s"] / r["cycles_s"] if r.get("cycles_s") else nan
+        cpu_ratio = r["hg_cpu_s"] / r["cycles_cpu_s"] if r.get("cycles_cpu_s") else nan
+        print(f"{r['scene']:15} {r['hg_psnr']:10.1f} {r['hg_s']:7.2f} {r['hg_cpu_s']:6.2f} {r['hg_mean_spp']:6.0f} "
+              f"{r.get('cycles_psnr', nan):10.1f} {r.get('cycles_s', nan):7.2f} {r.get('cycles_cpu_s', nan):6.2f} "
+              f"{ratio:10.2f} {cpu_ratio:9.2f} {r['clamp_bias_psnr']:10.1f}")
     print("clamp bias: PSNR of hybridgen's clamped reference against its unclamped one (higher = less bias)")

@@ -29,7 +29,8 @@ class ColorProducer:
     ``colors_hdr`` (float16) from one Mitsuba scene loaded at construction.
 
     With ``denoise`` the linear image goes through Open Image Denoise, guided by the raster view's albedo and
-    normals (box-filtered over the pixel, :mod:`hybridgen.render.denoise_guides`), before it is encoded; ``keep_raw`` also stores the image before denoising as ``colors_raw``
+    normals (filtered like the color's pixels, :mod:`hybridgen.render.denoise_guides`), before it is
+    encoded; ``keep_raw`` also stores the image before denoising as ``colors_raw``
     (sRGB uint8, encoded like ``colors``). ``sample_counts`` stores the samples each pixel received
     (uint32, ``sample_counts``; constant unless adaptive sampling is on).
     """
@@ -42,8 +43,9 @@ class ColorProducer:
         self._guides: DenoiseGuides | None = None
         if denoise:
             require_oidn()
-            self._guides = DenoiseGuides(scene, raster=raster)  # raster: the labels' view, shared
         self.view = view or PathTraceView(scene, settings, variant=variant)
+        if denoise:  # raster: the labels' view, shared; guides filtered like the color's pixels
+            self._guides = DenoiseGuides(scene, raster=raster, filter_width=self.view.filter_width)
 
     def layouts(self) -> list[PassLayout]:
         intr = self.scene.camera.intrinsics
@@ -56,6 +58,8 @@ class ColorProducer:
                 "min_samples": plan.min_samples if plan.adaptive else plan.max_samples,
                 "noise_threshold": plan.noise_threshold, "adaptive_sampling": plan.adaptive,
                 "clamp_indirect": s.clamp_indirect if self.view.clamped else 0.0,
+                "pixel_filter": (f"Blackman-Harris, filter_width {self.view.filter_width} px" if self.view.filter_width
+                                 else "box, 1 px"),
                 "min_bounces": s.min_bounces, "max_bounces": s.max_bounces, "mitsuba_max_depth": s.max_bounces + 2,
                 **{name: value for name, value in s.lobe_limits().items()},
                 "color_encoding": "sRGB transfer of linear radiance clipped to [0, 1]", "denoised": self.denoise}
