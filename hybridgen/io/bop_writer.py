@@ -144,6 +144,10 @@ class BopWriter:
         """The render-side per-object passes this writer needs (none without masks)."""
         return OBJECT_PASSES if self.calc_mask_info_coco else ()
 
+    def wanted_objects(self) -> list[int] | None:
+        """The annotated objects, whose per-object passes alone are made (known once ``begin`` chose them)."""
+        return None if self.objects is None else [obj.instance_id for obj in self.objects]
+
     def begin(self, n_keypoints: int, layouts: list[PassLayout], camera_records: dict[str, np.ndarray],
               attributes: dict[str, Any]) -> None:
         """Check the renderer's output and pick the annotated objects (once)."""

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any, Collection, Protocol
 
 import numpy as np
 
@@ -95,6 +95,11 @@ class SinkFilter:
         """The on-request passes the sink behind asks for."""
         wanted = getattr(self.sink, "wanted_passes", None)
         return tuple(wanted()) if wanted is not None else ()
+
+    def wanted_objects(self) -> Collection[int] | None:
+        """The objects (instance ids) whose per-object passes the sink behind reads; None: all."""
+        wanted = getattr(self.sink, "wanted_objects", None)
+        return wanted() if wanted is not None else None
 
     def finalize(self, records: dict[str, Any] | None = None,
                  attributes: dict[str, Any] | None = None) -> list[Path]:

@@ -34,7 +34,8 @@ class LabelTables:
 @dataclass
 class KeypointFrame:
     """Keypoint ``index`` (stereo ``eye``) at ``cam2world`` (4x4, OpenCV axes) with its readback ``raw``.
-    ``neighbour(step)`` is the pose of keypoint ``index + step`` moved like this eye (None past the ends)."""
+    ``neighbour(step)`` is the pose of keypoint ``index + step`` moved like this eye (None past the ends);
+    ``focus``: the objects whose per-object passes are made (None: all)."""
 
     index: int
     eye: int
@@ -43,6 +44,7 @@ class KeypointFrame:
     raster: SceneRaster
     tables: LabelTables
     neighbour: Callable[[int], np.ndarray | None]
+    focus: frozenset[int] | None = None
     _shared: dict[Any, Any] = field(default_factory=dict)
 
     @classmethod
@@ -82,12 +84,12 @@ class KeypointFrame:
                                               self.placements()[obj.instance_id].corners))
 
     def silhouettes(self) -> dict[int, Silhouette]:
-        """Every object's full silhouette (also counted outside the image), by instance id."""
+        """Every (focused) object's full silhouette (also counted outside the image), by instance id."""
         def make() -> dict[int, Silhouette]:
             return {obj.instance_id: full_silhouette(self.view, obj, self.cam2world,
                                                      self.placements()[obj.instance_id],
                                                      lambda obj=obj: self.image_silhouette(obj))  # type: ignore[misc]
-                    for obj in self.scene.objects}
+                    for obj in self.scene.objects if self.focus is None or obj.instance_id in self.focus}
         return self.shared("silhouettes", make)
 
     def neighbour_depth(self, step: int) -> tuple[np.ndarray | None, np.ndarray | None]:

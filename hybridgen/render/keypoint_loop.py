@@ -88,6 +88,9 @@ def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Prod
         routes = [_route(sink, keys) for sink in sinks]
         for sink, route in zip(sinks, routes):
             sink.begin(n, [layout for layout in layouts if layout.key in route], records, attributes)
+        focus = _focus(sinks, routes)
+        for producer in producers:  # per-object passes only for the objects the sinks read
+            getattr(producer, "focus_objects", lambda ids: None)(focus)
         bar = progress(n, what) if progress else None
         prefetching = [p for p in producers if hasattr(p, "prefetch")]
         keypoints = scene.camera.keypoints
@@ -118,6 +121,21 @@ def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Prod
         for producer in producers:
             producer.close()
     return n
+
+
+def _focus(sinks: list[FrameSink], routes: list[set[str]]) -> frozenset[int] | None:
+    """The objects whose per-object on-request passes some sink reads (``wanted_objects()`` after ``begin``;
+    None: all of them, also when a sink asking for such passes does not say)."""
+    ids: set[int] = set()
+    for sink, route in zip(sinks, routes):
+        if not any(on_request(key) for key in route):
+            continue
+        wanted = getattr(sink, "wanted_objects", None)
+        chosen = wanted() if wanted is not None else None
+        if chosen is None:
+            return None
+        ids.update(int(i) for i in chosen)
+    return frozenset(ids)
 
 
 def _route(sink: FrameSink, keys: list[str]) -> set[str]:
@@ -176,6 +194,10 @@ class StereoProducer:
         """The scene's objects moved or the intrinsics changed: tell the eyes' producers."""
         for producer in self.producers:
             getattr(producer, "view_changed", lambda: None)()
+
+    def focus_objects(self, ids: frozenset[int] | None) -> None:
+        for producer in self.producers:
+            getattr(producer, "focus_objects", lambda ids: None)(ids)
 
     def close(self) -> None:
         for producer in self.producers:

@@ -2,8 +2,9 @@
 fractions, and 2D boxes - made on the render side from one set of single-object silhouettes
 (:mod:`hybridgen.render.silhouettes`), so that writers need no GL and no geometry.
 
-Each value is a dict by instance id over every object of the scene that is not entirely behind the near or
-beyond the far plane (objects outside the image have empty masks inside it but may count pixels outside).
+Each value is a dict by instance id over every object of the scene - or only those the asking sinks read
+(``wanted_objects()``, :mod:`hybridgen.render.passes`) - (objects behind the near or beyond the far plane
+have empty masks and no pixels; objects outside the image may count pixels outside it).
 Counts and boxes follow the BOP toolkit: ``px_count_all`` counts the full silhouette also outside the image;
 boxes are ``[x, y, x_max - x, y_max - y]`` (:func:`~hybridgen.render.silhouettes.toolkit_box`), ``bbox_obj``
 may extend past the image, :data:`~hybridgen.render.silhouettes.NO_BOX` when there are no pixels.

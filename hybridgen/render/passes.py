@@ -17,7 +17,9 @@ returning their keys. Every renderer that also makes the pass's ``with_keys`` (h
 then computes them, announces them in ``begin`` (``PassLayout`` dtype ``"object"``) and hands them to
 ``write(index, values)`` of the sinks that asked only, in the same ``values`` as ``instance_segmaps``:
 ``values["amodal_masks"][instance_id]`` is the object's (H, W) bool full silhouette inside the image, and so
-on (see :mod:`hybridgen.render.object_passes`). In the Python API, ``MemorySink(wanted=[...])`` asks for them.
+on (see :mod:`hybridgen.render.object_passes`). A sink that reads only some objects says which with
+``wanted_objects() -> Collection[int] | None`` (instance ids, asked after its ``begin``; None: all): only those
+are drawn alone. In the Python API, ``MemorySink(wanted=[...])`` asks for them.
 :func:`hint` gives the line to print when a key is missing.
 """
 from __future__ import annotations

@@ -36,6 +36,11 @@ class LabelProducer:
         self.view = self.raster.view
         self._tables = request.tables(self.view)
         self._pending: dict[int, tuple[int, int, bytes]] = {}
+        self._focus: frozenset[int] | None = None
+
+    def focus_objects(self, ids: frozenset[int] | None) -> None:
+        """Make per-object passes (``amodal_masks``, ...) only for the objects ``ids`` (None: all)."""
+        self._focus = ids
 
     def layouts(self) -> list[PassLayout]:
         """The request's layouts; id passes carry the range of ids this scene can produce (writers store
@@ -66,7 +71,7 @@ class LabelProducer:
         else:
             raw = self.view.render_raw(cam2world)
         frame = KeypointFrame(index, eye, cam2world, raw, self.raster, self._tables,
-                              lambda step: self._neighbour(index, step, cam2world))
+                              lambda step: self._neighbour(index, step, cam2world), self._focus)
         return self.request.compute(frame)
 
     def _neighbour(self, index: int, step: int, cam2world: np.ndarray) -> np.ndarray | None:

@@ -174,3 +174,28 @@ def test_silhouettes_drawn_in_their_box_region_equal_full_canvas_draws(gl_contex
                 drawn += int(full.any())
     view.release()
     assert drawn > 20  # most objects are seen on most canvases
+
+
+def test_only_the_objects_a_sink_reads_are_drawn_alone(gl_context, monkeypatch):
+    from hybridgen.render import silhouettes
+
+    scene = _half_hidden_cube()
+    cube = scene.by_name("cube").instance_id
+
+    class CubeOnly(AskingSink):
+        def wanted_objects(self) -> list[int]:
+            return [cube]
+
+    drawn = []
+    original = silhouettes.draw_part
+    monkeypatch.setattr(silhouettes, "draw_part", lambda view, obj, *args: drawn.append(obj.name) or
+                        original(view, obj, *args))
+    focused, every = CubeOnly(), AskingSink()
+    request = hg.LabelRequest(map_by=["instance"], depth=False, normals=False)
+    hg.render_labels(scene, [focused], request)
+    assert set(drawn) == {"cube"} and all(set(focused.frames[0][key]) == {cube} for key in WANTED)
+    hg.render_labels(scene, [every], request)
+    assert set(drawn) == {"cube", "wall"}  # a sink that does not say reads every object
+    for key in ("visible_fractions", "object_boxes"):
+        assert focused.frames[0][key][cube] == every.frames[0][key][cube]
+    np.testing.assert_array_equal(focused.frames[0]["amodal_masks"][cube], every.frames[0]["amodal_masks"][cube])
