@@ -41,11 +41,9 @@ def upload_cutout(ctx: Any, obj: MeshObject, vertex_order: np.ndarray | None) ->
     return Cutout(1.0, texture, uv_buffer)
 
 
-def set_cutout_uniforms(program: Any, cutout: Cutout | None, unit: int = 0) -> None:
-    """Uniforms of the label program for one draw (no cut-out: every fragment is kept)."""
-    program["u_alpha_clip"].value = cutout is not None
-    if cutout is None:
-        return
+def set_cutout_uniforms(program: Any, cutout: Cutout, unit: int = 0) -> None:
+    """Uniforms of the label program's cut-out variant (``ALPHA_CUTOUT`` defined) for one draw; objects
+    without a cut-out are drawn by the plain variant, which keeps every fragment."""
     program["u_alpha_mapped"].value = cutout.texture is not None
     program["u_alpha"].value = cutout.alpha
     if cutout.texture is not None:

@@ -58,8 +58,8 @@ class RasterView:
         self.normals_space = normals_space
         self.depth_background = float(depth_background)
         self.ctx = ctx if ctx is not None else shared_context(device_index)
-        self.program = self.ctx.program(vertex_shader=shader_source("labels.vert"),
-                                        fragment_shader=shader_source("labels.frag"))
+        self.program = self._label_program(cutout=False)
+        self._cutout_program: Any = None  # built with the first object that cuts out (render/alpha_cutout.py)
         self.gpu_objects = self._upload_all(scene.objects)
         try:  # instance id -> category_id, for the category_id_segmaps pass (0 where an object has none)
             self._class_lut = self.category_lut()
@@ -73,6 +73,17 @@ class RasterView:
         self._cached_pose: dict[str, Any] = {}
 
     # ----------------------------------------------------------------- resources
+    def _label_program(self, cutout: bool) -> Any:
+        """The label program; its cut-out variant also interpolates UVs and drops fragments of low alpha (a
+        shader that may discard costs llvmpipe its early depth test and a varying for every object)."""
+        vertex, fragment = shader_source("labels.vert"), shader_source("labels.frag")
+        if cutout:
+            vertex, fragment = (text.replace("\n", "\n#define ALPHA_CUTOUT\n", 1) for text in (vertex, fragment))
+        return self.ctx.program(vertex_shader=vertex, fragment_shader=fragment)
+
+    def _programs(self) -> list[Any]:
+        return [p for p in (self.program, self._cutout_program) if p is not None]
+
     def _upload_all(self, objects: list[Any]) -> list[GpuObject]:
         """GPU objects of ``objects``; placements of shared geometry (render/shared_geometry.py) draw from the
         buffers of its first placement."""
@@ -105,9 +116,14 @@ class RasterView:
         indices = ctx.buffer(faces.astype(np.uint32).tobytes())
         cutout = upload_cutout(ctx, obj, vertex_order)
         content = [(positions, "3f", "in_position"), (normal_buffer, "3f", "in_normal")]
-        if cutout is not None and cutout.uv_buffer is not None:
-            content.append((cutout.uv_buffer, "2f", "in_uv"))
-        vao = ctx.vertex_array(self.program, content, index_buffer=indices, index_element_size=4)
+        program = self.program
+        if cutout is not None:
+            if self._cutout_program is None:
+                self._cutout_program = self._label_program(cutout=True)
+            program = self._cutout_program
+            if cutout.uv_buffer is not None:
+                content.append((cutout.uv_buffer, "2f", "in_uv"))
+        vao = ctx.vertex_array(program, content, index_buffer=indices, index_element_size=4)
         extra = cutout.resources() if cutout is not None else []
         # a cut-out volume shows its inside through its holes: never culled
         return GpuObject(obj.instance_id, vao, positions, indices, [positions, normal_buffer, indices, *extra],
@@ -185,18 +201,20 @@ class RasterView:
         world2cam = np.eye(4)
         world2cam[:3, :3] = cam2world[:3, :3].T
         world2cam[:3, 3] = -cam2world[:3, :3].T @ cam2world[:3, 3]
-        prog = self.program
-        prog["u_projection"].write(projection_from_K(intr.K, width, height, intr.clip_start, intr.clip_end)
-                                   .T.astype(np.float32).tobytes())
+        projection = projection_from_K(intr.K, width, height, intr.clip_start, intr.clip_end).T.astype(np.float32)
         to_output = np.eye(3) if (normals_space or self.normals_space) == "camera" else cam2world[:3, :3]
-        prog["u_cam_to_output"].write(to_output.T.astype(np.float32).tobytes())
+        for program in self._programs():
+            program["u_projection"].write(projection.tobytes())
+            program["u_cam_to_output"].write(to_output.T.astype(np.float32).tobytes())
         near_reach = near_plane_corner_distance(intr.K, width, height, intr.clip_start)
         draws = self._object_uniforms(cam2world, world2cam, near_reach, hidden)
         for gpu, modelview, normal_to_cam, cull, front_face in draws:
+            prog = self.program if gpu.cutout is None else self._cutout_program
             prog["u_modelview"].write(modelview)
             prog["u_normal_to_cam"].write(normal_to_cam)
             prog["u_instance_id"].value = gpu.instance_id
-            set_cutout_uniforms(prog, gpu.cutout)
+            if gpu.cutout is not None:
+                set_cutout_uniforms(prog, gpu.cutout)
             # The projection mirrors handedness (and so may the object's transform): front_face is set so
             # that gl_FrontFacing means "the side the normal points to faces the camera".
             self.ctx.front_face = front_face
@@ -297,7 +315,7 @@ class RasterView:
         for fbo in self._fbos.values():
             self._release_fbo(fbo)
         self._fbos.clear()
-        if self.program is not None:  # one compiled program per view: leaked ~1.7 MB per scene before
-            self.program.release()
-            self.program = None
+        for program in self._programs():  # compiled programs per view: leaked ~1.7 MB per scene before
+            program.release()
+        self.program = self._cutout_program = None
 
