@@ -8,6 +8,7 @@ from concurrent.futures import Future
 
 from ..errors import InputError, SystemSetupError
 from .executor import Executor
+from .ray_loopback import keep_ray_on_loopback
 from .signals import reclaim_sigterm
 from .unit_task import UnitTask
 from .units import WorkUnit
@@ -51,6 +52,7 @@ class RayExecutor(Executor):
                 check_reachable(address)
                 ray.init(address=address, include_dashboard=False, log_to_driver=False, runtime_env=runtime_env)
             else:
+                keep_ray_on_loopback()  # _node_ip_address alone is overridden by Ray (see ray_loopback.py)
                 ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False, runtime_env=runtime_env,
                          _node_ip_address="127.0.0.1")
             self.started = True

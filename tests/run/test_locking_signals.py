@@ -79,6 +79,28 @@ def _descendants(pid: int) -> set[int]:
     return found
 
 
+def _listening_addresses(pids: set[int]) -> set[tuple[str, int]]:
+    """(address, port) of every TCP socket in LISTEN state that one of ``pids`` holds (/proc/net/tcp{,6})."""
+    inodes = set()
+    for pid in pids:
+        try:
+            links = [os.readlink(fd) for fd in Path(f"/proc/{pid}/fd").iterdir()]
+        except OSError:
+            continue
+        inodes |= {link[8:-1] for link in links if link.startswith("socket:[")}
+    found = set()
+    for table, family in (("tcp", socket.AF_INET), ("tcp6", socket.AF_INET6)):
+        for line in Path(f"/proc/net/{table}").read_text().splitlines()[1:]:
+            fields = line.split()
+            if fields[3] != "0A" or fields[9] not in inodes:  # 0A: LISTEN
+                continue
+            address, port = fields[1].split(":")
+            raw = bytes.fromhex(address)  # 32-bit words in host (little-endian) order
+            raw = b"".join(raw[i:i + 4][::-1] for i in range(0, len(raw), 4))
+            found.add((socket.inet_ntop(family, raw), int(port, 16)))
+    return found
+
+
 def _alive(pid: int) -> bool:
     try:
         state = Path(f"/proc/{pid}/stat").read_text().split(")")[-1].split()[0]
@@ -228,6 +250,10 @@ def test_sigterm_stops_the_ray_cluster_the_run_started(gl_context, tmp_path, wri
         time.sleep(0.2)
     started |= _descendants(process.pid)
     assert process.poll() is None and len(started) >= 3  # gcs, raylet, workers ...
+    listening = _listening_addresses(started | {process.pid})
+    assert len(listening) >= 4, listening  # driver, gcs, raylet, agents, workers
+    # only loopback (Ray puts a loopback node address on the machine's reachable one unless told not to)
+    assert {address for address, _ in listening} <= {"127.0.0.1", "::ffff:127.0.0.1", "::1"}, listening
     os.kill(process.pid, signal.SIGTERM)
     assert process.wait(timeout=120) == 143
     deadline = time.monotonic() + 30
