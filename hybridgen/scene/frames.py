@@ -78,6 +78,8 @@ def euler_xyz_to_matrix(angles: Sequence[float]) -> np.ndarray:
     values = np.asarray(angles, dtype=np.float64).ravel()
     if values.size != 3:
         raise ValueError(f"Euler XYZ rotation needs 3 angles, got {list(values)}")
+    if not values.any():  # no rotation (every loader's default): SciPy's exact identity, without importing it
+        return np.eye(3)
     return _rotation().from_euler("xyz", values).as_matrix()
 
 
