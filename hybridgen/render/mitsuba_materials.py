@@ -152,3 +152,19 @@ def bsdf_dict(material: Material, owner: str, *, vertex_colors: bool = False) ->
         if alpha < 1.0:
             bsdf = {"type": "mask", "opacity": alpha, "material": bsdf}
     return bsdf
+
+
+def loaded_bsdf(material: Material, owner: str, *, vertex_colors: bool = False,
+                cache: dict[Any, Any] | None = None) -> Any:
+    """The Mitsuba BSDF object of ``material``; with ``cache`` (one per scene build), equal materials get the
+    same object, so their textures are read and held once however many shapes use them."""
+    import mitsuba as mi
+
+    from .shared_geometry import material_key
+
+    if cache is None:
+        return mi.load_dict(bsdf_dict(material, owner, vertex_colors=vertex_colors))
+    key = (material_key(material), vertex_colors and material.base_color_from_vertices)
+    if key not in cache:
+        cache[key] = mi.load_dict(bsdf_dict(material, owner, vertex_colors=vertex_colors))
+    return cache[key]

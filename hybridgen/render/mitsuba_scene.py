@@ -30,7 +30,7 @@ from ..scene.mesh_object import MeshObject
 from ..scene.scene import Scene, World
 from . import light_selection
 from .mitsuba_instances import instanced_entries
-from .mitsuba_materials import VERTEX_COLOR_ATTRIBUTE, bsdf_dict
+from .mitsuba_materials import VERTEX_COLOR_ATTRIBUTE, loaded_bsdf
 from .mitsuba_materials import rgb as _rgb
 
 ENVMAP_TO_WORLD = np.array([[0.0, 0, 1, 0], [1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 0, 1]])
@@ -57,7 +57,8 @@ def _world_normals(obj: MeshObject) -> np.ndarray:
     return normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
 
 
-def mesh_shape(obj: MeshObject, *, back_side: bool = False, sampling_weight: float = 1.0) -> Any:
+def mesh_shape(obj: MeshObject, *, back_side: bool = False, sampling_weight: float = 1.0,
+               bsdfs: dict[Any, Any] | None = None) -> Any:
     """An in-memory Mitsuba mesh of ``obj`` in world coordinates, with its BSDF (and emitter if emissive).
 
     ``back_side`` gives the emitting back of an emissive mesh: faces flipped and moved a hair (1e-6 of the
@@ -68,7 +69,7 @@ def mesh_shape(obj: MeshObject, *, back_side: bool = False, sampling_weight: flo
 
     props = mi.Properties()
     colored = obj.vertex_colors is not None and obj.material.base_color_from_vertices
-    props["bsdf"] = mi.load_dict(bsdf_dict(obj.material, obj.name, vertex_colors=colored))
+    props["bsdf"] = loaded_bsdf(obj.material, obj.name, vertex_colors=colored, cache=bsdfs)
     radiance = emitted_radiance(obj)
     if np.any(radiance > 0):
         props["emitter"] = mi.load_dict({"type": "area", "radiance": _rgb(radiance),
@@ -181,15 +182,17 @@ def scene_dict(scene: Scene) -> dict[str, Any]:
     weights = light_selection.normalised(powers)
     if world is not None:
         out["world"] = {**world, "sampling_weight": weights["world"]}
-    shared, instanced = instanced_entries(scene.objects, mesh_shape, lambda o: f"object_{o.instance_id}" in weights)
+    bsdfs: dict[Any, Any] = {}  # equal materials share one BSDF (textures read once)
+    shared, instanced = instanced_entries(scene.objects, lambda o: mesh_shape(o, bsdfs=bsdfs),
+                                          lambda o: f"object_{o.instance_id}" in weights)
     out.update(shared)
     for obj in scene.objects:
         key = f"object_{obj.instance_id}"
         if obj.instance_id in instanced:  # one shapegroup per shared geometry (render/mitsuba_instances.py)
             continue
-        out[key] = mesh_shape(obj, sampling_weight=weights.get(key, 1.0))
+        out[key] = mesh_shape(obj, sampling_weight=weights.get(key, 1.0), bsdfs=bsdfs)
         if key in weights:
-            out[f"{key}_back"] = mesh_shape(obj, back_side=True, sampling_weight=weights[key])
+            out[f"{key}_back"] = mesh_shape(obj, back_side=True, sampling_weight=weights[key], bsdfs=bsdfs)
     for index, light in enumerate(scene.lights):
         description = light_dict(light)
         weight = weights[f"light_{index}"]

@@ -2,6 +2,8 @@
 same as with every placement uploaded on its own."""
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 
 import hybridgen as hg
@@ -53,3 +55,31 @@ def test_shared_placements_render_the_same(gl_context, monkeypatch):
     assert len(np.unique(shared_labels["instance_segmaps"])) == 6  # background, floor, four boxes
     # Mitsuba intersects instances in their local frame: the same image up to float rounding
     np.testing.assert_allclose(shared_color, own_color, atol=2e-3)
+
+
+def test_equal_materials_share_one_bsdf_and_read_textures_once(monkeypatch):
+    """Six walls with one ambientCG-like material: its maps are turned into Mitsuba textures once."""
+    import mitsuba as mi
+
+    from hybridgen.render import mitsuba_materials
+
+    mi.set_variant(choose_variant())
+
+    calls: list[str] = []
+    real = mitsuba_materials.data_texture
+
+    def counting(texture, owner, slot, **kwargs):
+        calls.append(slot)
+        return real(texture, owner, slot, **kwargs)
+
+    monkeypatch.setattr(mitsuba_materials, "data_texture", counting)
+    ramp = np.tile(np.arange(0, 256, 32, dtype=np.uint8), (8, 1))
+    material = hg.Material(roughness_texture=ramp, displacement_texture=ramp)
+    scene = hg.Scene()
+    for i in range(6):
+        wall = hg.make_primitive("plane", 2.0, name=f"wall{i}", category_id=1)
+        wall.material = copy.copy(material)  # equal, not the same object
+        wall.local2world = hg.object_pose([3.0 * i, 0, 0])
+        scene.add(wall)
+    scene_dict(scene)
+    assert sorted(calls) == ["displacement_texture", "roughness_texture"]
