@@ -43,6 +43,8 @@ from . import pixel_filter
 
 CYCLES_THRESHOLD_SCALE = 5.0
 """The error estimate is compared with ``noise_threshold`` times this (Cycles' own factor)."""
+LAUNCH_STREAM = 1 << 20
+"""Round index (never reached by adaptive rounds) whose seeds the second and later launches of one trace use."""
 MAX_WAVEFRONT = 1 << 22
 """Samples per kernel launch at most (bounds the per-sample output arrays to ~50 MB)."""
 
@@ -132,7 +134,7 @@ class PixelTracer:
         An odd ``spp`` (fixed-count rendering only) leaves the odd sample in the first sum."""
         sum_a, sum_b = np.zeros((len(pixels), 3)), np.zeros((len(pixels), 3))
         for index, count in enumerate(launch_counts(spp, self.sensor.sampler().class_name())):
-            a, b = self._launch(pixels, count, seed if index == 0 else round_seed(seed, -1, index))
+            a, b = self._launch(pixels, count, seed if index == 0 else round_seed(seed, LAUNCH_STREAM, index))
             sum_a += a
             sum_b += b
         return sum_a, sum_b

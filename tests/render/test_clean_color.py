@@ -252,3 +252,26 @@ def test_scalar_variant_samples_adaptively_through_whole_frames():
     assert counts.min() == 8 and counts.max() == 64 and set(np.unique(counts)) <= {8, 16, 32, 64}
     reference = view.render(scene.camera.keypoints[0], seed=2, spp=256)
     assert image.mean() == pytest.approx(reference.mean(), rel=0.03)
+
+
+def test_stratified_sampler_launches_power_of_two_patterns(variant):
+    """The low-discrepancy sampler takes 4^k-point patterns: a count is traced as power-of-two launches (each
+    the first half or all of such a pattern), so any fixed spp works, deterministically and unbiased."""
+    from hybridgen.render.adaptive_sampling import launch_counts, pattern_size
+
+    assert launch_counts(100, "LowDiscrepancySampler") == [64, 32, 4]
+    assert launch_counts(7, "LowDiscrepancySampler") == [4, 2, 1]
+    assert launch_counts(100, "IndependentSampler") == [100]
+    assert [pattern_size(n, "LowDiscrepancySampler") for n in (1, 2, 16, 32, 512, 1024)] == [1, 4, 16, 64, 1024, 1024]
+    if not is_jit(variant):
+        pytest.skip("pixel launches are the JIT variants' tracer")
+    scene = _half_lit_scene()
+    view = PathTraceView(scene, PathTraceSettings(samples=7, max_bounces=1), variant=variant)
+    pose = scene.camera.keypoints[0]
+    image, counts = view.render_with_counts(pose, seed=3)
+    assert (counts == 7).all()
+    assert view.render(pose, seed=3).tobytes() == image.tobytes()
+    reference = view.render(pose, seed=11, spp=1024)
+    lit = reference[..., 0] > 0.05
+    assert lit.sum() > 50
+    assert image[lit].mean() == pytest.approx(reference[lit].mean(), rel=0.03)
