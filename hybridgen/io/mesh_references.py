@@ -22,9 +22,26 @@ def referenced_files(path: Path) -> list[Path]:
     suffix = path.suffix.lower()
     if suffix not in (".obj", ".mtl") or path.stat().st_size > MAX_SCANNED_BYTES:
         return []
-    pattern = _MTLLIB if suffix == ".obj" else _MAPS
-    names = [m.group(1).decode("utf-8", "replace") for m in pattern.finditer(path.read_bytes())]
+    data = path.read_bytes()
+    matches = _mtllib_statements(data) if suffix == ".obj" else _MAPS.finditer(data)
+    names = [m.group(1).decode("utf-8", "replace") for m in matches]
     return [path.parent / name.replace("\\", "/") for name in names]
+
+
+def _mtllib_statements(data: bytes) -> list[re.Match[bytes]]:
+    """``_MTLLIB``'s matches in an OBJ's bytes, found by looking only at the lines that contain ``mtllib``
+    (a regex tried at every line start of a 10 MB OBJ took ~0.2 s, twice per run)."""
+    matches = []
+    start = data.find(b"mtllib")
+    while start >= 0:
+        line_start = data.rfind(b"\n", 0, start) + 1
+        line_end = data.find(b"\n", start)
+        line_end = len(data) if line_end < 0 else line_end
+        match = _MTLLIB.match(data, line_start, line_end)
+        if match is not None:
+            matches.append(match)
+        start = data.find(b"mtllib", line_end)
+    return matches
 
 
 def missing_references(path: Path) -> list[Path]:
