@@ -275,3 +275,20 @@ def test_stratified_sampler_launches_power_of_two_patterns(variant):
     lit = reference[..., 0] > 0.05
     assert lit.sum() > 50
     assert image[lit].mean() == pytest.approx(reference[lit].mean(), rel=0.03)
+
+
+def test_denoiser_import_does_not_pull_in_torch():
+    """pyoidn imports torch when installed (~1 s of CPU per process); hybridgen hides it while importing pyoidn
+    and still denoises, and torch stays importable afterwards."""
+    pytest.importorskip("pyoidn")
+    import subprocess
+    import sys
+
+    code = ("import sys, numpy as np\n"
+            "from hybridgen.render.denoise import denoise, require_oidn\n"
+            "require_oidn()\n"
+            "assert 'torch' not in sys.modules, 'torch was imported'\n"
+            "x = np.full((8, 8, 3), 0.5, np.float32)\n"
+            "assert abs(float(denoise(x, x, x).mean()) - 0.5) < 0.01\n")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr[-2000:]
