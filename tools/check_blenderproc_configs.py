@@ -8,7 +8,8 @@ PATH is a BlenderProc working tree (its ``examples/`` is read) or a bare git mir
 repository). Configs run from the checkout's root, as BlenderProc runs them, so paths they name resolve. For each
 ``examples/**/*.yaml`` the tool makes stand-in inputs for its ``<args:N>`` from the config's ``# Args:``
 line (a Y-up OBJ with several ``o`` objects, a camera pose file, a small BOP dataset, a texture, an output
-folder ...), then
+folder ...) and, for a mesh file the config names by a checkout path that the checkout lacks (a mirror holds no
+large blobs), the stand-in OBJ or a box PLY at that path; then
 
 - validates: hybridgen reads the config and every module's keys (``load_config`` + ``build_modules``);
 - with ``--run``, runs the valid ones end to end on the stand-ins, each in its own process stopped after
@@ -160,6 +161,27 @@ def standin_args(config: Path, work: Path, output: Path) -> list[str]:
     return args
 
 
+def fill_missing_meshes(config: Path, root: Path) -> list[str]:
+    """Stand-ins for mesh files ``config`` names by a checkout path the checkout lacks (a mirror holds no
+    large blobs): the stand-in OBJ (and its MTL) or a box PLY; returns the paths made."""
+    import trimesh
+
+    made = []
+    for name in re.findall(r'"([^"<>:]+\.(?:obj|ply))"', config.read_text()):
+        target = root / name
+        if Path(name).is_absolute() or target.exists():
+            continue
+        target.parent.mkdir(parents=True, exist_ok=True)
+        if name.endswith(".obj"):
+            target.write_text(STANDIN_OBJ)
+            if not (target.parent / "scene.mtl").exists():
+                (target.parent / "scene.mtl").write_text(STANDIN_MTL)
+        else:
+            trimesh.creation.box(extents=[0.1, 0.1, 0.1]).export(target)
+        made.append(name)
+    return made
+
+
 def example_inputs(config: Path, root: Path) -> list[str | None]:
     """The inputs the example's README runs ``config`` with (``python run.py <config> <args>``): each argument
     that names a file or folder of the checkout, None for the others (outputs, datasets to download)."""
@@ -248,6 +270,7 @@ def check(config: Path, root: Path, run: bool, work: Path, output: Path, use_exa
     set_sink(lines.append)
     name = str(config.relative_to(root))
     args = standin_args(config, work, output)
+    fill_missing_meshes(config, root)
     if use_example_inputs:  # the example's own files where the checkout has them
         for index, given in enumerate(example_inputs(config, root)[:len(args)]):
             if given is not None:
