@@ -188,6 +188,10 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
         interrupted = False
     finally:
         pool.shutdown(interrupted)
+        if interrupted and plan.staged:
+            from .staged_output import remove_empty_staging
+
+            remove_empty_staging(plan.output_dir / plan.folder)
     outputs = []
     shards = complete_shards(plan)
     if shards is not None and plan.staged:

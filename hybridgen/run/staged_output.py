@@ -188,6 +188,14 @@ def consolidate(target: Path, parts: list[Path]) -> Path:
         raise
 
 
+def remove_empty_staging(folder: Path) -> None:
+    """After a failed or interrupted staged run: delete the staging folder when no part was completed (a
+    run that failed before finishing one part leaves nothing behind); completed parts are kept for the
+    rerun to resume from."""
+    if folder.is_dir() and not folder.is_symlink() and not any(folder.glob("scene_*_chunk_*.hdf5")):
+        shutil.rmtree(folder, ignore_errors=True)
+
+
 def remove_staging(folder: Path) -> None:
     """Delete the staging folder once its parts are merged (also temporary files of killed attempts)."""
     if folder.is_dir() and not folder.is_symlink():

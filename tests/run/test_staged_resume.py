@@ -206,3 +206,30 @@ def test_resumed_parts_build_the_scene_once_and_give_the_direct_bytes(reference,
     assert context.outputs[0].read_bytes() == data
     with h5py.File(out / "data.hdf5", "r") as h5:  # every keypoint rendered, each from its own camera
         assert h5["depth"].shape[0] == 7 and len({h5["depth"][i].tobytes() for i in range(7)}) == 7
+
+
+def test_failed_run_keeps_completed_parts_and_resumes(reference, run_cli, monkeypatch):
+    """An error (not a kill) in the third part: the run exits 2, keeps the two completed parts (a failure
+    before the first part completes leaves no staging folder: tests/config/test_config_errors.py), and the
+    rerun renders the rest into the reference bytes."""
+    from hybridgen.errors import InputError
+    from hybridgen.io.hdf5_single import Hdf5SingleFileWriter
+
+    config, out, data = reference
+    write = Hdf5SingleFileWriter.write
+
+    def failing_write(self, index, values):
+        if "chunk_00002" in self.path.name:
+            raise InputError("simulated failure in part 2")
+        return write(self, index, values)
+
+    monkeypatch.setattr(Hdf5SingleFileWriter, "write", failing_write)
+    code, _, err = run_cli("run", "-q", str(config), str(out))
+    assert code == 2 and "simulated failure in part 2" in err
+    staging = out / staging_folder_name("data.hdf5")
+    assert sorted(p.name for p in staging.iterdir()) == ["scene_000000_chunk_00000.hdf5",
+                                                          "scene_000000_chunk_00001.hdf5"]
+    monkeypatch.setattr(Hdf5SingleFileWriter, "write", write)
+    code, _, err = run_cli("run", str(config), str(out))
+    assert code == 0 and "resumed: 2 unit(s)" in err
+    assert (out / "data.hdf5").read_bytes() == data and not staging.exists()
