@@ -104,7 +104,8 @@ def example_configs(path: Path, tag: str | None, into: Path) -> list[Path]:
         return sorted((path / "examples").rglob("*.yaml"))
     if tag is None:
         raise SystemExit(f"{path} has no examples/ folder; for a bare git mirror give --tag (e.g. v1.12.0)")
-    names = subprocess.run(["git", "-C", str(path), "ls-tree", "-r", "--name-only", tag, "examples"],
+    names = subprocess.run(["git", "-C", str(path), "ls-tree", "-r", "--name-only", tag, "examples",
+                            "resources/id_mappings"],  # label mappings dataset loaders read by default
                            check=True, capture_output=True, text=True).stdout.split()
     configs = []
     for name in names:  # every example file the mirror holds (inputs a config names by path, too)
@@ -154,6 +155,9 @@ def standin_args(config: Path, work: Path, output: Path) -> list[str]:
     for key, value in usage.items():
         for index in re.findall(rf'"{key}"\s*:\s*"<args:(\d+)>"', text):
             args[int(index)] = str(value)
+    for index, value in dataset_standins(text, work).items():
+        if index < len(args):
+            args[index] = value
     for root, name in re.findall(r'"bop_dataset_path"\s*:\s*"<args:(\d+)>/<args:(\d+)>"', text):
         args[int(root)], args[int(name)] = str(work / "bop"), BOP_NAME
     for root in re.findall(r'"bop_dataset_path"\s*:\s*"<args:(\d+)>/\w+"', text):
@@ -194,6 +198,86 @@ def example_inputs(config: Path, root: Path) -> list[str | None]:
         if len(words) > 2 and words[:3] == ["python", "run.py", relative]:
             return [w if "output" not in w and (root / w).exists() else None for w in words[3:]]
     return []
+
+
+def _box_obj(path: Path, size: tuple[float, float, float], mtl: bool = False) -> None:
+    """A box OBJ (file axes, y up) of ``size`` standing on y = 0, optionally with an MTL next to it."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    x, y, z = (s / 2 for s in size)
+    corners = [(a, b, c) for a in (-x, x) for b in (0, 2 * y) for c in (-z, z)]
+    quads = [(1, 2, 4, 3), (5, 7, 8, 6), (1, 5, 6, 2), (3, 4, 8, 7), (1, 3, 7, 5), (2, 6, 8, 4)]
+    lines = [f"mtllib {path.stem}.mtl", "usemtl body"] if mtl else []
+    lines += [f"v {a} {b} {c}" for a, b, c in corners] + ["vt 0 0", "vt 1 0", "vt 1 1", "vt 0 1"]
+    lines += [f"f {a}/1 {b}/2 {c}/3 {d}/4" for a, b, c, d in quads]
+    path.write_text("\n".join(lines) + "\n")
+    if mtl:
+        path.with_suffix(".mtl").write_text("newmtl body\nKd 0.6 0.5 0.4\n")
+
+
+def _args_of(text: str, key: str) -> list[int]:
+    return [int(i) for i in re.findall(rf'"{key}"\s*:\s*"<args:(\d+)>"', text)]
+
+
+def dataset_standins(text: str, work: Path) -> dict[int, str]:
+    """Stand-in layouts for the dataset loaders a config uses, with the ids and categories it asks for:
+    ShapeNetCore.v2 (taxonomy.json, <synset>/<model>/models/model_normalized.obj), Pix3D (pix3d.json +
+    model/<category>/...), IKEA (IKEA/IKEA_<category>_<style>/ with .mtl) and a SceneNet room with its texture
+    folder. Returns {argument index: path}."""
+    import json
+
+    from PIL import Image
+
+    out: dict[int, str] = {}
+    if "loader.ShapeNetLoader" in text:
+        root = work / "ShapeNetCore.v2"
+        synsets = re.findall(r'"used_synset_id"\s*:\s*"(\w+)"', text)
+        sources = re.findall(r'"used_source_id"\s*:\s*"(\w+)"', text)
+        taxonomy = []
+        for i, synset in enumerate(synsets):
+            model = sources[i] if i < len(sources) else "standin"
+            _box_obj(root / synset / model / "models" / "model_normalized.obj", (0.3, 0.2, 0.4))
+            taxonomy.append({"synsetId": synset, "name": f"synset {synset}", "children": [], "numInstances": 1})
+        root.mkdir(parents=True, exist_ok=True)
+        (root / "taxonomy.json").write_text(json.dumps(taxonomy))
+        if "loader.Pix3DLoader" not in text:
+            out.update({i: str(root) for i in _args_of(text, "data_path")})
+    if "loader.Pix3DLoader" in text:
+        root = work / "pix3d"
+        annotations = []
+        for category in re.findall(r'"used_category"\s*:\s*"(\w+)"', text) or ["chair"]:
+            _box_obj(root / "model" / category / "standin" / "model.obj", (1.0, 0.5, 2.0))
+            annotations.append({"category": category, "model": f"model/{category}/standin/model.obj"})
+        root.mkdir(parents=True, exist_ok=True)
+        (root / "pix3d.json").write_text(json.dumps(annotations))
+        out.update({i: str(root) for i in _args_of(text, "data_path")})
+    if "loader.IKEALoader" in text:
+        root = work / "ikea"
+        for category in re.findall(r'"category"\s*:\s*"(\w+)"', text) or ["chair"]:
+            _box_obj(root / "IKEA" / f"IKEA_{category}_STANDIN" / "standin.obj", (1.2, 0.75, 0.8), mtl=True)
+        out.update({i: str(root) for i in _args_of(text, "data_dir")})
+    if "loader.SceneNetLoader" in text:
+        room = work / "scenenet" / "1Bedroom" / "bedroom_standin.obj"
+        room.parent.mkdir(parents=True, exist_ok=True)
+        parts = [("floor", "ground_mat", (8.0, 0.0, 8.0)), ("Bed", "bed_01", (2.0, 0.6, 1.6)),
+                 ("Chair", "Wood_2", (0.5, 0.9, 0.5))]
+        lines, offset = ["mtllib bedroom_standin.mtl", "vt 0 0", "vt 1 0", "vt 1 1"], 0
+        for index, (name, material, (sx, sy, sz)) in enumerate(parts):
+            x0 = 2.5 * index - 2.5
+            corners = [(x0 - sx / 2, 0, -sz / 2), (x0 + sx / 2, 0, -sz / 2), (x0 + sx / 2, sy, sz / 2),
+                       (x0 - sx / 2, sy, sz / 2)]
+            lines += [f"o {name}", f"usemtl {material}"] + [f"v {a} {b} {c}" for a, b, c in corners]
+            lines += [f"f {offset + 1}/1 {offset + 2}/2 {offset + 3}/3",
+                      f"f {offset + 1}/1 {offset + 3}/3 {offset + 4}/1"]
+            offset += 4
+        room.write_text("\n".join(lines) + "\n")
+        room.with_suffix(".mtl").write_text("".join(f"newmtl {m}\nKd 0.5 0.5 0.5\n" for _, m, _ in parts))
+        textures = work / "scenenet_textures"
+        for folder in ("bed", "Wood", "ground", "unknown"):
+            (textures / folder).mkdir(parents=True, exist_ok=True)
+            Image.new("RGB", (8, 8), (120, 100, 80)).save(textures / folder / f"{folder}_0.jpg")
+        out.update({i: str(room) for i in _args_of(text, "file_path")})
+        out.update({i: str(textures) for i in _args_of(text, "texture_folder")})
+    return out
 
 
 BOP_NAME = "lm"

@@ -15,6 +15,7 @@ ALIASES = {
     "manipulators.FloorExtractor": "object.FloorExtractor",
     "object.ObjectReplacer": "object.ObjectSwapper",
     "constructor.BasicMeshInitializer": "loader.PrimitiveLoader",
+    "writer.ShapeNetWriter": "writer.ObjectStateWriter",  # the ids are attributes in object_states
 }
 """BlenderProc module name -> the hybridgen module that does its work (keys translated below)."""
 
@@ -27,7 +28,6 @@ UNAVAILABLE = {
                               "with a selector for the lamp objects",
     "camera.SuncgCameraSampler": "samples cameras inside SUNCG rooms (a withdrawn dataset); use "
                                  "camera.CameraSampler with proximity_checks",
-    "writer.ShapeNetWriter": "writes ShapeNet ids of the loader hybridgen does not have; use attributes + map_by",
     "camera.Front3DCameraSampler": "samples inside 3D-FRONT rooms; use camera.CameraSampler with "
                                    "proximity_checks",
     "camera.ReplicaCameraSampler": "samples inside Replica scenes; use camera.CameraSampler with proximity_checks",
