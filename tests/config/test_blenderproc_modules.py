@@ -32,6 +32,7 @@ renderer.FlowRenderer constructor.RandomRoomConstructor writer.StereoGlobalMatch
 composite.CameraObjectSampler loader.IKEALoader loader.Pix3DLoader loader.ReplicaLoader
 loader.RockEssentialsRockLoader constructor.RockEssentialsGroundConstructor materials.RockEssentialsTextureSampler
 writer.ShapeNetWriter object.ObjectReplacer loader.PlyLoader manipulators.FloorExtractor
+loader.TextureLoader loader.VisNormalImage
 """.split()
 
 
