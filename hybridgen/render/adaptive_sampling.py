@@ -190,8 +190,9 @@ class PixelTracer:
 
 def pattern_size(spp: int, sampler: str) -> int:
     """The sample count to give ``sampler`` for a launch of ``spp`` samples per pixel: the low-discrepancy
-    sampler's patterns have 4^k points (it warns and rounds up otherwise); a launch of 2^k of them uses the
-    first half of the 4^(k+1/2)-point pattern, itself a stratified (0, k, 2)-net."""
+    sampler's patterns have 4^k points (it warns and rounds up otherwise); a launch of 2^(2k+1) samples takes
+    half of a 4^(k+1)-point pattern (a random half: the sampler shuffles the sample order per dimension;
+    measured on the tabletop scene, as clean as splitting it into two full 4^k patterns)."""
     if sampler != "LowDiscrepancySampler" or spp & (spp - 1):
         return spp
     return spp if spp.bit_length() % 2 == 1 else spp * 2

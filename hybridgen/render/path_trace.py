@@ -28,10 +28,11 @@ OPENCV_TO_MITSUBA = np.diag([-1.0, -1.0, 1.0, 1.0])
 
 SAMPLER = "ldsampler"
 """Mitsuba's sample generator: its low-discrepancy sampler (a scrambled (0, 2)-sequence per pair of
-dimensions), stratified like Cycles' Sobol pattern; the first and second half of a pixel's 2^k samples are
-each stratified too, so adaptive sampling's half-buffer error estimate measures this estimator's error.
-Against Mitsuba's default ``independent`` random numbers it lowers the noise of the tabletop scene of
-tools/color_quality.py at 16 / 64 / 256 spp from 28.5 / 34.3 / 40.1 dB to 35.3 / 40.7 / 45.5 dB (PSNR
+dimensions, the sample order shuffled per dimension), stratified like Cycles' Sobol pattern. Because of the
+shuffle, the two halves adaptive sampling compares are random halves of a stratified set, so its error
+estimate is conservative (it sees more noise than the full estimate has) and pixels may get more samples
+than the threshold strictly needs. Against Mitsuba's default ``independent`` random numbers it lowers the
+noise of the tabletop scene of tools/color_quality.py at 16 / 64 / 256 spp from 28.5 / 34.3 / 40.1 dB to 35.3 / 40.7 / 45.5 dB (PSNR
 against a 4096-spp reference): as clean as 8-16x the samples, for ~15 % more CPU time per sample. Sample
 counts are traced in power-of-two launches (:func:`hybridgen.render.adaptive_sampling.launch_counts`)."""
 
