@@ -258,21 +258,25 @@ def dataset_standins(text: str, work: Path) -> dict[int, str]:
     if "loader.SceneNetLoader" in text:
         room = work / "scenenet" / "1Bedroom" / "bedroom_standin.obj"
         room.parent.mkdir(parents=True, exist_ok=True)
-        parts = [("floor", "ground_mat", (8.0, 0.0, 8.0)), ("Bed", "bed_01", (2.0, 0.6, 1.6)),
-                 ("Chair", "Wood_2", (0.5, 0.9, 0.5))]
+        # SceneNet rooms hold their floor inside the walls' object (BlenderProc's examples split it off with
+        # object.FloorExtractor); quads: (name, material, corners in file axes, y up)
+        parts = [("Wall", "wall_paint", [[(-4, 0, 4), (4, 0, 4), (4, 0, -4), (-4, 0, -4)],
+                                         [(-4, 0, -4), (4, 0, -4), (4, 3, -4), (-4, 3, -4)]]),
+                 ("Ceiling", "ceiling_white", [[(-4, 3, -4), (4, 3, -4), (4, 3, 4), (-4, 3, 4)]]),
+                 ("Bed", "bed_01", [[(-2, 0.6, 1), (0, 0.6, 1), (0, 0.6, -1), (-2, 0.6, -1)]]),
+                 ("Chair", "Wood_2", [[(1, 0.5, 1), (1.5, 0.5, 1), (1.5, 0.5, 0.5), (1, 0.5, 0.5)]])]
         lines, offset = ["mtllib bedroom_standin.mtl", "vt 0 0", "vt 1 0", "vt 1 1"], 0
-        for index, (name, material, (sx, sy, sz)) in enumerate(parts):
-            x0 = 2.5 * index - 2.5
-            corners = [(x0 - sx / 2, 0, -sz / 2), (x0 + sx / 2, 0, -sz / 2), (x0 + sx / 2, sy, sz / 2),
-                       (x0 - sx / 2, sy, sz / 2)]
-            lines += [f"o {name}", f"usemtl {material}"] + [f"v {a} {b} {c}" for a, b, c in corners]
-            lines += [f"f {offset + 1}/1 {offset + 2}/2 {offset + 3}/3",
-                      f"f {offset + 1}/1 {offset + 3}/3 {offset + 4}/1"]
-            offset += 4
+        for name, material, quads in parts:
+            lines += [f"o {name}", f"usemtl {material}"]
+            for quad in quads:
+                lines += [f"v {a} {b} {c}" for a, b, c in quad]
+                lines += [f"f {offset + 1}/1 {offset + 2}/2 {offset + 3}/3",
+                          f"f {offset + 1}/1 {offset + 3}/3 {offset + 4}/1"]
+                offset += 4
         room.write_text("\n".join(lines) + "\n")
         room.with_suffix(".mtl").write_text("".join(f"newmtl {m}\nKd 0.5 0.5 0.5\n" for _, m, _ in parts))
         textures = work / "scenenet_textures"
-        for folder in ("bed", "Wood", "ground", "unknown"):
+        for folder in ("bed", "Wood", "wall", "ceiling", "unknown"):
             (textures / folder).mkdir(parents=True, exist_ok=True)
             Image.new("RGB", (8, 8), (120, 100, 80)).save(textures / folder / f"{folder}_0.jpg")
         out.update({i: str(room) for i in _args_of(text, "file_path")})

@@ -46,8 +46,8 @@ class Selector:
 def _attribute(obj: Any, key: str) -> Any:
     if key == "name":
         return obj.name
-    if key in ("category_id", "instance_id"):
-        return getattr(obj, key)
+    if key in ("category_id", "instance_id", "cp_category_id"):  # BlenderProc's custom property is the category
+        return getattr(obj, key.removeprefix("cp_"))
     if key == "material_name":  # BlenderProc's getter.Material selects by material name
         return obj.material.name
     name = key[3:] if key.startswith("cp_") else key

@@ -48,3 +48,13 @@ def test_values_of_every_kind(tmp_path):
     assert object_value(cube, "cp_mass") == 4 and object_value(cube, "name") == "Cube"
     with pytest.raises(ConfigError, match="get must be one of"):
         _sphere_location(tmp_path, '{"provider": "getter.Attribute", %s, "get": "colour"}' % CUBES)
+
+
+def test_cp_category_id_conditions_select_by_the_category(tmp_path):
+    """add_properties' cp_category_id is the object's category, so a cp_category_id condition selects by it."""
+    text = SCENE.replace('"conditions": {"name": "Sphere"}', '"conditions": {"cp_category_id": 7}')
+    text = text.replace('"location": [0, 0, 9]}', '"location": [0, 0, 9], "add_properties": {"cp_category_id": 7}}')
+    scene = run_config_text(tmp_path, text.replace("GETTER", "[5, 6, 7]") % tmp_path).scene
+    assert scene.by_name("Sphere").category_id == 7
+    np.testing.assert_allclose(scene.by_name("Sphere").local2world[:3, 3], [5, 6, 7])
+    np.testing.assert_allclose(scene.by_name("Cube").local2world[:3, 3], [1, 2, 3])
