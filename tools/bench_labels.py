@@ -331,13 +331,22 @@ def check_output(path: Path, spec: Path) -> None:
                          f"({json.loads(spec.read_text())['meshes'][0]['path']})")
 
 
-def run_timed(command: list[str], env: dict[str, str]) -> float:
-    """Wall seconds of one whole process (fails loudly)."""
+def run_timed(command: list[str], env: dict[str, str], cpu: list[float] | None = None) -> float:
+    """Wall seconds of one whole process (fails loudly); appends its CPU seconds (user + system, all its threads:
+    llvmpipe's too) to ``cpu`` - steadier than wall time while other processes share the cores."""
     start = time.perf_counter()
-    done = subprocess.run(command, env=env, capture_output=True, text=True)
-    elapsed = time.perf_counter() - start
-    if done.returncode != 0:
-        raise SystemExit(f"{' '.join(command)} failed ({done.returncode}):\n{done.stdout[-2000:]}{done.stderr[-4000:]}")
+    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
+        process = subprocess.Popen(command, env=env, stdout=out, stderr=err)
+        _, status, usage = os.wait4(process.pid, 0)
+        elapsed = time.perf_counter() - start
+        code = os.waitstatus_to_exitcode(status)
+        if code != 0:
+            out.seek(0)
+            err.seek(0)
+            raise SystemExit(f"{' '.join(command)} failed ({code}):\n{out.read()[-2000:].decode(errors='replace')}"
+                             f"{err.read()[-4000:].decode(errors='replace')}")
+    if cpu is not None:
+        cpu.append(usage.ru_utime + usage.ru_stime)
     return elapsed
 
 
@@ -350,10 +359,11 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
     print(f"\nwhole processes, {count} keypoints, {rounds} alternating rounds, medians; 1st kp = a whole run of one "
           "keypoint (cold cache: once, with an empty mesh cache); hybridgen run = labels-only "
           "config (depth + normals + class + instance, default writer); pyrender = script loading the same files, "
-          "rendering depth + seg of the same poses, writing nothing; mesh cache in "
+          "rendering depth + seg of the same poses, writing nothing; ratio = pyrender's wall time / ours, cpu ratio = "
+          "the same for CPU seconds of the whole processes (user + system, every thread); mesh cache in "
           f"{cache_dir} (warmed by an untimed run)")
     print(f"{'scene':<20} {'resolution':<10} {'raw fps':>8} {'e2e fps':>8} {'run fps':>8} {'pyrender':>9} "
-          f"{'ratio':>6} {'MB/kp':>6} {'1st kp run':>11} {'cold cache':>11} {'1st kp pyr':>11}")
+          f"{'ratio':>6} {'cpu ratio':>9} {'MB/kp':>6} {'1st kp run':>11} {'cold cache':>11} {'1st kp pyr':>11}")
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         for name in names:
@@ -369,27 +379,29 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
                 shutil.rmtree(work / "warm", ignore_errors=True)
                 run_timed([*hybridgen, "run", "--quiet", str(config1), str(work / "warm")], env)  # warms caches
                 times: dict[str, list[float]] = {"ours": [], "theirs": [], "ours1": [], "theirs1": []}
+                cpu: dict[str, list[float]] = {"ours": [], "theirs": []}
                 size = 0
                 for r in range(rounds):
                     order = ("ours", "theirs") if r % 2 == 0 else ("theirs", "ours")
                     for engine in order:
                         if engine == "ours":
                             shutil.rmtree(out, ignore_errors=True)
-                            times["ours"].append(run_timed(ours_cmd, env))
+                            times["ours"].append(run_timed(ours_cmd, env, cpu["ours"]))
                             size = sum(f.stat().st_size for f in out.rglob("*.hdf5"))
                             check_output(out / "data.hdf5", spec)
                             shutil.rmtree(work / "one", ignore_errors=True)
                             times["ours1"].append(run_timed([*hybridgen, "run", "--quiet", str(config1),
                                                              str(work / "one")], env))
                         else:
-                            times["theirs"].append(run_timed(theirs_cmd, env))
+                            times["theirs"].append(run_timed(theirs_cmd, env, cpu["theirs"]))
                             times["theirs1"].append(run_timed([sys.executable, __file__, PYRENDER_SCRIPT,
                                                                str(spec1)], env))
                 med = {k: statistics.median(v) for k, v in times.items()}
                 raw = ask("ours", "raw", name, resolution, 8)
                 e2e, _ = ask("ours", "hdf5", name, resolution, 8, "default")
                 print(f"{name:<20} {resolution:<10} {raw:>8.1f} {e2e:>8.1f} {count / med['ours']:>8.1f} "
-                      f"{count / med['theirs']:>9.1f} {med['theirs'] / med['ours']:>6.2f} {size / count / 1e6:>6.2f} "
+                      f"{count / med['theirs']:>9.1f} {med['theirs'] / med['ours']:>6.2f} "
+                      f"{statistics.median(cpu['theirs']) / statistics.median(cpu['ours']):>9.2f} {size / count / 1e6:>6.2f} "
                       f"{med['ours1']:>10.2f}s {cold:>10.2f}s {med['theirs1']:>10.2f}s", flush=True)
 
 
