@@ -1,16 +1,20 @@
 """Label passes derived from the raster depth and ids with the camera geometry: optical flow and NOCS.
 
 Optical flow (pixels, float32 H x W x 2): for the surface point seen at pixel centre (u, v) of keypoint i,
-its image position in keypoint j minus (u, v) - forward: j = i + 1, backward: j = i - 1 - of a static
-scene. ``*_flow_occluded`` (uint8) is 1 where that point is not visible in keypoint j: something else is
-in front of it there (its depth in j is more than 1 % + 1 mm behind the surface j sees at the nearest
-pixel), it leaves j's image or crosses j's near plane, or there is no surface (background), or there is
-no keypoint j. Flow is 0 where it is undefined (background, no keypoint j).
+its image position in keypoint j minus (u, v) - forward: j = i + 1, backward: j = i - 1. The point moves with
+its object: where objects change pose between keypoints (:mod:`hybridgen.scene.object_keyframes`), the
+object-local point is placed with the object's pose at j (``motion``: world -> world per instance id); other
+points are static and move in the image only with the camera. ``*_flow_occluded`` (uint8) is 1 where that
+point is not visible in keypoint j: something else is in front of it there (its depth in j is more than
+1 % + 1 mm behind the surface j sees at the nearest pixel), it leaves j's image or crosses j's near plane,
+or there is no surface (background), or there is no keypoint j. Flow is 0 where it is undefined (background, no keypoint j).
 
 NOCS (float32 H x W x 3, background 0): the object-local coordinates of the surface point, normalized
 as in the NOCS paper: ``(p_local - box_centre) / box_diagonal + 0.5`` with the object's local bounding box.
 """
 from __future__ import annotations
+
+from typing import Mapping
 
 import numpy as np
 
@@ -30,17 +34,27 @@ def camera_points(raw: RasterOutput, intr: Intrinsics) -> np.ndarray:
 
 
 def optical_flow(raw: RasterOutput, intr: Intrinsics, pose_from: np.ndarray, pose_to: np.ndarray | None,
-                 depth_to: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+                 depth_to: np.ndarray | None, motion: Mapping[int, np.ndarray] | None = None
+                 ) -> tuple[np.ndarray, np.ndarray]:
     """Flow (H, W, 2) from keypoint ``pose_from`` to ``pose_to`` and its occlusion mask (H, W) uint8.
 
-    ``depth_to`` is the z-depth image (inf background) rendered at ``pose_to``."""
+    ``depth_to`` is the z-depth image (inf background) rendered at ``pose_to`` with the objects at their poses
+    there; ``motion``: instance id -> 4x4 world -> world map of the objects that move between the two
+    keypoints (``local2world`` at j @ inverse ``local2world`` at i; absent: static)."""
     height, width = raw.instance.shape
     flow = np.zeros((height, width, 2), np.float32)
     occluded = np.ones((height, width), np.uint8)
     if pose_to is None or depth_to is None:
         return flow, occluded
-    relative = np.linalg.inv(pose_to) @ pose_from  # camera i -> camera j
-    points = camera_points(raw, intr) @ relative[:3, :3].T + relative[:3, 3]
+    world2cam_to = np.linalg.inv(pose_to)
+    relative = world2cam_to @ pose_from  # camera i -> camera j
+    here = camera_points(raw, intr)
+    points = here @ relative[:3, :3].T + relative[:3, 3]
+    for instance_id, moved in (motion or {}).items():
+        mask = raw.instance == instance_id
+        if mask.any():
+            carried = world2cam_to @ moved @ pose_from  # camera i -> the object's place at j -> camera j
+            points[mask] = here[mask] @ carried[:3, :3].T + carried[:3, 3]
     z = points[..., 2]
     with np.errstate(invalid="ignore", divide="ignore"):
         u = intr.K[0, 0] * points[..., 0] / z + intr.K[0, 2]

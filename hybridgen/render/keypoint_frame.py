@@ -4,13 +4,15 @@ the scene's one :class:`~hybridgen.render.scene_raster.SceneRaster`.
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 import numpy as np
 
 from ..scene.camera import Intrinsics
 from ..scene.mesh_object import MeshObject
+from ..scene.object_keyframes import keyframes_of
 from ..scene.scene import Scene
 from .raster import RasterView
 from .readback import RasterOutput
@@ -93,8 +95,42 @@ class KeypointFrame:
         return self.shared("silhouettes", make)
 
     def neighbour_depth(self, step: int) -> tuple[np.ndarray | None, np.ndarray | None]:
-        """(pose, z-depth image) of the neighbour keypoint ``index + step`` (None, None past the ends)."""
+        """(pose, z-depth image) of the neighbour keypoint ``index + step`` (None, None past the ends), drawn
+        with the objects at their poses there (:meth:`object_motion`)."""
         def make() -> tuple[np.ndarray | None, np.ndarray | None]:
             other = self.neighbour(step)
-            return other, None if other is None else self.view.render(other, ["depth"])["depth"]
+            if other is None:
+                return None, None
+            with moved_objects(self.scene, self.object_motion(step)):
+                return other, self.view.render(other, ["depth"])["depth"]
         return self.shared(("neighbour", step), make)
+
+    def object_motion(self, step: int) -> dict[int, np.ndarray]:
+        """Instance id -> 4x4 world -> world map of each object whose pose at keypoint ``index + step``
+        differs from its pose now (``local2world`` there @ inverse ``local2world`` here); empty: static."""
+        def make() -> dict[int, np.ndarray]:
+            keyframes = keyframes_of(self.scene)
+            if keyframes is None or keyframes.group(self.index) == keyframes.group(self.index + step):
+                return {}
+            motion = {}
+            for obj in self.scene.objects:
+                there = keyframes.pose(self.index + step, obj.instance_id)
+                if there is not None and not np.array_equal(there, obj.local2world):
+                    motion[obj.instance_id] = there @ np.linalg.inv(obj.local2world)
+            return motion
+        return self.shared(("motion", step), make)
+
+
+@contextmanager
+def moved_objects(scene: Scene, motion: dict[int, np.ndarray]) -> Iterator[None]:
+    """The scene's objects moved by ``motion`` (instance id -> world -> world map) inside the block."""
+    kept = {obj.instance_id: obj.local2world for obj in scene.objects if obj.instance_id in motion}
+    try:
+        for obj in scene.objects:
+            if obj.instance_id in kept:
+                obj.local2world = motion[obj.instance_id] @ kept[obj.instance_id]
+        yield
+    finally:
+        for obj in scene.objects:
+            if obj.instance_id in kept:
+                obj.local2world = kept[obj.instance_id]

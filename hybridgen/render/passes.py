@@ -106,7 +106,8 @@ def _flow(step: int, part: int) -> Compute:
     def compute(frame: "KeypointFrame", key: str) -> np.ndarray:
         def make() -> tuple[np.ndarray, np.ndarray]:
             other, depth = frame.neighbour_depth(step)
-            return optical_flow(frame.raw, frame.intrinsics, frame.cam2world, other, depth)
+            motion = None if other is None else frame.object_motion(step)
+            return optical_flow(frame.raw, frame.intrinsics, frame.cam2world, other, depth, motion)
         return frame.shared(("flow", step), make)[part]
     return compute
 

@@ -112,3 +112,41 @@ def test_object_records_poses_boxes_and_visible_fractions(gl_context):
     corners = np.array(cube["bbox3d_cam"])
     np.testing.assert_allclose(corners[:, 2].min(), 5.5) and np.testing.assert_allclose(corners[:, 2].max(), 6.5)
     assert records["wall"]["visib_fract"] == 1.0
+
+
+def test_flow_follows_an_object_moved_between_keypoints(gl_context):
+    """Fixed camera 4 m above the floor, looking down; a 0.4 m cube (top face at z = 0.4) moves by (0.5, 0.2)
+    between keypoints 0 and 1 (ObjectKeyframes, as composite.CameraObjectSampler records them). On the top
+    face the flow is the projected displacement f * d / (4 - 0.4) (camera x = world x, camera y = -world y);
+    on the floor it is 0, and the floor the cube covers at keypoint 1 is flagged occluded."""
+    from hybridgen.scene.object_keyframes import ObjectKeyframes
+
+    scene = hg.Scene()
+    scene.add(hg.make_primitive("plane", 200.0, name="floor", category_id=1))
+    cube = scene.add(hg.make_primitive("cube", 0.4, name="box", category_id=2,
+                                       local2world=hg.object_pose([-0.3, 0.1, 0.2])))
+    focal, height = 60.0, 4.0
+    scene.camera.intrinsics = hg.Intrinsics(np.array([[focal, 0, 31.5], [0, focal, 23.5], [0, 0, 1]]), 64, 48)
+    camera = np.diag([1.0, -1.0, -1.0, 1.0])
+    camera[:3, 3] = [0, 0, height]
+    keyframes = ObjectKeyframes()
+    shift = np.array([0.5, 0.2, 0.0])
+    for place in ([-0.3, 0.1, 0.2], [-0.3 + shift[0], 0.1 + shift[1], 0.2]):
+        cube.local2world = hg.object_pose(place)
+        keyframes.record(scene)
+        scene.camera.add_keypoint(camera)
+    scene.object_keyframes = keyframes
+    first, second = _render(scene, flow=True, depth=True)
+    expected = focal * np.array([shift[0], -shift[1]]) / (height - 0.4)  # (u, v) px
+    for frame, key, sign in ((first, "forward", 1.0), (second, "backward", -1.0)):
+        top = (frame["instance_segmaps"] == cube.instance_id) & np.isclose(frame["depth"], height - 0.4, atol=1e-4)
+        assert top.sum() > 20
+        np.testing.assert_allclose(frame[f"{key}_flow"][top], np.broadcast_to(sign * expected, (top.sum(), 2)),
+                                   atol=1e-3)
+        assert (frame[f"{key}_flow_occluded"][top] == 0).all()  # the top face is seen where it moved to
+        floor = frame["instance_segmaps"] == 1
+        np.testing.assert_allclose(frame[f"{key}_flow"][floor], 0.0, atol=1e-4)  # static: camera motion only
+        # the floor is hidden in the other keypoint exactly where the cube stands there
+        other = second if key == "forward" else first
+        covered = other["instance_segmaps"] == cube.instance_id
+        np.testing.assert_array_equal(frame[f"{key}_flow_occluded"][floor], covered[floor].astype(np.uint8))
