@@ -138,7 +138,7 @@ def load_config(path: str | Path, args: Sequence[str] = (), env: Mapping[str, st
         family = family_globals.get(name.split(".", 1)[0])
         if family:  # BlenderProc v1: global.<family> settings are defaults for that family's modules
             module_config = {**family, **module_config}
-        if name == "main.Initializer" and "global" in module_config:  # BlenderProc v3: the run's global
+        if "global" in module_config and _sets_up_run(name):  # BlenderProc v3: the Initializer holds 'global'
             module_config = dict(module_config)
             initializer_global = _mapping(module_config.pop("global"), file, "config.global", module=name,
                                           index=index)
@@ -160,6 +160,17 @@ def load_config(path: str | Path, args: Sequence[str] = (), env: Mapping[str, st
         notice(f"ignored: {GLOBAL_IGNORED[key]}", file=file, key=f"global.{key}")
         del config.global_all[key]
     return config
+
+
+def _sets_up_run(name: str) -> bool:
+    """True if ``name`` is a setup module (run-wide settings, e.g. main.Initializer); unknown names are not."""
+    from ..modules.base import Role
+    from .registry import get_module
+
+    try:
+        return get_module(name).role is Role.SETUP
+    except ConfigError:
+        return False
 
 
 def _declared(modules: list[ModuleEntry], key: str) -> bool:
