@@ -110,3 +110,14 @@ def test_the_graph_sees_relative_and_lazy_imports():
 def test_no_import_cycles():
     graph = import_graph()
     assert cycles(graph) == [], "\n".join(" <-> ".join(c) for c in cycles(graph))
+
+
+def test_config_uses_sampling_but_sampling_never_imports_config():
+    """Config values hold samplers (config.schema parses them), so sampling sits below config: the helpers both
+    read (input paths, nested values) live in hybridgen.input_paths and hybridgen.nested, below both."""
+    graph = import_graph()
+    upward = sorted(f"{module} -> {target}" for module, targets in graph.items()
+                    if module.startswith("hybridgen.sampling") for target in targets
+                    if target.startswith("hybridgen.config"))
+    assert upward == [], "\n".join(upward)
+    assert any(t.startswith("hybridgen.sampling") for t in graph["hybridgen.config.schema"])  # the other way is used

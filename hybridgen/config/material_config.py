@@ -7,7 +7,7 @@ from typing import Any
 
 from ..errors import ConfigError
 from ..scene.material import ALPHA_MODES, TEXTURE_SLOTS, Material
-from .paths import locate_input
+from ..input_paths import locate_input
 from .schema import closest
 
 _UNIT_KEYS = ("roughness", "metallic", "specular", "transmission", "alpha")

@@ -10,7 +10,7 @@ import re
 from typing import Any, Mapping, Sequence
 
 from ..errors import ConfigError
-from .nested import map_nested
+from ..nested import map_nested
 
 PLACEHOLDER = re.compile(r"<(args|env):([^<>]*)>")
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..config.paths import not_found
+from ..input_paths import not_found
 from ..errors import InputError
 
 MAX_POSE_FILE_BYTES = 64 * 2**20

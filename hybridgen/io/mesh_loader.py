@@ -26,7 +26,7 @@ from typing import Any, Callable, Iterable
 import numpy as np
 
 from ..config.notices import notice
-from ..config.paths import not_found
+from ..input_paths import not_found
 from ..errors import InputError
 from ..scene.frames import Y_UP_TO_Z_UP
 from ..scene.material import Material

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..config.paths import resolve_input
+from ..input_paths import resolve_input
 from ..config.registry import register_module
 from ..config.schema import Param, positive
 from ..errors import InputError

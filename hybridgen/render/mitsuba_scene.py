@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from ..config.paths import not_found
+from ..input_paths import not_found
 from ..errors import InputError
 from ..io.image_check import check_image_file
 from ..scene.light import Light

@@ -5,10 +5,11 @@ from __future__ import annotations
 from typing import Any, Callable, Mapping
 
 from ..config.config_file import ConfigFile
-from ..config.paths import config_folder, resolve_module_paths
+from ..config.paths import resolve_module_paths
 from ..config.registry import get_module
 from ..config.schema import validate_config
 from ..errors import ConfigError, HybridgenError, closest
+from ..input_paths import config_folder
 from ..modules.base import Module
 from .context import RunContext
 from .plan import check_keys, check_order

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from ..config.nested import map_nested
+from ..nested import map_nested
 from ..errors import ConfigError, InputError, closest
 from . import attribute_getter, attribute_merger, getters, samplers  # noqa: F401  (the built-ins register themselves)
 from .sampler_table import ALIASES, SAMPLERS, DrawContext, SamplerSpec

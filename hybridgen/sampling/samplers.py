@@ -7,7 +7,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..config.paths import describe_glob_miss, glob_inputs
+from ..input_paths import describe_glob_miss, glob_inputs
 from .sampler_table import DrawContext, register_sampler
 
 

@@ -92,7 +92,7 @@ def test_shipped_configs_resolve_from_any_working_directory(tmp_path, monkeypatc
 
 
 def test_path_sampler_globs_beside_the_config(tmp_path, monkeypatch):
-    from hybridgen.config.paths import config_folder
+    from hybridgen.input_paths import config_folder
     from hybridgen.sampling.registry import DrawContext
     from hybridgen.sampling.samplers import path
 
@@ -112,7 +112,7 @@ def test_path_sampler_globs_beside_the_config(tmp_path, monkeypatch):
 
 
 def test_missing_texture_names_both_places(tmp_path, monkeypatch):
-    from hybridgen.config.paths import config_folder, not_found
+    from hybridgen.input_paths import config_folder, not_found
 
     monkeypatch.chdir(tmp_path)
     assert not_found("texture file", "t/wood.png") == "texture file not found: 't/wood.png'"  # Python API: as given
