@@ -16,6 +16,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from tools.scene_yaml import shell_cameras  # noqa: E402
+
 CONFIG = """
 global: {all: {output_dir: "<args:0>"}}
 modules:
@@ -30,14 +32,7 @@ modules:
     config: {shape: sphere, size: 0.6, name: ball, category_id: 3, location: [0.9, 0.7, 0.3]}
   - name: lighting.LightLoader
     config: {lights: [{type: SUN, name: sun, energy: 2, rotation: [0.5, 0.2, 0.3]}]}
-  - name: camera.CameraSampler
-    config:
-      intrinsics: {resolution_x: 320, resolution_y: 240, fov: 1.0}
-      cam_poses:
-        - number_of_samples: 8
-          location: {provider: sampler.Shell, center: [0, 0, 0], radius_min: 3, radius_max: 5,
-                     elevation_min: 20, elevation_max: 60}
-          rotation: {format: look_at, value: [0, 0, 0.3]}
+""" + shell_cameras(width=320, height=240, count=8, fov=1.0, radius=(3, 5), look_at="[0, 0, 0.3]") + """
   - name: renderer.RgbRenderer
     config: {samples: 4, max_bounces: 2, render_depth: true, render_distance: true, render_normals: true,
              map_by: [class, instance]}

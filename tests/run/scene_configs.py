@@ -3,6 +3,8 @@ shell around it. Each test file picks the seed, the Initializer's scene/chunk se
 the renderer; the text is plain YAML so tests can still edit it with ``str.replace``."""
 from __future__ import annotations
 
+from tools.scene_yaml import shell_cameras
+
 
 def floor_and_object(*, initializer: str, shape: str = "sphere", name: str = "ball", width: int, height: int,
                      keypoints: int, look_at: str = "[0, 0, 0]", renderer: str) -> str:
@@ -18,14 +20,7 @@ modules:
   - name: loader.PrimitiveLoader
     config: {{shape: {shape}, size: 0.6, name: {name}, category_id: 2,
              location: {{provider: sampler.Uniform3d, min: [-1, -1, 0.3], max: [1, 1, 0.3]}}}}
-  - name: camera.CameraSampler
-    config:
-      intrinsics: {{resolution_x: {width}, resolution_y: {height}}}
-      cam_poses:
-        - number_of_samples: {keypoints}
-          location: {{provider: sampler.Shell, center: [0, 0, 0], radius_min: 2, radius_max: 4,
-                     elevation_min: 20, elevation_max: 60}}
-          rotation: {{format: look_at, value: {look_at}}}
+{shell_cameras(width=width, height=height, count=keypoints, look_at=look_at)}
 {renderer}
   - name: writer.Hdf5Writer
 """

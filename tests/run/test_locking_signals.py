@@ -18,6 +18,7 @@ from hybridgen.errors import InputError
 from hybridgen.io.atomic import confined_path, temporary_path
 from hybridgen.io.integrity import verify
 from tests.conftest import REPO
+from tools.scene_yaml import shell_cameras
 
 SCENES = """
 global: {all: {output_dir: "<args:0>"}}
@@ -28,14 +29,7 @@ modules:
     config: {shape: plane, size: 6, name: floor, category_id: 1}
   - name: loader.PrimitiveLoader
     config: {shape: sphere, size: 0.6, name: ball, category_id: 2}
-  - name: camera.CameraSampler
-    config:
-      intrinsics: {resolution_x: 16, resolution_y: 12}
-      cam_poses:
-        - number_of_samples: 4
-          location: {provider: sampler.Shell, center: [0, 0, 0], radius_min: 2, radius_max: 4,
-                     elevation_min: 20, elevation_max: 60}
-          rotation: {format: look_at, value: [0, 0, 0]}
+""" + shell_cameras(width=16, height=12, count=4) + """
   - name: renderer.SegMapRenderer
   - name: writer.Hdf5Writer
 """
@@ -44,13 +38,7 @@ global: {all: {output_dir: "<args:0>"}}
 modules:
   - name: loader.PrimitiveLoader
     config: {shape: sphere, size: 0.6, name: ball, category_id: 2}
-  - name: camera.CameraSampler
-    config:
-      intrinsics: {resolution_x: 8, resolution_y: 6}
-      cam_poses:
-        - number_of_samples: COUNT
-          location: {provider: sampler.Shell, center: [0, 0, 0], radius_min: 2, radius_max: 4}
-          rotation: {format: look_at, value: [0, 0, 0]}
+""" + shell_cameras(width=8, height=6, count="COUNT", elevation=None) + """
   - name: renderer.SegMapRenderer
     config: {render_normals: false}
   - name: writer.Hdf5Writer
