@@ -206,3 +206,15 @@ def test_hide_takes_objects_out_of_the_scene_keeping_ids(tmp_path):
     ]}
     """)
     assert [(o.name, o.instance_id) for o in context.scene.objects] == [("a", 1), ("c", 3)]
+
+
+def test_lazy_builtin_table_names_the_file_that_registers_each_module():
+    """get_module imports only the file _BUILTIN_NAMES gives for a built-in name: each entry must be where that
+    name is registered (names missing from the table still resolve, after every module is loaded)."""
+    from hybridgen.config import registry
+
+    modules = registry.all_modules()
+    assert registry._BUILTIN_NAMES
+    for name, package in registry._BUILTIN_NAMES.items():
+        assert name in modules and modules[name].__module__ == package, name
+        assert registry.get_module(name) is modules[name]
