@@ -7,7 +7,8 @@ object-local point is placed with the object's pose at j (``motion``: world -> w
 points are static and move in the image only with the camera. ``*_flow_occluded`` (uint8) is 1 where that
 point is not visible in keypoint j: something else is in front of it there (its depth in j is more than
 1 % + 1 mm behind the surface j sees at the nearest pixel), it leaves j's image or crosses j's near plane,
-or there is no surface (background), or there is no keypoint j. Flow is 0 where it is undefined (background, no keypoint j).
+or there is no surface (background), or there is no keypoint j. Flow is 0 where it is undefined (background,
+no keypoint j). Keypoint j's own intrinsics (per-keypoint intrinsics) project the point there.
 
 NOCS (float32 H x W x 3, background 0): the object-local coordinates of the surface point, normalized
 as in the NOCS paper: ``(p_local - box_centre) / box_diagonal + 0.5`` with the object's local bounding box.
@@ -34,13 +35,14 @@ def camera_points(raw: RasterOutput, intr: Intrinsics) -> np.ndarray:
 
 
 def optical_flow(raw: RasterOutput, intr: Intrinsics, pose_from: np.ndarray, pose_to: np.ndarray | None,
-                 depth_to: np.ndarray | None, motion: Mapping[int, np.ndarray] | None = None
-                 ) -> tuple[np.ndarray, np.ndarray]:
+                 depth_to: np.ndarray | None, motion: Mapping[int, np.ndarray] | None = None,
+                 intr_to: Intrinsics | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Flow (H, W, 2) from keypoint ``pose_from`` to ``pose_to`` and its occlusion mask (H, W) uint8.
 
     ``depth_to`` is the z-depth image (inf background) rendered at ``pose_to`` with the objects at their poses
     there; ``motion``: instance id -> 4x4 world -> world map of the objects that move between the two
-    keypoints (``local2world`` at j @ inverse ``local2world`` at i; absent: static)."""
+    keypoints (``local2world`` at j @ inverse ``local2world`` at i; absent: static); ``intr_to``: keypoint j's
+    intrinsics when they differ from keypoint i's ``intr`` (same image size)."""
     height, width = raw.instance.shape
     flow = np.zeros((height, width, 2), np.float32)
     occluded = np.ones((height, width), np.uint8)
@@ -56,11 +58,12 @@ def optical_flow(raw: RasterOutput, intr: Intrinsics, pose_from: np.ndarray, pos
             carried = world2cam_to @ moved @ pose_from  # camera i -> the object's place at j -> camera j
             points[mask] = here[mask] @ carried[:3, :3].T + carried[:3, 3]
     z = points[..., 2]
+    to = intr if intr_to is None else intr_to
     with np.errstate(invalid="ignore", divide="ignore"):
-        u = intr.K[0, 0] * points[..., 0] / z + intr.K[0, 2]
-        v = intr.K[1, 1] * points[..., 1] / z + intr.K[1, 2]
+        u = to.K[0, 0] * points[..., 0] / z + to.K[0, 2]
+        v = to.K[1, 1] * points[..., 1] / z + to.K[1, 2]
     grid_v, grid_u = np.mgrid[0:height, 0:width]
-    defined = raw.hit & (z > intr.clip_start)
+    defined = raw.hit & (z > to.clip_start)
     flow[defined, 0] = (u - grid_u)[defined]
     flow[defined, 1] = (v - grid_v)[defined]
     ui, vi = np.rint(np.where(defined, u, -1)).astype(np.int64), np.rint(np.where(defined, v, -1)).astype(np.int64)

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..scene.camera import Intrinsics
 from ..scene.mesh_object import MeshObject
-from ..scene.object_keyframes import keyframes_of
+from ..scene.object_keyframes import keyframes_of, keypoint_intrinsics
 from ..scene.scene import Scene
 from .raster import RasterView
 from .readback import RasterOutput
@@ -96,14 +96,18 @@ class KeypointFrame:
 
     def neighbour_depth(self, step: int) -> tuple[np.ndarray | None, np.ndarray | None]:
         """(pose, z-depth image) of the neighbour keypoint ``index + step`` (None, None past the ends), drawn
-        with the objects at their poses there (:meth:`object_motion`)."""
+        with the objects at their poses there (:meth:`object_motion`) and its intrinsics."""
         def make() -> tuple[np.ndarray | None, np.ndarray | None]:
             other = self.neighbour(step)
             if other is None:
                 return None, None
             with moved_objects(self.scene, self.object_motion(step)):
-                return other, self.view.render(other, ["depth"])["depth"]
+                return other, self.view.render(other, ["depth"], self.neighbour_intrinsics(step))["depth"]
         return self.shared(("neighbour", step), make)
+
+    def neighbour_intrinsics(self, step: int) -> Intrinsics:
+        """The intrinsics keypoint ``index + step`` renders with (per keypoint or the camera's)."""
+        return keypoint_intrinsics(self.scene, self.index + step)
 
     def object_motion(self, step: int) -> dict[int, np.ndarray]:
         """Instance id -> 4x4 world -> world map of each object whose pose at keypoint ``index + step``

@@ -106,8 +106,10 @@ def _flow(step: int, part: int) -> Compute:
     def compute(frame: "KeypointFrame", key: str) -> np.ndarray:
         def make() -> tuple[np.ndarray, np.ndarray]:
             other, depth = frame.neighbour_depth(step)
-            motion = None if other is None else frame.object_motion(step)
-            return optical_flow(frame.raw, frame.intrinsics, frame.cam2world, other, depth, motion)
+            if other is None:
+                return optical_flow(frame.raw, frame.intrinsics, frame.cam2world, None, None)
+            return optical_flow(frame.raw, frame.intrinsics, frame.cam2world, other, depth, frame.object_motion(step),
+                                frame.neighbour_intrinsics(step))
         return frame.shared(("flow", step), make)[part]
     return compute
 

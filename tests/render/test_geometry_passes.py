@@ -150,3 +150,22 @@ def test_flow_follows_an_object_moved_between_keypoints(gl_context):
         other = second if key == "forward" else first
         covered = other["instance_segmaps"] == cube.instance_id
         np.testing.assert_array_equal(frame[f"{key}_flow_occluded"][floor], covered[floor].astype(np.uint8))
+
+
+def test_flow_to_a_keypoint_with_other_intrinsics_zooms(gl_context):
+    """Fixed camera over a plane, keypoint 1 with twice the focal length (per-keypoint intrinsics, as BOP scene
+    replication sets them): the point at pixel u of keypoint 0 lands at c + 2 (u - c), so forward flow is
+    (u - c, v - c_y) where it stays in the image, and the rest is flagged as leaving it."""
+    scene = _plane_scene(4.0, 0.0, with_box=False)
+    first_k = scene.camera.intrinsics.K
+    zoomed = first_k.copy()
+    zoomed[0, 0] = zoomed[1, 1] = 2 * first_k[0, 0]
+    scene.camera.intrinsics_per_keypoint = [scene.camera.intrinsics, hg.Intrinsics(zoomed, 64, 48)]
+    first, second = _render(scene, flow=True)
+    v, u = np.mgrid[0:48, 0:64]
+    expected = np.stack([u - 31.5, v - 23.5], axis=-1)
+    stays = (np.abs(2 * (u - 31.5)) < 32) & (np.abs(2 * (v - 23.5)) < 24)
+    np.testing.assert_allclose(first["forward_flow"][stays], expected[stays], atol=1e-3)
+    np.testing.assert_array_equal(first["forward_flow_occluded"], (~stays).astype(np.uint8))
+    np.testing.assert_allclose(second["backward_flow"], -expected / 2, atol=1e-3)  # zooming out: all visible
+    assert (second["backward_flow_occluded"] == 0).all()
