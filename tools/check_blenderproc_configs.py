@@ -259,12 +259,15 @@ def dataset_standins(text: str, work: Path) -> dict[int, str]:
         room = work / "scenenet" / "1Bedroom" / "bedroom_standin.obj"
         room.parent.mkdir(parents=True, exist_ok=True)
         # SceneNet rooms hold their floor inside the walls' object (BlenderProc's examples split it off with
-        # object.FloorExtractor); quads: (name, material, corners in file axes, y up)
+        # object.FloorExtractor), some a separate 'ground' (floor), lamps lit by SurfaceLighting; quads: (name,
+        # material, corners in file axes, y up)
         parts = [("Wall", "wall_paint", [[(-4, 0, 4), (4, 0, 4), (4, 0, -4), (-4, 0, -4)],
                                          [(-4, 0, -4), (4, 0, -4), (4, 3, -4), (-4, 3, -4)]]),
                  ("Ceiling", "ceiling_white", [[(-4, 3, -4), (4, 3, -4), (4, 3, 4), (-4, 3, 4)]]),
                  ("Bed", "bed_01", [[(-2, 0.6, 1), (0, 0.6, 1), (0, 0.6, -1), (-2, 0.6, -1)]]),
-                 ("Chair", "Wood_2", [[(1, 0.5, 1), (1.5, 0.5, 1), (1.5, 0.5, 0.5), (1, 0.5, 0.5)]])]
+                 ("Chair", "Wood_2", [[(1, 0.5, 1), (1.5, 0.5, 1), (1.5, 0.5, 0.5), (1, 0.5, 0.5)]]),
+                 ("ground", "floor_tiles", [[(2, 0.01, 3.5), (3.5, 0.01, 3.5), (3.5, 0.01, 2), (2, 0.01, 2)]]),
+                 ("desk_lamp", "lamp_shade", [[(-1, 2.5, -1), (-0.5, 2.5, -1), (-0.5, 2.5, -0.5), (-1, 2.5, -0.5)]])]
         lines, offset = ["mtllib bedroom_standin.mtl", "vt 0 0", "vt 1 0", "vt 1 1"], 0
         for name, material, quads in parts:
             lines += [f"o {name}", f"usemtl {material}"]
@@ -276,7 +279,7 @@ def dataset_standins(text: str, work: Path) -> dict[int, str]:
         room.write_text("\n".join(lines) + "\n")
         room.with_suffix(".mtl").write_text("".join(f"newmtl {m}\nKd 0.5 0.5 0.5\n" for _, m, _ in parts))
         textures = work / "scenenet_textures"
-        for folder in ("bed", "Wood", "wall", "ceiling", "unknown"):
+        for folder in ("bed", "Wood", "wall", "ceiling", "floor", "lamp", "unknown"):
             (textures / folder).mkdir(parents=True, exist_ok=True)
             Image.new("RGB", (8, 8), (120, 100, 80)).save(textures / folder / f"{folder}_0.jpg")
         out.update({i: str(room) for i in _args_of(text, "file_path")})
