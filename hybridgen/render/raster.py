@@ -4,6 +4,10 @@ Geometry is uploaded once when the view is built; each keypoint only changes uni
 culled for an object only where that cannot change a label: the mesh is a closed, outward-wound volume and
 the camera (with its near plane) is outside its bounding box, so the first surface every ray meets is a
 front face.
+
+Why one file of ~320 lines: every GL object (programs, buffers, vertex arrays, framebuffers) is created and
+released by :class:`RasterView` itself, so that ``release()`` frees exactly what the view made; upload, draw
+and readback share that ownership and stay together.
 """
 from __future__ import annotations
 
