@@ -108,8 +108,9 @@ def _hdf5_content_digest(path: Path) -> str:
     def attributes(obj: h5py.HLObject) -> None:
         for key in sorted(obj.attrs):
             value = obj.attrs[key]
-            digest.update(f"@{key}={np.asarray(value).dtype.str}:".encode())
-            digest.update(np.asarray(value).tobytes() if np.asarray(value).dtype != object else repr(value).encode())
+            array = np.asarray(value)
+            digest.update(f"@{key}={array.dtype.str}:".encode())
+            digest.update(array.tobytes() if array.dtype != object else repr(value).encode())
 
     def visit(name: str, obj: h5py.HLObject) -> None:
         digest.update(f"\n{name}:{type(obj).__name__}".encode())
