@@ -28,7 +28,9 @@ def apply_material_config(material: Material, config: dict[str, Any]) -> Materia
 
     Overrides replace what they name: a ``base_color`` without a ``base_color_texture`` also removes the
     mesh's own base-color texture (as setting a value on a linked input in BlenderProc unlinks the texture);
-    likewise ``roughness``, ``metallic`` and ``alpha`` remove their maps unless the map is given too.
+    likewise ``roughness``, ``metallic``, ``alpha``, ``specular`` and ``emission`` remove their maps unless the
+    map is given too. An ``emission_texture`` without ``emission_strength`` on a material that emits nothing
+    gets strength 1 (Blender's default), so the map emits as in Blender.
     """
     values: dict[str, Any] = {}
     for key, value in config.items():
@@ -74,9 +76,12 @@ def apply_material_config(material: Material, config: dict[str, Any]) -> Materia
             if not isinstance(value, str) or not value:
                 raise ConfigError(f"must be a non-empty string, got {value!r}", key=f"material.{key}")
             values[key] = locate_input(value) if key in _TEXTURE_KEYS else value
-    for key in ("base_color", "roughness", "metallic", "alpha"):
+    for key in ("base_color", "roughness", "metallic", "alpha", "specular", "emission"):
         if key in values and f"{key}_texture" not in values:
             values[f"{key}_texture"] = None
+    if values.get("emission_texture") is not None and "emission_strength" not in values \
+            and material.emission_strength == 0:
+        values["emission_strength"] = 1.0  # Blender's Emission Strength default, so a given map emits
     if "base_color" in values or values.get("base_color_texture") is not None:
         values["base_color_from_vertices"] = False
     return dataclasses.replace(material, **values)

@@ -27,7 +27,7 @@ class MaterialManipulator(SelectingModule):
         Param("material", "dict", sampleable=True, doc="principled values: base_color, roughness, metallic, "
               "specular, transmission, ior, alpha, alpha_mode, emission, emission_strength, and maps (paths): "
               "base_color_texture, roughness_texture, metallic_texture, alpha_texture, normal_texture "
-              "(normal_y_down), displacement_texture (displacement_scale)"),
+              "(normal_y_down), displacement_texture (displacement_scale), specular_texture, emission_texture"),
         Param("randomize_color", "bool", False, doc="a uniform random base color per object"),
     )
 

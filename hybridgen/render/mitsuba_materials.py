@@ -3,7 +3,8 @@
 The BSDF is built inside out:
 
 - ``diffuse`` when the material has no specular, metal or transmission (Blender 4's principled is Lambertian
-  then), else ``principled`` with base color, roughness and metallic each a value or a texture;
+  then), else ``principled`` with base color, roughness and metallic each a value or a texture; a specular
+  map blends principled BSDFs of a few specular amounts per texel (:func:`specular_levels`);
 - ``normalmap`` around it for a tangent-space normal map (Mitsuba's tangent frame: x = dP/du projected
   into the surface, y = n x x, i.e. +v for a right-handed UV layout, the OpenGL convention; DirectX maps
   get their green channel inverted first);
@@ -23,6 +24,7 @@ Color textures are sRGB encoded (``raw`` false), data maps are linear (``raw`` t
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
@@ -103,6 +105,74 @@ def check_material(material: Material, owner: str) -> None:
                          f"{sorted(material.extra)}")
 
 
+SPECULAR_LEVELS = 4
+"""Principled BSDFs a specular map is interpolated between (see :func:`specular_levels`)."""
+
+
+def specular_levels(material: Material, owner: str) -> tuple[list[float], list[np.ndarray]]:
+    """Specular amounts s_0 < s_1 < ... and the blend weight maps a_k = clamp((s - s_(k-1)) / (s_k - s_(k-1)))
+    (k >= 1) that interpolate ``principled(s_k)`` piecewise linearly per texel.
+
+    Mitsuba's principled BSDF takes specular as one number per BSDF. Its diffuse lobe does not depend on it
+    and its Fresnel reflectance at normal incidence is 0.08 x specular, linear in it, so a chain of
+    ``blendbsdf`` s (``B_k = blend(a_k, B_(k-1), principled(s_k))``) reflects at each texel as the
+    interpolation between the two levels around its value. A map of at most :data:`SPECULAR_LEVELS`
+    distinct values uses them as the levels (exact at every texel); other maps use that many levels spaced
+    evenly in sqrt(specular) between their lowest and highest value: exact at normal incidence, and towards
+    grazing angles, where Fresnel is not linear in specular (steepest near 0), off by at most 0.005 (60
+    degrees) and 0.05 (75 degrees) in reflectance for a map spanning 0..1 (less for narrower ranges).
+    A value (no map) gives ([specular], []).
+    """
+    texture = material.specular_texture
+    if texture is None:
+        return [float(material.specular)], []
+    if isinstance(texture, (str, Path)):
+        _checked_path(texture, owner, "specular_texture")
+    values = data_image(texture, owner, "specular_texture")[..., 0].astype(np.float64)
+    distinct = np.unique(values)
+    if len(distinct) <= SPECULAR_LEVELS:
+        levels = distinct
+    else:
+        roots = np.linspace(math.sqrt(distinct[0]), math.sqrt(distinct[-1]), SPECULAR_LEVELS)
+        levels = roots ** 2
+        levels[0], levels[-1] = distinct[0], distinct[-1]
+    weights = [np.clip((values - levels[k - 1]) / (levels[k] - levels[k - 1]), 0.0, 1.0).astype(np.float32)
+               for k in range(1, len(levels))]
+    return [float(level) for level in levels], weights
+
+
+def _specular_bsdf(material: Material, owner: str, base: dict[str, Any],
+                   levels: list[float], weights: list[np.ndarray]) -> dict[str, Any]:
+    """The principled BSDF of ``material``: a chain of blends over ``levels`` (:func:`specular_levels`);
+    the levels' BSDFs share one loaded copy of each texture."""
+    inputs: dict[str, Any] = {"base_color": base, "roughness": _scalar_or_map(material, "roughness", owner),
+                              "metallic": _scalar_or_map(material, "metallic", owner)}
+    if material.transmission > 0:  # defined by its IOR; specular does not apply (Blender likewise)
+        levels, weights = levels[:1], []
+    if weights:
+        import mitsuba as mi
+
+        inputs = {key: mi.load_dict(value) if isinstance(value, dict) else value for key, value in inputs.items()}
+    bsdf = _principled(material, inputs, levels[0])
+    for level, weight in zip(levels[1:], weights):
+        bsdf = {"type": "blendbsdf", "weight": data_texture(weight, owner, "specular_texture"),
+                "bsdf_0": bsdf, "bsdf_1": _principled(material, inputs, level)}
+    return bsdf
+
+
+def _principled(material: Material, inputs: dict[str, Any], specular: float) -> dict[str, Any]:
+    """Mitsuba's principled BSDF of ``material`` with ``inputs`` (base_color, roughness, metallic) and the
+    specular amount ``specular``."""
+    bsdf = {"type": "principled", **inputs, "spec_trans": float(material.transmission)}
+    # Mitsuba's principled BSDF takes either the specular amount or the IOR: transmissive materials are
+    # defined by their IOR, opaque ones by their specular amount (as in Blender's UI).
+    if material.transmission > 0:
+        bsdf["eta"] = float(material.ior)
+    else:
+        bsdf["specular"] = float(specular)
+    return bsdf
+
+
 VERTEX_COLOR_ATTRIBUTE = "vertex_color"
 """Name of the mesh attribute holding per-vertex linear RGB (``vertex_`` prefix: interpolated over faces)."""
 
@@ -119,19 +189,13 @@ def bsdf_dict(material: Material, owner: str, *, vertex_colors: bool = False) ->
     else:
         base = rgb(material.base_color)
     bsdf: dict[str, Any]
-    plain = material.specular == 0 and material.metallic == 0 and material.metallic_texture is None
+    levels, weights = specular_levels(material, owner)
+    plain = levels[-1] == 0 and material.metallic == 0 and material.metallic_texture is None
     if plain and material.transmission == 0:
         # A principled material without specular, metal or transmission is Lambertian (as Blender 4's).
         bsdf = {"type": "diffuse", "reflectance": base}
     else:
-        bsdf = {"type": "principled", "base_color": base, "roughness": _scalar_or_map(material, "roughness", owner),
-                "metallic": _scalar_or_map(material, "metallic", owner), "spec_trans": float(material.transmission)}
-        # Mitsuba's principled BSDF takes either the specular amount or the IOR: transmissive materials are
-        # defined by their IOR, opaque ones by their specular amount (as in Blender's UI).
-        if material.transmission > 0:
-            bsdf["eta"] = float(material.ior)
-        else:
-            bsdf["specular"] = float(material.specular)
+        bsdf = _specular_bsdf(material, owner, base, levels, weights)
     if material.normal_texture is not None:
         bsdf = {"type": "normalmap", "bsdf": bsdf, "use_shadowing_function": False,
                 "normalmap": data_texture(material.normal_texture, owner, "normal_texture", channels=3,

@@ -9,8 +9,9 @@ map as follows (Blender's units, as BlenderProc configs give them):
 - SUN of strength E [W/m^2]: ``directional`` with irradiance E, shining along the light's -z axis.
 - AREA of power P, square of edge ``size``: a one-sided emitting rectangle of radiance P / (size^2 pi),
   facing the light's -z axis.
-- Emissive materials (``emission`` x ``emission_strength``): an ``area`` emitter on the mesh, radiance
-  emission x strength, on both sides (a flipped copy a hair behind the surface emits backwards).
+- Emissive materials (``emission`` or ``emission_texture`` x ``emission_strength``): an ``area`` emitter on
+  the mesh, radiance emission x strength (:mod:`hybridgen.render.material_emission`), on both sides (a
+  flipped copy a hair behind the surface emits backwards).
 - Opaque BSDFs are two-sided (Mitsuba's are one-sided; Blender's and most real meshes' are not).
 - World: ``constant`` radiance color x strength, or an ``envmap`` HDRI (scale = strength, rotated about +Z).
 """
@@ -29,6 +30,7 @@ from ..scene.light import Light
 from ..scene.mesh_object import MeshObject
 from ..scene.scene import Scene, World
 from . import light_selection
+from .material_emission import emitted_radiance, radiance_texture
 from .mitsuba_instances import instanced_entries
 from .mitsuba_materials import VERTEX_COLOR_ATTRIBUTE, loaded_bsdf
 from .mitsuba_materials import rgb as _rgb
@@ -37,14 +39,6 @@ ENVMAP_TO_WORLD = np.array([[0.0, 0, 1, 0], [1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 0
 """Lays Mitsuba's lat-long map (local +Y up, u = atan2(x, -z) / 2 pi mod 1) out as Blender's equirectangular
 mapping (world +Z up, u = 1/2 - atan2(y, x) / 2 pi): image centre column = world +X, a quarter from the left
 = +Y, top row = +Z, so an HDRI lights a scene from the same side as in BlenderProc."""
-
-
-def emitted_radiance(obj: MeshObject) -> np.ndarray:
-    """Linear RGB radiance (W sr^-1 m^-2) the object's surface emits: emission x emission_strength."""
-    radiance = np.asarray(obj.material.emission, float)[:3] * float(obj.material.emission_strength)
-    if np.any(radiance < 0) or not np.all(np.isfinite(radiance)):
-        raise InputError(f"object '{obj.name}': emission must be finite and >= 0, got {radiance.tolist()}")
-    return radiance
 
 
 def _world_normals(obj: MeshObject) -> np.ndarray:
@@ -72,7 +66,7 @@ def mesh_shape(obj: MeshObject, *, back_side: bool = False, sampling_weight: flo
     props["bsdf"] = loaded_bsdf(obj.material, obj.name, vertex_colors=colored, cache=bsdfs)
     radiance = emitted_radiance(obj)
     if np.any(radiance > 0):
-        props["emitter"] = mi.load_dict({"type": "area", "radiance": _rgb(radiance),
+        props["emitter"] = mi.load_dict({"type": "area", "radiance": radiance_texture(obj),
                                          "sampling_weight": float(sampling_weight)})
     smooth = obj.vertex_normals is not None
     has_uv = obj.uvs is not None and len(obj.uvs) == len(obj.vertices)

@@ -8,7 +8,7 @@ import numpy as np
 
 
 TEXTURE_SLOTS = ("base_color_texture", "roughness_texture", "metallic_texture", "alpha_texture",
-                 "normal_texture", "displacement_texture")
+                 "normal_texture", "displacement_texture", "specular_texture", "emission_texture")
 """The material's image inputs, all sampled with the mesh UVs."""
 ALPHA_MODES = ("BLEND", "CLIP")
 
@@ -23,7 +23,12 @@ class Material:
 
     PBR maps (file path or HxW[xC] uint8 array, read as data, not sRGB; the first channel of a gray map):
 
-    - ``roughness_texture`` / ``metallic_texture`` / ``alpha_texture`` replace their value.
+    - ``roughness_texture`` / ``metallic_texture`` / ``alpha_texture`` / ``specular_texture`` replace their
+      value. ``specular`` has Blender's Principled meaning: the dielectric reflectance at normal incidence
+      is 0.08 x specular (0.5 -> 4 %, the F0 of glass-like IOR 1.5).
+    - ``emission_texture``: an sRGB color image replacing ``emission``'s RGB (as an image linked to the
+      Principled BSDF's Emission input); the surface emits texture (decoded to linear) x
+      ``emission_strength`` W sr^-1 m^-2 per texel.
     - ``normal_texture``: tangent-space normal map, RGB = (x, y, z) * 0.5 + 0.5 with x along the mesh's +u
       and y along +v (OpenGL convention, ambientCG's ``_NormalGL``); ``normal_y_down`` reads DirectX maps
       (green along -v, ambientCG's ``_NormalDX`` and cc0textures' older ``_Normal``) by inverting green.
@@ -56,6 +61,8 @@ class Material:
     normal_y_down: bool = False
     displacement_texture: Any = None
     displacement_scale: float = 0.15  # metres per unit of height (Blender's Displacement node default in BlenderProc)
+    specular_texture: Any = None
+    emission_texture: Any = None  # path or HxWx{3,4} uint8 array, sRGB encoded, like base_color_texture
     extra: dict[str, Any] = field(default_factory=dict)
 
     @property
