@@ -46,6 +46,7 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.material_randomizer",
     "hybridgen.modules.hide_objects",
     "hybridgen.modules.camera_object_sampler",
+    "hybridgen.modules.random_room",
 )
 
 _BUILTIN_NAMES = {
@@ -86,6 +87,7 @@ _BUILTIN_NAMES = {
     "manipulators.MaterialRandomizer": "hybridgen.modules.material_randomizer",
     "object.Hide": "hybridgen.modules.hide_objects",
     "composite.CameraObjectSampler": "hybridgen.modules.camera_object_sampler",
+    "constructor.RandomRoomConstructor": "hybridgen.modules.random_room",
 }
 """Built-in module name -> the file registering it: :func:`get_module` imports that file alone (importing all
 of them costs ~0.2 s of every run's start); a name missing here, or a plugin's, loads every module first."""

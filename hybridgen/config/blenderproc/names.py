@@ -37,8 +37,6 @@ UNAVAILABLE = {
     "constructor.RockEssentialsGroundConstructor": "builds Blender node-displaced ground; use "
                                                    "loader.PrimitiveLoader (plane) with a texture",
     "materials.RockEssentialsTextureSampler": "samples Blender node textures; use manipulators.MaterialManipulator",
-    "constructor.RandomRoomConstructor": "extrudes rooms from Blender meshes with loaders hybridgen does not have; "
-                                         "model the room and load it with loader.ObjLoader",
     "constructor.BasicEmptyInitializer": "Blender empties (axes without geometry) have no counterpart in "
                                          "hybridgen scenes; use a location directly where an empty was a target",
     "object.CalibrationboardSampler": "samples a Blender calibration-board asset; load the board as a mesh "

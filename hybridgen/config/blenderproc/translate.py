@@ -14,6 +14,7 @@ from .names import ALIASES
 from .objects import (bop_loader, camera_loader, camera_sampler, loader, mesh_initializer, passthrough, physics,
                       pose_sampler, replacer)
 from .renderers import rgb, segmap, single_pass
+from .room import random_room
 from .selectors import samplers_as_blenderproc
 from .writers import writer
 
@@ -71,6 +72,8 @@ def translate_module(name: str, config: dict[str, Any], note: Note,
         return WRITERS[name](config, note, state)
     if name == "composite.CameraObjectSampler":
         return camera_object_sampler(config, note, state, translate_module)
+    if name == "constructor.RandomRoomConstructor":
+        return random_room(config, note, state, translate_module)
     if name in TRANSLATORS:
         if not name.startswith("renderer."):
             return TRANSLATORS[name](config, note)
