@@ -217,11 +217,9 @@ class GeneratorDataset:
         if _inherited_renderer:
             raise SystemSetupError(f"GeneratorDataset: {_FORK_HINT}")
         if workers > 1:
-            from ..run.unit_task import apply_thread_limit, limit_threads
+            from ..run.unit_task import limit_threads
 
-            limit_threads(max(1, (os.cpu_count() or 1) // workers))
-            if self.color:
-                apply_thread_limit()
+            limit_threads(max(1, (os.cpu_count() or 1) // workers))  # Dr.Jit takes it when color activates Mitsuba
         config = self._load()
         for scene in self.worker_scenes(worker, workers):
             yield from self.scene_samples(scene, config)

@@ -69,11 +69,23 @@ def choose_variant(requested: str | None = None) -> str:
 
 
 def activate(variant: str) -> None:
-    """Make ``variant`` the current Mitsuba variant of this process."""
+    """Make ``variant`` the current Mitsuba variant of this process, with the threads it was given."""
     import mitsuba as mi
 
     if mi.variant() != variant:
         mi.set_variant(variant)
+    apply_thread_limit()
+
+
+def apply_thread_limit() -> None:
+    """Dr.Jit uses the threads :func:`hybridgen.run.unit_task.limit_threads` gave this process
+    (``$HYBRIDGEN_THREADS``). Called when Mitsuba is put to work, so a labels-only run never imports it."""
+    threads = os.environ.get("HYBRIDGEN_THREADS", "")
+    if threads.isdigit():
+        import drjit
+
+        if drjit.thread_count() != int(threads):
+            drjit.set_thread_count(int(threads))
 
 
 def is_jit(variant: str) -> bool:

@@ -6,13 +6,12 @@ from __future__ import annotations
 
 import abc
 import os
-from concurrent.futures import Future, ProcessPoolExecutor
-from multiprocessing import get_context
-from typing import Any, Callable
+from concurrent.futures import Future
+from typing import TYPE_CHECKING, Any, Callable
 
-from .scene_reuse import SceneReuse
-from .unit_task import UnitTask, limit_threads
-from .units import WorkUnit
+if TYPE_CHECKING:  # imported where used: the command line reads EXECUTORS without loading the run machinery
+    from .unit_task import UnitTask
+    from .units import WorkUnit
 
 EXECUTORS = ("pool", "ray")
 DEFAULT_MAX_TASKS_PER_CHILD = 25
@@ -37,6 +36,8 @@ class InProcessExecutor(Executor):
     def __init__(self, task: UnitTask, progress: Callable[[int, str], Any] | None = None,
                  reuse_scenes: bool = False) -> None:
         self.task = task
+        from .scene_reuse import SceneReuse
+
         self.progress = progress
         self.scenes = SceneReuse() if reuse_scenes else None
 
@@ -60,6 +61,11 @@ class PoolExecutor(Executor):
     and are replaced after ``max_tasks_per_child`` units."""
 
     def __init__(self, task: UnitTask, workers: int, max_tasks_per_child: int) -> None:
+        from concurrent.futures import ProcessPoolExecutor
+        from multiprocessing import get_context
+
+        from .unit_task import limit_threads
+
         threads = max(1, (os.cpu_count() or 1) // workers)
         self.task = task
         self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"), initializer=limit_threads,

@@ -20,19 +20,9 @@ def limit_threads(threads: int, parent_pid: int | None = None) -> None:
     With ``parent_pid`` (pool workers) the process also stops when that parent does (see
     :func:`hybridgen.run.signals.die_with_parent`)."""
     os.environ["LP_NUM_THREADS"] = str(threads)  # read by Mesa when the GL context is created
-    os.environ["HYBRIDGEN_THREADS"] = str(threads)
+    os.environ["HYBRIDGEN_THREADS"] = str(threads)  # read by Dr.Jit's set-up (render.mitsuba_variant.activate)
     if parent_pid is not None:
         die_with_parent(parent_pid)
-
-
-def apply_thread_limit() -> None:
-    """Dr.Jit uses the threads :func:`limit_threads` gave this process (once Mitsuba is needed)."""
-    threads = os.environ.get("HYBRIDGEN_THREADS", "")
-    if threads.isdigit():
-        import drjit
-
-        if drjit.thread_count() != int(threads):
-            drjit.set_thread_count(int(threads))
 
 
 def run_unit(path: str, args: Sequence[str], env: Mapping[str, str] | None, unit: WorkUnit,
@@ -41,8 +31,8 @@ def run_unit(path: str, args: Sequence[str], env: Mapping[str, str] | None, unit
     """Run one unit (in whatever process this is); returns (keypoints rendered, keypoints of its scene).
     ``fingerprint`` (the parent's, JSON) is recorded in the unit's file; ``progress`` makes progress bars
     (units run in this process); with ``scenes`` consecutive units of one scene build it once
-    (:mod:`hybridgen.run.scene_reuse`)."""
-    apply_thread_limit()
+    (:mod:`hybridgen.run.scene_reuse`). Mitsuba takes its thread limit when a color renderer activates it
+    (:func:`hybridgen.render.mitsuba_variant.apply_thread_limit`)."""
     attributes = {FINGERPRINT_ATTR: fingerprint} if fingerprint is not None else None
     if scenes is not None:
         context = scenes.execute(path, args, env, unit, attributes=attributes, progress=progress)

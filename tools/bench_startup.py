@@ -1,0 +1,172 @@
+"""Time to first keypoint of a labels-only ``hybridgen run``, and the start-up cost of ``import hybridgen``.
+
+Run: .venv/bin/python tools/bench_startup.py [--rounds 5] [--scenes monastery 1.4M] [--profile] [--importtime]
+Needs pybullet (its ``pybullet_data`` meshes) and trimesh (the 1.4M scene is written once as a binary PLY).
+
+Every figure is a whole process, started by this script: wall seconds and CPU seconds (user + system of every
+thread; ``wait4``), medians over ``--rounds``. CPU seconds are the steadier figure while other processes share
+the cores. Rows:
+
+- ``python -c 'import hybridgen'`` and ``hybridgen --help``;
+- ``1st kp``: ``hybridgen run`` of a labels-only config (depth + normals + class + instance, default HDF5
+  writer, 640x480, 1 keypoint) from process start to the first keypoint handed to the writer (the child
+  stamps wall time and its own CPU time at that moment), plus the whole process. ``cold``: an empty cache
+  folder (``HYBRIDGEN_CACHE_DIR``: mesh cache and input hashes); ``warm``: the caches of a previous run.
+
+By default the children keep compiled bytecode in a private ``PYTHONPYCACHEPREFIX`` (warmed by an untimed run),
+as an installed package has it; ``--no-bytecode`` measures with ``PYTHONDONTWRITEBYTECODE=1`` (every hybridgen
+module compiled on each start). ``--profile`` prints a cProfile of one warm run; ``--importtime`` the slowest
+imports of one warm run (``python -X importtime``).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+TOOLS = Path(__file__).resolve().parent
+sys.path.insert(0, str(TOOLS))
+
+SCENE_NAMES = {"monastery": "monastery (real)", "1.4M": "1.4M real, subdiv.", "50": "50 objects"}
+
+FIRST_KEYPOINT_DRIVER = """\
+import os, resource, sys, time
+import hybridgen.io.hdf5_single as _single
+_write = _single.Hdf5SingleFileWriter.write
+def _stamped(self, index, values):
+    if not getattr(_single, '_first_stamped', False):
+        _single._first_stamped = True
+        usage = resource.getrusage(resource.RUSAGE_SELF)
+        with open(os.environ['BENCH_FIRST_KEYPOINT'], 'w') as out:
+            out.write(repr((time.time(), usage.ru_utime + usage.ru_stime)))
+    return _write(self, index, values)
+_single.Hdf5SingleFileWriter.write = _stamped
+from hybridgen.cli import main
+sys.exit(main(sys.argv[1:]))
+"""
+"""The child of a ``1st kp`` row: the real CLI, with the writer's ``write`` wrapped to stamp its first call.
+(It imports the HDF5 writer's module first, which a labels-only run with the default writer imports anyway.)"""
+
+
+def timed(command: list[str], env: dict[str, str]) -> tuple[float, float, float]:
+    """(start wall time.time(), wall seconds, CPU seconds of the whole process); fails loudly."""
+    start_epoch, start = time.time(), time.perf_counter()
+    with tempfile.TemporaryFile() as out:
+        process = subprocess.Popen(command, env=env, stdout=out, stderr=subprocess.STDOUT)
+        _, status, usage = os.wait4(process.pid, 0)
+        elapsed = time.perf_counter() - start
+        if os.waitstatus_to_exitcode(status) != 0:
+            out.seek(0)
+            raise SystemExit(f"{' '.join(command)} failed:\n{out.read()[-4000:].decode(errors='replace')}")
+    return start_epoch, elapsed, usage.ru_utime + usage.ru_stime
+
+
+def first_keypoint(config: Path, out: Path, env: dict[str, str], stamp: Path) -> dict[str, float]:
+    """One labels-only run: seconds from process start to the first keypoint written (wall, CPU) and whole."""
+    shutil.rmtree(out, ignore_errors=True)
+    stamp.unlink(missing_ok=True)
+    start, wall, cpu = timed([sys.executable, "-c", FIRST_KEYPOINT_DRIVER, "run", "-q", str(config), str(out)],
+                             dict(env, BENCH_FIRST_KEYPOINT=str(stamp)))
+    at, cpu_at = eval(stamp.read_text())  # noqa: S307 - our own repr of two floats
+    return {"first_wall": at - start, "first_cpu": cpu_at, "wall": wall, "cpu": cpu}
+
+
+def median_row(rows: list[dict[str, float]]) -> dict[str, float]:
+    return {key: statistics.median(r[key] for r in rows) for key in rows[0]}
+
+
+def profile(command: list[str], env: dict[str, str], limit: int) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        stats = Path(tmp) / "run.prof"
+        subprocess.run([sys.executable, "-m", "cProfile", "-o", str(stats), *command], env=env, check=True,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        import pstats
+
+        pstats.Stats(str(stats)).sort_stats("cumulative").print_stats(limit)
+
+
+def importtime(command: list[str], env: dict[str, str], limit: int) -> None:
+    """The slowest imports (self time) and the top-level packages a run imports, by cumulative time."""
+    done = subprocess.run([sys.executable, "-X", "importtime", *command], env=env, capture_output=True, text=True,
+                          check=True)
+    rows = []
+    for line in done.stderr.splitlines():
+        if line.startswith("import time:") and "|" in line and "self [us]" not in line:
+            own, cumulative, name = line[len("import time:"):].split("|")
+            rows.append((int(own), int(cumulative), name.rstrip()))
+    top_level = sorted(((c, n.strip()) for _, c, n in rows if not n.startswith("  ")), reverse=True)
+    print(f"imports of one warm run: {len(rows)} modules, {sum(r[0] for r in rows) / 1e3:.0f} ms in total; top level:")
+    for cumulative, name in top_level[:limit]:
+        print(f"  {cumulative / 1e3:7.1f} ms  {name}")
+    print("largest self times:")
+    for own, _, name in sorted(rows, reverse=True)[:limit]:
+        print(f"  {own / 1e3:7.1f} ms  {name.strip()}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rounds", type=int, default=5, help="runs per row (medians)")
+    parser.add_argument("--scenes", nargs="+", default=["monastery", "1.4M"], choices=list(SCENE_NAMES))
+    parser.add_argument("--no-bytecode", action="store_true", help="children run with PYTHONDONTWRITEBYTECODE=1")
+    parser.add_argument("--profile", action="store_true", help="cProfile of one warm run per scene")
+    parser.add_argument("--importtime", action="store_true", help="python -X importtime of one warm run per scene")
+    parser.add_argument("--limit", type=int, default=30, help="lines of --profile / --importtime")
+    args = parser.parse_args()
+
+    import bench_labels as bl
+
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        env = dict(os.environ, HYBRIDGEN_CACHE_DIR=str(work / "cache"))
+        if args.no_bytecode:
+            env["PYTHONDONTWRITEBYTECODE"] = "1"
+        else:
+            env.pop("PYTHONDONTWRITEBYTECODE", None)
+            env["PYTHONPYCACHEPREFIX"] = str(work / "pycache")
+        hybridgen = [sys.executable, "-m", "hybridgen"]
+        timed([*hybridgen, "--help"], env)  # untimed: compiles bytecode into the private prefix
+        print(f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f} (others' processes skew wall times); "
+              f"bytecode {'not cached' if args.no_bytecode else 'cached'}; medians of {args.rounds} whole processes")
+        print(f"{'what':<40} {'wall s':>8} {'cpu s':>8}")
+        for label, command in (("python -c 'import numpy'", [sys.executable, "-c", "import numpy"]),
+                               ("python -c 'import hybridgen'", [sys.executable, "-c", "import hybridgen"]),
+                               ("hybridgen --help", [*hybridgen, "--help"])):
+            runs = [timed(command, env)[1:] for _ in range(args.rounds)]
+            print(f"{label:<40} {statistics.median(r[0] for r in runs):>8.3f} "
+                  f"{statistics.median(r[1] for r in runs):>8.3f}", flush=True)
+        print(f"\nlabels-only run, 640x480, 1 keypoint: 1st kp = process start -> first keypoint handed to the "
+              "writer; whole = the process")
+        print(f"{'scene':<22} {'cache':<6} {'1st kp wall':>11} {'1st kp cpu':>11} {'whole wall':>11} {'whole cpu':>10}")
+        for short in args.scenes:
+            name = SCENE_NAMES[short]
+            config, _ = bl.write_configs(name, "640x480", 1, work / "configs")
+            out, stamp = work / "out", work / "stamp"
+            cold = []
+            for r in range(args.rounds):
+                shutil.rmtree(work / "cache", ignore_errors=True)
+                cold.append(first_keypoint(config, out, env, stamp))
+            warm = [first_keypoint(config, out, env, stamp) for _ in range(args.rounds)]
+            for kind, rows in (("cold", cold), ("warm", warm)):
+                m = median_row(rows)
+                print(f"{short:<22} {kind:<6} {m['first_wall']:>10.3f}s {m['first_cpu']:>10.3f}s "
+                      f"{m['wall']:>10.3f}s {m['cpu']:>9.3f}s", flush=True)
+            command = ["-m", "hybridgen", "run", "-q", str(config), str(out)]
+            if args.profile:
+                shutil.rmtree(out, ignore_errors=True)
+                print(f"\ncProfile of one warm run ({short}):")
+                profile(command, env, args.limit)
+            if args.importtime:
+                shutil.rmtree(out, ignore_errors=True)
+                importtime(command, env, args.limit)
+        print(f"\nload average at the end: {os.getloadavg()[0]:.1f}")
+
+
+if __name__ == "__main__":
+    main()
