@@ -1,9 +1,13 @@
 """``camera.CameraSampler``: keypoints from pose samplers, kept only when they pass the checks."""
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
+import numpy as np
+
 from ..config.camera_poses import intrinsics_from_config, pose_from_entry
+from ..config.depth_of_field import depth_of_field_from_config
 from ..config.registry import register_module
 from ..config.schema import Param, positive
 from ..errors import ConfigError, InputError, closest
@@ -12,14 +16,15 @@ from ..run.context import RunContext
 from ..sampling.camera_checks import NoveltyCheck, ProximityChecks
 from ..sampling.camera_sampling import PoseChecks, SamplingReport, sample_camera_poses
 from ..sampling.getters import parse_selector
-from ..sampling.interest_score import InterestScore
+from ..sampling.interest_score import InterestScore, interest_levels
 from ..sampling.registry import DrawContext, draw
 from .base import Module, Role
 
 ENTRY_KEYS = ("number_of_samples", "location", "rotation", "cam2world_matrix", "source_frame",
               "proximity_checks", "excluded_objs_in_proximity_check", "check_if_objects_visible",
               "min_coverage", "check_pose_novelty_rot", "check_pose_novelty_translation",
-              "min_var_diff_rot", "min_var_diff_translation", "min_interest_score", "special_objects", "special_objects_weight", "sqrt_number_of_rays",
+              "min_var_diff_rot", "min_var_diff_translation", "min_interest_score", "interest_score_range",
+              "interest_score_step", "special_objects", "special_objects_weight", "sqrt_number_of_rays",
               "check_if_pose_above_object_list")
 POSE_ONLY = ("location", "rotation", "cam2world_matrix", "source_frame")
 
@@ -35,7 +40,8 @@ class CameraSampler(Module):
         Param("cam_poses", "list", sampleable=True, doc=f"entries with keys {', '.join(ENTRY_KEYS)}; "
               "proximity_checks: {min, max [m], avg: {min, max}, var: {min, max}, no_background}; "
               "min_coverage: {selector, fraction} (image fraction the selected objects must cover); "
-              "min_interest_score (BlenderProc's scene coverage score, hybridgen.sampling.interest_score) with "
+              "min_interest_score (BlenderProc's scene coverage score, hybridgen.sampling.interest_score; "
+              "interest_score_range/interest_score_step: start there, lower by the step after max_tries) with "
               "special_objects, special_objects_weight, sqrt_number_of_rays; check_if_pose_above_object_list: "
               "a selector, one of whose objects must be straight below the camera"),
         Param("source_frame", "list", ["X", "Y", "Z"], doc="axes the poses are given in, named in Blender's "
@@ -51,6 +57,10 @@ class CameraSampler(Module):
         camera = context.scene.camera
         if cfg["intrinsics"]:
             camera.intrinsics = intrinsics_from_config(cfg["intrinsics"])
+        if "depth_of_field" in cfg["intrinsics"]:
+            camera.depth_of_field = depth_of_field_from_config(cfg["intrinsics"]["depth_of_field"], context.scene,
+                                                               context.rng, "intrinsics.depth_of_field")
+        self._prepare_sampling(context)
         view = RasterView(context.scene)
         report = SamplingReport()
         try:
@@ -67,10 +77,17 @@ class CameraSampler(Module):
                 pose_part = {k: v for k, v in entry.items() if k in POSE_ONLY}
 
                 def propose(part: dict[str, Any] = pose_part, at: str = where) -> Any:
-                    return pose_from_entry(draw(part, draw_ctx), at, source_frame=cfg["source_frame"])
+                    return self._relocate(pose_from_entry(draw(part, draw_ctx), at, source_frame=cfg["source_frame"]),
+                                          context)
 
-                poses, report = sample_camera_poses(context.scene, propose, count, cfg["max_tries"], checks,
-                                                    check_width=cfg["check_width"], view=view, report=report)
+                poses: list[np.ndarray] = []
+                for level_checks in self._interest_schedule(entry, checks, where):  # BlenderProc's lowering
+                    found, report = sample_camera_poses(context.scene, propose, count - len(poses), cfg["max_tries"],
+                                                        level_checks, check_width=cfg["check_width"], view=view,
+                                                        report=report)
+                    poses += found
+                    if len(poses) == count:
+                        break
                 for pose in poses:
                     camera.add_keypoint(pose)
                 if len(poses) < count:
@@ -82,6 +99,28 @@ class CameraSampler(Module):
         finally:
             view.release()
         context.log(f"{self.module_name}: {report.summary()}")
+
+    def _prepare_sampling(self, context: RunContext) -> None:
+        """Hook for subclasses (room samplers): called once before any pose is drawn."""
+
+    def _relocate(self, cam2world: np.ndarray, context: RunContext) -> np.ndarray:
+        """Hook for subclasses: a drawn candidate pose (OpenCV axes) moved where they sample; unchanged here."""
+        return cam2world
+
+    @staticmethod
+    def _interest_schedule(entry: dict[str, Any], checks: PoseChecks, where: str) -> list[PoseChecks]:
+        """``checks`` with each interest-score threshold of the entry's schedule (``interest_score_range`` down to
+        ``min_interest_score`` by ``interest_score_step``, each with its own ``max_tries``); one item without
+        a schedule."""
+        if checks.interest is None:
+            return [checks]
+        try:
+            levels = interest_levels(float(entry.get("min_interest_score", 0.0)), entry.get("interest_score_range"),
+                                     float(entry.get("interest_score_step", 0.1)))
+        except ValueError as exc:
+            raise ConfigError(str(exc).replace("interest_score_step ", ""), key=f"{where}.interest_score_step") from None
+        return [dataclasses.replace(checks, interest=dataclasses.replace(checks.interest, minimum=level)
+                                    if level > 0 else None) for level in levels]
 
     @staticmethod
     def _ids(value: Any, context: RunContext, key: str) -> frozenset[int]:
@@ -108,9 +147,9 @@ class CameraSampler(Module):
             if "check_if_objects_visible" in entry else frozenset(),
             coverage_of=coverage_of, min_coverage=fraction, novelty=novelty,
             interest=InterestScore.for_objects(
-                context.scene.objects, entry["min_interest_score"], entry.get("special_objects", []),
+                context.scene.objects, entry.get("min_interest_score", 0.0), entry.get("special_objects", []),
                 entry.get("special_objects_weight", 2.0), entry.get("sqrt_number_of_rays", 10))
-            if entry.get("min_interest_score", 0) > 0 else None,
+            if max(entry.get("min_interest_score", 0), entry.get("interest_score_range", 0)) > 0 else None,
             above=self._ids(entry["check_if_pose_above_object_list"], context,
                             f"{where}.check_if_pose_above_object_list")
             if "check_if_pose_above_object_list" in entry else frozenset())

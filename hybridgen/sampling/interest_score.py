@@ -86,3 +86,19 @@ def above_pose(cam2world: np.ndarray) -> np.ndarray:
     pose = np.diag([1.0, -1.0, -1.0, 1.0])
     pose[:3, 3] = np.asarray(cam2world, dtype=np.float64)[:3, 3]
     return pose
+
+
+def interest_levels(minimum: float, top: float | None = None, step: float = 0.1) -> list[float]:
+    """The interest-score thresholds a camera sampler tries in turn, as BlenderProc lowers them: from ``top``
+    (``interest_score_range``, default ``minimum``) down by ``step`` (``interest_score_step``) while the current
+    one is above ``minimum`` (``min_interest_score``); the last may fall below ``minimum`` when the range is no
+    multiple of the step, as in BlenderProc. Each threshold gets its own ``max_tries``; 0 or below: no check.
+    ``minimum + 1e-9`` absorbs float drift (1.0 - 0.1 - 0.1 is 0.8 here, as BlenderProc's documentation lists)."""
+    if step <= 0:
+        raise ValueError("interest_score_step must be > 0")
+    level = float(minimum if top is None else top)
+    levels = [level]
+    while level > minimum + 1e-9:
+        level -= step
+        levels.append(round(level, 12))
+    return levels

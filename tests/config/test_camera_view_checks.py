@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hybridgen.errors import InputError
+from hybridgen.errors import ConfigError, InputError
 from hybridgen.sampling.interest_score import InterestScore
 from tests.config.test_blenderproc_modules import HEADER, run_config_text
 
@@ -64,3 +64,26 @@ def test_interest_and_above_checks_accept_and_reject_views(tmp_path):
     assert len(_sample(tmp_path, "[0.2, -0.3, 3]", above)) == 1
     with pytest.raises(InputError, match="above"):
         _sample(tmp_path, "[1.5, 0, 3]", above)
+
+
+def test_interest_levels_as_blenderproc_lowers_them():
+    from hybridgen.sampling.interest_score import interest_levels
+
+    assert interest_levels(0.8, 1.0, 0.1) == [1.0, 0.9, 0.8]  # BlenderProc's documented example
+    assert interest_levels(0.8) == [0.8] and interest_levels(0.8, 0.8, 0.5) == [0.8]
+    assert interest_levels(0.8, 1.0, 0.3) == [1.0, 0.7]  # the last step may pass below the minimum
+    assert interest_levels(0.0, 0.2, 0.1) == [0.2, 0.1, 0.0]  # 0: no check at the end
+
+
+def test_interest_threshold_is_lowered_after_max_tries(tmp_path):
+    # the view straight down from 3 m scores about 0.13 (box and floor share it): above every level from 0.95
+    # down to 0.25 it is rejected 3 times per level (max_tries: 3); at 0.05 it is accepted
+    schedule = '"min_interest_score": %s, "interest_score_range": 0.95, "interest_score_step": 0.1'
+    assert len(_sample(tmp_path, "[0, 0, 3]", schedule % 0.05)) == 1
+    with pytest.raises(InputError, match="interest"):
+        _sample(tmp_path, "[0, 0, 3]", schedule % 0.25)
+    with pytest.raises(InputError, match="interest"):  # no range: the minimum alone
+        _sample(tmp_path, "[0, 0, 3]", '"min_interest_score": 0.95')
+    with pytest.raises(ConfigError, match="interest_score_step"):
+        _sample(tmp_path, "[0, 0, 3]", '"min_interest_score": 0.1, "interest_score_range": 0.5, '
+                                       '"interest_score_step": 0')

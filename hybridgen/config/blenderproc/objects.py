@@ -135,23 +135,19 @@ _MODULE_LEVEL_CHECKS = ("check_pose_novelty_rot", "check_pose_novelty_translatio
 
 def camera_sampler(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]]]:
     """``camera.CameraSampler``: module-level novelty checks go into every entry; an entry's ``max_tries`` is
-    the module's; the interest-score schedule (range, step) is reported: hybridgen checks the minimum."""
+    the module's (BlenderProc counts tries per interest-score threshold too)."""
     cfg = dict(config)
     shared = {k: cfg.pop(k) for k in _MODULE_LEVEL_CHECKS if k in cfg}
     entries = cfg.get("cam_poses")
     if isinstance(entries, list):
         out = []
-        for i, entry in enumerate(entries):
+        for entry in entries:
             if not isinstance(entry, dict):
                 out.append(entry)
                 continue
             entry = {**shared, **entry}
             if "max_tries" in entry:
                 cfg["max_tries"] = max(int(entry.pop("max_tries")), int(cfg.get("max_tries", 0)))
-            for key in ("interest_score_range", "interest_score_step"):
-                pop_ignored(entry, key, note if key not in entry else
-                            (lambda m, k, i=i: note(m, f"cam_poses[{i}].{k}")),
-                            "hybridgen checks min_interest_score alone, without lowering it after max_tries")
             out.append(entry)
         cfg["cam_poses"] = out
     return [("camera.CameraSampler", cfg)]
