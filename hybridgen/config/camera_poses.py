@@ -181,7 +181,8 @@ def poses_from_file(path: str | Path, file_format: str, defaults: dict[str, Any]
 
 def intrinsics_from_config(config: dict[str, Any]) -> Intrinsics:
     """Intrinsics from ``{resolution_x, resolution_y, cam_K | fov, fov_axis, clip_start, clip_end}``."""
-    known = ("resolution_x", "resolution_y", "cam_K", "fov", "fov_axis", "clip_start", "clip_end")
+    known = ("resolution_x", "resolution_y", "cam_K", "fov", "fov_axis", "clip_start", "clip_end",
+             "depth_of_field")  # depth_of_field: the camera modules read it (hybridgen.config.depth_of_field)
     for key in config:
         if key not in known:
             raise ConfigError(f"unknown key{closest(key, known)}; known: {list(known)}", key=f"intrinsics.{key}")

@@ -47,6 +47,8 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.hide_objects",
     "hybridgen.modules.camera_object_sampler",
     "hybridgen.modules.random_room",
+    "hybridgen.modules.room_camera_samplers",
+    "hybridgen.modules.empty_initializer",
 )
 
 _BUILTIN_NAMES = {
@@ -88,6 +90,9 @@ _BUILTIN_NAMES = {
     "object.Hide": "hybridgen.modules.hide_objects",
     "composite.CameraObjectSampler": "hybridgen.modules.camera_object_sampler",
     "constructor.RandomRoomConstructor": "hybridgen.modules.random_room",
+    "camera.Front3DCameraSampler": "hybridgen.modules.room_camera_samplers",
+    "camera.ReplicaCameraSampler": "hybridgen.modules.room_camera_samplers",
+    "constructor.BasicEmptyInitializer": "hybridgen.modules.empty_initializer",
 }
 """Built-in module name -> the file registering it: :func:`get_module` imports that file alone (importing all
 of them costs ~0.2 s of every run's start); a name missing here, or a plugin's, loads every module first."""

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from ..config.camera_poses import intrinsics_from_config, pose_from_entry, poses_from_file
+from ..config.depth_of_field import depth_of_field_from_config
 from ..config.registry import register_module
 from ..config.schema import Param
 from ..errors import ConfigError
@@ -36,6 +37,9 @@ class CameraLoader(Module):
         camera = context.scene.camera
         if cfg["intrinsics"] or not camera.keypoints:
             camera.intrinsics = intrinsics_from_config(cfg["intrinsics"])
+        if "depth_of_field" in cfg["intrinsics"]:
+            camera.depth_of_field = depth_of_field_from_config(cfg["intrinsics"]["depth_of_field"], context.scene,
+                                                               context.rng, "intrinsics.depth_of_field")
         defaults = cfg["default_cam_param"]
         entries = self.value(context, "cam_poses")
         frame = cfg["source_frame"]

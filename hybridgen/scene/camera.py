@@ -8,10 +8,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import InputError
+
+if TYPE_CHECKING:
+    from .depth_of_field import DepthOfField
 
 DEFAULT_RESOLUTION = (512, 512)
 DEFAULT_FOV = 0.691111  # rad, horizontal
@@ -104,6 +108,8 @@ class Camera:
     intrinsics_per_keypoint: list[Intrinsics] | None = None
     """One Intrinsics per keypoint where they differ between keypoints (BOP scene replication); renderers give
     ``intrinsics`` each keypoint's before rendering it (:func:`hybridgen.scene.object_keyframes.apply_keypoint`)."""
+    depth_of_field: "DepthOfField | None" = None
+    """A thin lens (color only; labels stay pinhole, exact at pixel centres); None: a pinhole camera."""
 
     def add_keypoint(self, cam2world: np.ndarray) -> int:
         """Append a pose (OpenCV axes) and return its keypoint index."""

@@ -6,6 +6,7 @@ from typing import Iterator
 
 from ..errors import InputError
 from .camera import Camera
+from .empty import Empty
 from .light import Light
 from .mesh_object import MeshObject
 from .object_keyframes import ObjectKeyframes
@@ -38,6 +39,8 @@ class Scene:
     object_keyframes: ObjectKeyframes | None = None
     """Object poses per keypoint when they change between keypoints (composite.CameraObjectSampler); None:
     every keypoint shows the objects' ``local2world``."""
+    empties: list[Empty] = field(default_factory=list)
+    """Named poses without geometry (never drawn, no instance id; :mod:`hybridgen.scene.empty`)."""
 
     def add(self, obj: MeshObject) -> MeshObject:
         """Add ``obj``, assigning its stable instance id; returns it."""

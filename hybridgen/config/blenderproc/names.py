@@ -28,17 +28,12 @@ UNAVAILABLE = {
                               "with a selector for the lamp objects",
     "camera.SuncgCameraSampler": "samples cameras inside SUNCG rooms (a withdrawn dataset); use "
                                  "camera.CameraSampler with proximity_checks",
-    "camera.Front3DCameraSampler": "samples inside 3D-FRONT rooms; use camera.CameraSampler with "
-                                   "proximity_checks",
-    "camera.ReplicaCameraSampler": "samples inside Replica scenes; use camera.CameraSampler with proximity_checks",
     "loader.AMASSLoader": "posing SMPL bodies needs the AMASS data and the SMPL body model (licensed, not "
                           "distributable); export posed bodies to OBJ and load them with loader.ObjLoader",
     "loader.RockEssentialsRockLoader": "reads Blender .blend rock packs; " + _EXPORT,
     "constructor.RockEssentialsGroundConstructor": "builds Blender node-displaced ground; use "
                                                    "loader.PrimitiveLoader (plane) with a texture",
     "materials.RockEssentialsTextureSampler": "samples Blender node textures; use manipulators.MaterialManipulator",
-    "constructor.BasicEmptyInitializer": "Blender empties (axes without geometry) have no counterpart in "
-                                         "hybridgen scenes; use a location directly where an empty was a target",
     "object.CalibrationboardSampler": "samples a Blender calibration-board asset; load the board as a mesh "
                                       "and place it with object.ObjectPoseSampler",
     "writer.StereoGlobalMatchingWriter": "stereo depth by SGM is not implemented; renderer.RgbRenderer with "

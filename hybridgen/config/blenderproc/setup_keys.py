@@ -23,8 +23,6 @@ GLOBAL_IGNORED = {
     "output_is_temp": "hybridgen keeps no temporary per-frame files; writers write the final files",
     "pixel_aspect_x": "hybridgen cameras have square pixels unless cam_K says otherwise",
     "pixel_aspect_y": "hybridgen cameras have square pixels unless cam_K says otherwise",
-    "data_set_name": "a dataset loader setting (Replica); that loader is not available",
-    "data_path": "a dataset loader setting; that loader is not available",
     "avoid_rendering": "hybridgen always renders what the config's renderers ask",
 }
 """``global`` keys that only configure Blender or BlenderProc internals: ignored with a notice."""
