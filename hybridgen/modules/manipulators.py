@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..config.displacement_config import displacement_from_config
 from ..config.material_config import apply_material_config
 from ..config.registry import register_module
 from ..config.schema import Param
@@ -11,6 +12,7 @@ from ..errors import InputError
 from ..scene.frames import object_pose
 from ..run.context import RunContext
 from ..scene.material import TEXTURE_SLOTS
+from ..scene.displacement import displace_objects
 from ..scene.frames import matrix_to_euler_xyz
 from .base import Role
 from .selecting import SelectingModule
@@ -55,10 +57,19 @@ class EntityManipulator(SelectingModule):
         Param("scale", "float|list|null", None, doc="new scale", sampleable=True),
         Param("attributes", "dict", {}, sampleable=True, doc="custom attributes to set (e.g. for map_by)"),
         Param("category_id", "int|null", None, doc="new category_id"),
+        Param("displace", "dict|null", None, sampleable=True,
+              doc="true geometric displacement (Blender's Subdivision + Displace modifiers, BlenderProc's "
+                  "cf_add_displace_modifier_with_texture): {texture: height image, strength: 0.1, mid_level: 0.5, "
+                  "subdiv_level: 2, min_vertices_for_subdiv: 10000, texture_coords: LOCAL|UV}; labels and color "
+                  "see the displaced mesh (hybridgen/scene/displacement.py)"),
     )
 
     def run(self, context: RunContext) -> None:
+        displaced: dict = {}  # objects sharing a mesh and modifier share one displaced mesh
         for obj in self.selected(context):
+            displace = self.value(context, "displace")
+            if displace is not None:
+                displace_objects([obj], displacement_from_config(displace), displaced)
             location, rotation, scale = (self.value(context, k) for k in ("location", "rotation", "scale"))
             if location is not None or rotation is not None or scale is not None:
                 current = obj.local2world

@@ -35,7 +35,10 @@ class Material:
     - ``displacement_texture``: height h in 0..1; the surface is displaced by (h - 0.5) x
       ``displacement_scale`` metres along its normal. Rendered as a bump (shading normals only, the geometry
       and so the labels stay undisplaced) - what Blender's default material displacement method "Bump
-      Only" does with BlenderProc's displacement node.
+      Only" does with BlenderProc's displacement node: BlenderProc (1.12) never sets a material's
+      ``cycles.displacement_method``, so ambientCG / Poly Haven ``_Displacement`` maps are bumps in its
+      renders too. True geometric displacement is the Displace modifier's job
+      (:mod:`hybridgen.scene.displacement`, EntityManipulator ``displace``).
     - ``alpha_mode``: "BLEND" - alpha is a fractional opacity in color, labels see the surface (BlenderProc's
       default, segmentation without ``use_alpha``); "CLIP" - alpha >= 0.5 is opaque, below it the surface is
       cut out of color, albedo and every label (Blender's alpha clip, BlenderProc's ``use_alpha``).
