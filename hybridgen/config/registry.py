@@ -49,6 +49,7 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.random_room",
     "hybridgen.modules.room_camera_samplers",
     "hybridgen.modules.empty_initializer",
+    "hybridgen.modules.calibration_board",
 )
 
 _BUILTIN_NAMES = {
@@ -93,6 +94,7 @@ _BUILTIN_NAMES = {
     "camera.Front3DCameraSampler": "hybridgen.modules.room_camera_samplers",
     "camera.ReplicaCameraSampler": "hybridgen.modules.room_camera_samplers",
     "constructor.BasicEmptyInitializer": "hybridgen.modules.empty_initializer",
+    "object.CalibrationboardSampler": "hybridgen.modules.calibration_board",
 }
 """Built-in module name -> the file registering it: :func:`get_module` imports that file alone (importing all
 of them costs ~0.2 s of every run's start); a name missing here, or a plugin's, loads every module first."""

@@ -34,8 +34,6 @@ UNAVAILABLE = {
     "constructor.RockEssentialsGroundConstructor": "builds Blender node-displaced ground; use "
                                                    "loader.PrimitiveLoader (plane) with a texture",
     "materials.RockEssentialsTextureSampler": "samples Blender node textures; use manipulators.MaterialManipulator",
-    "object.CalibrationboardSampler": "samples a Blender calibration-board asset; load the board as a mesh "
-                                      "and place it with object.ObjectPoseSampler",
     "writer.StereoGlobalMatchingWriter": "stereo depth by SGM is not implemented; renderer.RgbRenderer with "
                                          "stereo: true writes exact per-eye depth instead",
     "loader.TextureLoader": "loads images as Blender textures for node functions and modifiers hybridgen does not "

@@ -125,7 +125,25 @@ def camera_loader(config: dict[str, Any], note: Note) -> list[tuple[str, dict[st
         if moved:
             cfg["default_cam_param"] = {k: v for k, v in defaults.items() if k not in moved}
             cfg["intrinsics"] = {**moved, **(cfg.get("intrinsics") or {})}
+    poses = cfg.get("cam_poses")
+    if isinstance(poses, list):  # BlenderProc reads location/rotation/cam2world_matrix and skips other keys
+        cfg["cam_poses"] = [_read_pose_keys(entry, i, note) if isinstance(entry, dict) else entry
+                            for i, entry in enumerate(poses)]
     return [("camera.CameraLoader", cfg)]
+
+
+_POSE_KEYS = ("location", "rotation", "cam2world_matrix", "source_frame")
+
+
+def _read_pose_keys(entry: dict[str, Any], index: int, note: Note) -> dict[str, Any]:
+    """A cam_poses entry without the keys BlenderProc's CameraLoader does not read (e.g. ``rotation_euler``,
+    where it reads ``rotation: {value}``), each reported."""
+    kept = dict(entry)
+    for key in [k for k in entry if k not in _POSE_KEYS]:
+        pop_ignored(kept, key, lambda m, k: note(m, f"cam_poses[{index}].{k}"),
+                    "BlenderProc's CameraLoader does not read this key (a pose has location, rotation: "
+                    "{value, format}, cam2world_matrix)")
+    return kept
 
 
 _MODULE_LEVEL_CHECKS = ("check_pose_novelty_rot", "check_pose_novelty_translation", "min_var_diff_rot",
