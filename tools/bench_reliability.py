@@ -169,7 +169,8 @@ def folder_fingerprint(files: int, kib: int, tmp: Path) -> None:
 
     from hybridgen.config.config_file import load_config
     from hybridgen.run.fingerprint import run_fingerprint
-    from hybridgen.run.input_hashes import SETTLE_NS, InputHashes
+    from hybridgen.io.file_identity import SETTLE_NS
+    from hybridgen.run.input_hashes import InputHashes
 
     folder = tmp / "textures"
     folder.mkdir()

@@ -3,10 +3,12 @@
 :func:`load_objects_cached` returns what :func:`hybridgen.io.mesh_loader.load_objects` returns, but keeps
 the parsed objects (in the file's own frame, with the properties the label pass needs - face normals and
 whether each part is a closed volume - already computed) under ``$HYBRIDGEN_CACHE_DIR/meshes`` (default
-``$XDG_CACHE_HOME/hybridgen/meshes`` or ``~/.cache/hybridgen/meshes``, as the physics cache). The key is a SHA-256 over the bytes of the file and of every MTL / texture
-file it names, the options that change parsing (``name``, ``up_axis``), the hybridgen version and the
-source of the modules that build the objects - so an edited file, texture or loader never meets a stale
-entry. Entries are written to a temporary name and renamed (atomic); a damaged or unreadable entry is a
+``$XDG_CACHE_HOME/hybridgen/meshes`` or ``~/.cache/hybridgen/meshes``, see :mod:`hybridgen.io.cache_folder`).
+The key is a SHA-256 over the bytes of the file and of every MTL / texture file it names, the options that
+change parsing (``name``, ``up_axis``), the hybridgen version and the source of the modules that build the
+objects - so an edited file, texture or loader never meets a stale entry. The file hashes and the scan for
+the names come from :mod:`hybridgen.io.file_identity`'s per-process memos, which the run's fingerprint has
+usually filled already: a warm load reads only the entry. Entries are written to a temporary name and renamed (atomic); a damaged or unreadable entry is a
 miss. ``HYBRIDGEN_CACHE_DIR=off`` (or an unwritable folder) turns the cache off.
 
 Entries are pickles: the cache folder must be writable only by its user (as any ``~/.cache``).
@@ -17,29 +19,29 @@ import hashlib
 import os
 import pickle
 import tempfile
+from functools import cache
 from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 
 from .._version import __version__
+from .cache_folder import cache_path
+from .file_identity import content_sha256
 from .mesh_references import referenced_files
 
-CACHE_ENV = "HYBRIDGEN_CACHE_DIR"
 _FORMAT = 1
 
 
 def cache_dir() -> Path | None:
     """The folder of cached meshes (``meshes`` in hybridgen's cache folder), or None when turned off."""
-    from ..physics.shapes import cache_dir as hybridgen_cache_dir
-
-    if os.environ.get(CACHE_ENV, "").lower() in ("off", "0", "none"):
-        return None
-    return hybridgen_cache_dir() / "meshes"
+    return cache_path("meshes")
 
 
+@cache
 def _source_digest() -> str:
-    """SHA-256 of the modules whose code decides what a loaded object holds."""
+    """SHA-256 of the modules whose code decides what a loaded object holds (read once: it is the code this
+    process runs)."""
     from ..scene import material, mesh_object
     from . import mesh_loader
 
@@ -65,8 +67,7 @@ def cache_key(path: Path, options: dict[str, Any]) -> str:
     for file in files:
         digest.update(f"\0{file.name}\0".encode())
         try:
-            with open(file, "rb") as handle:
-                digest.update(hashlib.file_digest(handle, "sha256").digest())
+            digest.update(bytes.fromhex(content_sha256(file)))
         except OSError:
             digest.update(b"<missing>")
     return digest.hexdigest()

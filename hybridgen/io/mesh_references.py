@@ -1,13 +1,17 @@
 """Files a mesh file names: the MTL libraries of an OBJ and the texture maps of an MTL.
 
 Used to check that they exist before loading (trimesh renders a mesh untextured, without a word, when they
-are missing) and to include them in a run's fingerprint (an edited texture changes the output).
+are missing), to include them in a run's fingerprint (an edited texture changes the output) and in the mesh
+cache's key. The scan of a file is remembered by the file's identity (:mod:`hybridgen.io.file_identity`),
+so these users share one read of a large OBJ per process.
 """
 from __future__ import annotations
 
 import os
 import re
 from pathlib import Path
+
+from .file_identity import IdentityMemo
 
 MAX_SCANNED_BYTES = 512 * 2**20
 _MTLLIB = re.compile(rb"^[ \t]*mtllib[ \t]+(.+?)[ \t]*\r?$", re.MULTILINE)
@@ -22,10 +26,18 @@ def referenced_files(path: Path) -> list[Path]:
     suffix = path.suffix.lower()
     if suffix not in (".obj", ".mtl") or path.stat().st_size > MAX_SCANNED_BYTES:
         return []
+    return [path.parent / name for name in scanned_names(path)]
+
+
+def _scan(path: Path) -> tuple[str, ...]:
     data = path.read_bytes()
-    matches = _mtllib_statements(data) if suffix == ".obj" else _MAPS.finditer(data)
-    names = [m.group(1).decode("utf-8", "replace") for m in matches]
-    return [path.parent / name.replace("\\", "/") for name in names]
+    matches = _mtllib_statements(data) if path.suffix.lower() == ".obj" else _MAPS.finditer(data)
+    return tuple(m.group(1).decode("utf-8", "replace").replace("\\", "/") for m in matches)
+
+
+scanned_names: IdentityMemo[tuple[str, ...]] = IdentityMemo(_scan)
+"""The names an .obj (``mtllib``) or .mtl (texture maps) file holds, as written ('/' separators), read once
+per process and file identity."""
 
 
 def _mtllib_statements(data: bytes) -> list[re.Match[bytes]]:

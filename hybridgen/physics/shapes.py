@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError, SystemSetupError
+from ..io.cache_folder import cache_root
 
 SHAPES = ("convex_hull", "convex_decomposition", "auto", "mesh")
 """Collision shape kinds: ``mesh`` (the exact triangles) is only possible for passive (static) objects."""
@@ -80,11 +81,8 @@ class CollisionGeometry:
 
 def cache_dir() -> Path:
     """Where hybridgen caches derived data (decompositions): ``$HYBRIDGEN_CACHE_DIR``, else
-    ``$XDG_CACHE_HOME/hybridgen``, else ``~/.cache/hybridgen``."""
-    if os.environ.get("HYBRIDGEN_CACHE_DIR"):
-        return Path(os.environ["HYBRIDGEN_CACHE_DIR"])
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "hybridgen"
+    ``$XDG_CACHE_HOME/hybridgen``, else ``~/.cache/hybridgen`` (:func:`hybridgen.io.cache_folder.cache_root`)."""
+    return cache_root()
 
 
 def _coacd() -> Any:

@@ -4,20 +4,20 @@ A run's fingerprint (:mod:`hybridgen.run.fingerprint`) holds the content hash of
 names - up to 10,000 files per named folder (texture libraries, model folders). Hashing them on every run
 (and on every resume) reads all their bytes. :class:`InputHashes` keeps each hash with the file's identity
 ``(device, inode, size, mtime_ns, ctime_ns)`` in ``input_hashes.json`` in hybridgen's cache folder
-(``$HYBRIDGEN_CACHE_DIR``, else ``$XDG_CACHE_HOME/hybridgen`` or ``~/.cache/hybridgen``, as the mesh and
-physics caches; ``HYBRIDGEN_CACHE_DIR=off`` turns it off), shared by every output folder that uses the same
-assets. A file whose identity changed in any field is hashed again; ``ctime`` changes on every write and
-cannot be set back by tools that restore ``mtime`` (``touch -d``, ``rsync -t``, ``cp -p``).
+(:mod:`hybridgen.io.cache_folder`; ``HYBRIDGEN_CACHE_DIR=off`` turns it off), shared by every output folder
+that uses the same assets. A file whose identity changed in any field is hashed again; ``ctime`` changes on
+every write and cannot be set back by tools that restore ``mtime`` (``touch -d``, ``rsync -t``, ``cp -p``).
 
-As with git's index, a file changed within :data:`SETTLE_NS` of being hashed could change again within the
-same timestamp tick, so its hash is used but not remembered; a file that changes while it is hashed is not
-remembered either. The cache is written to a temporary name and renamed (concurrent runs: the last writer
+As with git's index, a file changed within :data:`~hybridgen.io.file_identity.SETTLE_NS` of being hashed
+could change again within the same timestamp tick, so its hash is used but not remembered; a file that
+changes while it is hashed is not remembered either (the rule of :mod:`hybridgen.io.file_identity`, whose
+per-process memo also receives every hash used here, so the mesh cache's key does not read the file again).
+The cache is written to a temporary name and renamed (concurrent runs: the last writer
 wins, a lost entry is only hashed again), merged with what another run stored meanwhile, and bounded to
 :data:`MAX_ENTRIES` entries (least recently used dropped). A damaged or unreadable cache is ignored.
 """
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import tempfile
@@ -25,31 +25,22 @@ import time
 from pathlib import Path
 from typing import Any
 
+from ..io.cache_folder import cache_path
+from ..io.file_identity import content_sha256, file_identity, file_sha256, is_settled
+
 CACHE_FILE = "input_hashes.json"
-CACHE_ENV = "HYBRIDGEN_CACHE_DIR"
 MAX_ENTRIES = 100_000
-SETTLE_NS = 2_000_000_000  # a file changed less than 2 s before it was hashed is not remembered
 _FORMAT = 1
 _USE_RESOLUTION_S = 86_400  # last-use times are refreshed at most daily (a hit rarely rewrites the cache)
 
 
-def file_sha256(path: Path) -> str:
-    """Hex SHA-256 of a file's bytes (read in full)."""
-    with open(path, "rb") as handle:
-        return hashlib.file_digest(handle, "sha256").hexdigest()
-
-
 def default_cache_file() -> Path | None:
     """``input_hashes.json`` in hybridgen's cache folder, or None when ``HYBRIDGEN_CACHE_DIR=off``."""
-    from ..physics.shapes import cache_dir
-
-    if os.environ.get(CACHE_ENV, "").lower() in ("off", "0", "none"):
-        return None
-    return cache_dir() / CACHE_FILE
+    return cache_path(CACHE_FILE)
 
 
 def _identity(stat: os.stat_result) -> list[int]:
-    return [stat.st_dev, stat.st_ino, stat.st_size, stat.st_mtime_ns, stat.st_ctime_ns]
+    return list(file_identity(stat))
 
 
 def _read_entries(path: Path | None) -> dict[str, list[Any]]:
@@ -94,13 +85,14 @@ class InputHashes:
             if now - entry[6] > _USE_RESOLUTION_S:
                 entry[6] = int(now)
                 self._changed = True
+            content_sha256.remember(Path(key), before, str(entry[5]))
             return str(entry[5])
         digest = file_sha256(Path(key))
         self.hashed += 1
-        settled = time.time_ns() - max(before.st_mtime_ns, before.st_ctime_ns) > SETTLE_NS
-        if settled and _identity(os.stat(key)) == identity:
+        if is_settled(before) and _identity(os.stat(key)) == identity:
             self._entries[key] = [*identity, digest, int(now)]
             self._changed = True
+            content_sha256.remember(Path(key), before, digest)
         return digest
 
     def save(self) -> None:

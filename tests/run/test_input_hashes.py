@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from hybridgen.io import file_identity
 from hybridgen.run import input_hashes
 from hybridgen.run.input_hashes import InputHashes
 
@@ -22,7 +23,7 @@ def _settled(path: Path, data: bytes) -> Path:
 @pytest.fixture
 def no_settling(monkeypatch):
     """Files written by the test count as settled at once (else they are hashed but not remembered)."""
-    monkeypatch.setattr(input_hashes, "SETTLE_NS", 0)
+    monkeypatch.setattr(file_identity, "SETTLE_NS", 0)  # the racily-clean guard lives in io.file_identity
 
 
 def test_unchanged_files_are_not_read_again(tmp_path, no_settling, monkeypatch):

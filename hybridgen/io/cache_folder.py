@@ -1,0 +1,30 @@
+"""hybridgen's cache folder: where derived data that is expensive to recompute is kept between runs.
+
+``$HYBRIDGEN_CACHE_DIR``, else ``$XDG_CACHE_HOME/hybridgen``, else ``~/.cache/hybridgen``. Parsed meshes
+(:mod:`hybridgen.io.mesh_cache`), input-file hashes (:mod:`hybridgen.run.input_hashes`) and convex
+decompositions (:mod:`hybridgen.physics.shapes`) live in it. ``HYBRIDGEN_CACHE_DIR=off`` (or ``0``, ``none``)
+turns the mesh and input-hash caches off. Nothing here imports more than the standard library, so every
+layer (io, run, physics) can use it.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+CACHE_ENV = "HYBRIDGEN_CACHE_DIR"
+OFF_VALUES = ("off", "0", "none")
+
+
+def cache_root() -> Path:
+    """The cache folder (see the module documentation); it may not exist yet."""
+    if os.environ.get(CACHE_ENV):
+        return Path(os.environ[CACHE_ENV])
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "hybridgen"
+
+
+def cache_path(name: str) -> Path | None:
+    """``name`` (a file or folder) in the cache folder, or None when ``$HYBRIDGEN_CACHE_DIR`` turns caching off."""
+    if os.environ.get(CACHE_ENV, "").lower() in OFF_VALUES:
+        return None
+    return cache_root() / name
