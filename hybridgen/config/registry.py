@@ -50,6 +50,7 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.room_camera_samplers",
     "hybridgen.modules.empty_initializer",
     "hybridgen.modules.calibration_board",
+    "hybridgen.modules.texture_loader",
 )
 
 _BUILTIN_NAMES = {
@@ -95,6 +96,7 @@ _BUILTIN_NAMES = {
     "camera.ReplicaCameraSampler": "hybridgen.modules.room_camera_samplers",
     "constructor.BasicEmptyInitializer": "hybridgen.modules.empty_initializer",
     "object.CalibrationboardSampler": "hybridgen.modules.calibration_board",
+    "loader.TextureLoader": "hybridgen.modules.texture_loader",
 }
 """Built-in module name -> the file registering it: :func:`get_module` imports that file alone (importing all
 of them costs ~0.2 s of every run's start); a name missing here, or a plugin's, loads every module first."""

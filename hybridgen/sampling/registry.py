@@ -15,7 +15,7 @@ import numpy as np
 
 from ..nested import map_nested
 from ..errors import ConfigError, InputError, closest
-from . import attribute_getter, attribute_merger, getters, samplers  # noqa: F401  (the built-ins register themselves)
+from . import attribute_getter, attribute_merger, getters, samplers, texture_getter  # noqa: F401  (they register)
 from .sampler_table import ALIASES, SAMPLERS, DrawContext, SamplerSpec
 
 

@@ -7,6 +7,7 @@ from typing import Iterator
 from ..errors import InputError
 from .camera import Camera
 from .empty import Empty
+from .image_texture import ImageTexture
 from .light import Light
 from .mesh_object import MeshObject
 from .object_keyframes import ObjectKeyframes
@@ -41,6 +42,8 @@ class Scene:
     every keypoint shows the objects' ``local2world``."""
     empties: list[Empty] = field(default_factory=list)
     """Named poses without geometry (never drawn, no instance id; :mod:`hybridgen.scene.empty`)."""
+    textures: list[ImageTexture] = field(default_factory=list)
+    """Images loaded for later use (``loader.TextureLoader``), selected with ``getter.Texture``; never drawn."""
 
     def add(self, obj: MeshObject) -> MeshObject:
         """Add ``obj``, assigning its stable instance id; returns it."""

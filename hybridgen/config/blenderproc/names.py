@@ -36,9 +36,6 @@ UNAVAILABLE = {
     "materials.RockEssentialsTextureSampler": "samples Blender node textures; use manipulators.MaterialManipulator",
     "writer.StereoGlobalMatchingWriter": "stereo depth by SGM is not implemented; renderer.RgbRenderer with "
                                          "stereo: true writes exact per-eye depth instead",
-    "loader.TextureLoader": "loads images as Blender textures for node functions and modifiers hybridgen does not "
-                            "apply (cf_add_dust, cf_infuse_texture, displacement); give materials image maps with "
-                            "manipulators.MaterialManipulator (base_color_texture ...) or loader.CCMaterialLoader",
     "loader.VisNormalImage": "a debugging view of Blender's normal images; view hybridgen's normals with "
                              "'hybridgen vis'",
     "writer.MyWriter": "an example of a user plugin; write it as a hybridgen plugin (entry point "
