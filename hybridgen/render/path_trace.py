@@ -17,7 +17,8 @@ import numpy as np
 from ..errors import InputError
 from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
-from . import clamped_path, pinhole_sensor, pixel_filter
+from ..scene.depth_of_field import DepthOfField
+from . import clamped_path, pinhole_sensor, pixel_filter, thin_lens_sensor
 from .adaptive_sampling import PixelTracer, SamplingPlan, render_adaptive
 from .mitsuba_scene import scene_dict
 from .mitsuba_variant import activate, choose_variant, is_jit
@@ -139,11 +140,13 @@ class PathTraceSettings:
                 "clamp_indirect": float(self.clamp_indirect), **{keys[k]: v for k, v in limits.items()}}
 
 
-def sensor_dict(intr: Intrinsics, cam2world: np.ndarray, variant: str) -> dict[str, Any]:
+def sensor_dict(intr: Intrinsics, cam2world: np.ndarray, variant: str,
+                depth_of_field: DepthOfField | None = None) -> dict[str, Any]:
     """The sensor of ``intr`` with a one-pixel box filter.
 
-    JIT variants use :mod:`hybridgen.render.pinhole_sensor` (any K); ``scalar_rgb``, where a Python sensor
-    would run per sample, uses Mitsuba's ``perspective`` sensor, which needs square pixels.
+    JIT variants use :mod:`hybridgen.render.pinhole_sensor` (any K), or with a ``depth_of_field``
+    :mod:`hybridgen.render.thin_lens_sensor`; ``scalar_rgb``, where a Python sensor would run per sample, uses
+    Mitsuba's ``perspective`` sensor, which needs square pixels (and has no depth of field).
     """
     import mitsuba as mi
 
@@ -152,6 +155,11 @@ def sensor_dict(intr: Intrinsics, cam2world: np.ndarray, variant: str) -> dict[s
     fx, fy, cx, cy = intr.K[0, 0], intr.K[1, 1], intr.K[0, 2], intr.K[1, 2]
     common = {"near_clip": intr.clip_start, "far_clip": intr.clip_end, "film": film,
               "sampler": {"type": SAMPLER}}
+    if is_jit(variant) and depth_of_field is not None:
+        return thin_lens_sensor.sensor(intr, cam2world, variant, depth_of_field, common)
+    if depth_of_field is not None:
+        raise InputError("depth of field needs a JIT Mitsuba variant (llvm_ad_rgb or cuda_ad_rgb; install "
+                         "libllvm19)")
     if is_jit(variant):
         pinhole_sensor.register(variant)
         return {"type": pinhole_sensor.PLUGIN_NAME, "fx": fx, "fy": fy, "cx": cx, "cy": cy, **common}
@@ -185,7 +193,7 @@ class PathTraceView:
         self._own_film = integrator is not None  # e.g. AOV integrators: rendered through Mitsuba's film
         description["integrator"] = integrator or self.settings.integrator_for(self.variant)
         first = scene.camera.keypoints[0] if scene.camera.keypoints else np.eye(4)
-        description["sensor"] = sensor_dict(self.intrinsics, first, self.variant)
+        description["sensor"] = sensor_dict(self.intrinsics, first, self.variant, scene.camera.depth_of_field)
         try:
             self.mi_scene = mi.load_dict(description)
         except RuntimeError as exc:
