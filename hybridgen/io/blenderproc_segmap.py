@@ -6,13 +6,18 @@ are its ``map_by`` entries in order - ``instance`` (the object's id), ``class`` 
 attribute whose values are numbers - squeezed to H x W when there is one channel. Attributes that are not
 numbers (``name``, text custom properties) get no channel: they are in the per-keypoint attribute map (here
 ``instance_attribute_maps``). ``default_values`` give objects that lack an attribute that value (``class`` is
-``category_id``); without one, a missing attribute is an error, as in BlenderProc.
+``category_id``); without one, a missing attribute is an error, as in BlenderProc. An attribute that only
+default values fill - no object holds a value of its own - gets no channel either (BlenderProc keeps a channel
+only when a value not taken from ``default_values`` was used; it decides per frame among the visible objects,
+hybridgen once per scene among all objects, because the segmap dataset has one layout for every keypoint);
+when that leaves no channel at all, the run stops with one line, as BlenderProc's stacking of no channel does.
 
 hybridgen renders each attribute as its own ``<attr>_segmaps`` pass; :class:`SegmapSink` stacks them into the
 ``segmap`` dataset in front of the writers, which still get the per-attribute passes too.
 """
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, replace
 from typing import Any, Mapping
 
@@ -42,8 +47,13 @@ def _numeric(value: Any) -> bool:
     return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
 
 
+_DEFAULTED: "weakref.WeakKeyDictionary[Any, set[str]]" = weakref.WeakKeyDictionary()
+"""Per object, the attributes it holds because ``default_values`` gave them (not its own values)."""
+
+
 def apply_default_values(scene: Scene, defaults: Mapping[str, Any]) -> None:
-    """Objects lacking an attribute of ``defaults`` (``class`` / ``cp_<name>`` / ``<name>``) get its value."""
+    """Objects lacking an attribute of ``defaults`` (``class`` / ``cp_<name>`` / ``<name>``) get its value
+    (remembered as a default value, see :func:`segmap_plan`)."""
     for key, value in defaults.items():
         attribute = key[3:] if key.startswith("cp_") else _ATTRIBUTE.get(key, key)
         for obj in scene.objects:
@@ -53,13 +63,19 @@ def apply_default_values(scene: Scene, defaults: Mapping[str, Any]) -> None:
                 obj.category_id = int(value) if _numeric(value) else value
             else:
                 obj.attributes[attribute] = value
+            _DEFAULTED.setdefault(obj, set()).add(attribute)
+
+
+def only_defaults(scene: Scene, attribute: str) -> bool:
+    """Whether every object holds ``attribute`` only because ``default_values`` gave it."""
+    return all(attribute in _DEFAULTED.get(obj, ()) for obj in scene.objects)
 
 
 def segmap_plan(scene: Scene, map_by: list[str]) -> SegmapPlan:
     """Channels of BlenderProc's segmap for ``map_by`` (hybridgen names: ``instance``, ``class``, attributes).
     An attribute every object holds as a number is a channel; one no object holds as a number is left to the
     attribute map; a mix, or one some object lacks, is an error naming the object."""
-    rendered, channels = [], []
+    rendered, channels, dropped = [], [], []
     for entry in map_by:
         if entry == "instance":
             rendered.append(entry)
@@ -72,12 +88,20 @@ def segmap_plan(scene: Scene, map_by: list[str]) -> SegmapPlan:
             raise InputError(f"object '{missing[0]}' has no '{entry}' to map segmentation by; give it one or set "
                              f"SegMapRenderer's default_values")
         numeric = [_numeric(value) for value in values.values()]
+        if all(numeric) and only_defaults(scene, attribute):
+            rendered.append(entry)  # hybridgen's own <attr>_segmaps pass stays (writers may read it) ...
+            dropped.append(entry)  # ... but BlenderProc drops a channel no value of an object's own went into
+            continue
         if all(numeric):
             rendered.append(entry)
             channels.append(f"{attribute}_segmaps")
         elif any(numeric):
             raise InputError(f"'{entry}' holds numbers on some objects and text on others: BlenderProc's "
                              "segmap needs one kind per attribute (check default_values' type)")
+    if dropped and not channels:
+        raise InputError(f"every object takes {', '.join(dropped)} from default_values: BlenderProc's segmap would "
+                         "have no channel (BlenderProc stops here too); give the objects their own values or map "
+                         "by instance as well")
     return SegmapPlan(rendered, channels)
 
 

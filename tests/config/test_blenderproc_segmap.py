@@ -31,6 +31,7 @@ CONFIG = """\
 
 
 def _run(tmp_path, map_by, defaults, output=""):
+    tmp_path.mkdir(exist_ok=True)
     text = CONFIG.replace("MAP_BY", json.dumps(map_by)).replace("DEFAULTS", json.dumps(defaults))
     text = text.replace(" OUTPUT", f', "output_key": "{output}"' if output else "")
     config = tmp_path / "config.yaml"
@@ -69,3 +70,14 @@ def test_one_channel_is_an_image_and_class_is_the_default(tmp_path):
 def test_an_attribute_some_object_lacks_needs_a_default(tmp_path):
     with pytest.raises(HybridgenError, match="'floor' has no 'weight'.*default_values"):
         _run(tmp_path, ["instance", "cp_weight"], {})
+
+
+def test_a_channel_only_default_values_fill_is_dropped(tmp_path):
+    # no object has a 'score' of its own: BlenderProc keeps no channel for it; 'weight' (the box's own 3) stays
+    data = _run(tmp_path, ["instance", "cp_score", "cp_weight"], {"cp_score": 4, "cp_weight": 7})
+    segmap = np.asarray(data["segmap"])[0]
+    assert segmap.shape == (24, 32, 2)  # instance, weight
+    assert tuple(segmap[12, 16]) == (2, 3) and tuple(segmap[0, 0]) == (1, 7)
+    np.testing.assert_array_equal(np.asarray(data["score_segmaps"])[0], 4)  # hybridgen's own pass stays
+    with pytest.raises(HybridgenError, match="every object takes score from default_values"):
+        _run(tmp_path / "single", ["cp_score"], {"cp_score": 4})
