@@ -27,6 +27,8 @@ from __future__ import annotations
 from functools import lru_cache
 from typing import Any
 
+from . import transparent_shadows
+
 PLUGIN_NAME = "hybridgen_clamped_path"
 
 
@@ -43,6 +45,8 @@ def register(variant: str) -> None:
             self.rr_depth = int(props.get("rr_depth", 5))
             self.clamp_indirect = float(props.get("clamp_indirect", 0.0))
             self.limits = tuple(int(props.get(k, -1)) for k in ("max_diffuse", "max_glossy", "max_transmission"))
+            # hybridgen/render/transparent_shadows.py: shadow rays through masks, null passes cost no bounce
+            self.transparent_shadows = bool(props.get("transparent_shadows", False))
 
         @staticmethod
         def _mis_weight(pdf_a: Any, pdf_b: Any) -> Any:
@@ -64,6 +68,8 @@ def register(variant: str) -> None:
             import mitsuba as mi
 
             mis_weight = self._mis_weight
+            transparent = self.transparent_shadows
+            n_transparent = mi.UInt32(0)
             bsdf_ctx = mi.BSDFContext()
             ray = mi.Ray3f(ray)
             depth = mi.UInt32(0)
@@ -95,8 +101,10 @@ def register(variant: str) -> None:
 
                 # Next-event estimation: one emitter sample, MIS-weighted against BSDF sampling.
                 active_em = active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth)
-                ds_em, em_weight = scene.sample_emitter_direction(si, sampler.next_2d(), True, active_em)
+                ds_em, em_weight = scene.sample_emitter_direction(si, sampler.next_2d(), not transparent, active_em)
                 active_em &= ds_em.pdf != 0.0
+                if transparent:
+                    em_weight *= transparent_shadows.shadow_transmittance(scene, si, ds_em, active_em)
                 wo = si.to_local(ds_em.d)
                 bsdf_val, bsdf_pdf = bsdf.eval_pdf(bsdf_ctx, si, wo, active_em)
                 mis_em = dr.select(ds_em.delta, 1.0, mis_weight(ds_em.pdf, bsdf_pdf))
@@ -120,10 +128,15 @@ def register(variant: str) -> None:
                 ray = si.spawn_ray(si.to_world(bsdf_sample.wo))
                 throughput *= bsdf_weight
                 eta *= bsdf_sample.eta
-                si_prev = si
-                bsdf_pdf_prev = bsdf_sample.pdf
-                bsdf_delta_prev = mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
-                depth[si.is_valid()] += 1
+                # a null pass (through a transparent texel) keeps the last real vertex's MIS state and bounces
+                null_pass = mi.has_flag(sampled, mi.BSDFFlags.Null) & transparent & si.is_valid()
+                n_transparent[null_pass] += 1
+                last_segment |= n_transparent > transparent_shadows.MAX_TRANSPARENT
+                si_prev = dr.select(null_pass, si_prev, si)
+                bsdf_pdf_prev = dr.select(null_pass, bsdf_pdf_prev, bsdf_sample.pdf)
+                bsdf_delta_prev = dr.select(null_pass, bsdf_delta_prev,
+                                            mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta))
+                depth[si.is_valid() & ~null_pass] += 1
 
                 # Russian roulette from rr_depth on (survivors are reweighted: unbiased).
                 throughput_max = dr.max(mi.unpolarized_spectrum(throughput))

@@ -18,7 +18,7 @@ from ..errors import InputError
 from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
 from ..scene.depth_of_field import DepthOfField
-from . import clamped_path, pinhole_sensor, pixel_filter, thin_lens_sensor
+from . import clamped_path, pinhole_sensor, pixel_filter, thin_lens_sensor, transparent_shadows
 from .adaptive_sampling import PixelTracer, SamplingPlan, render_adaptive
 from .mitsuba_scene import scene_dict
 from .mitsuba_variant import activate, choose_variant, is_jit
@@ -120,24 +120,27 @@ class PathTraceSettings:
         return {name: value for name, value in self._lobe_bounces().items()
                 if value is not None and value < self.max_bounces}
 
-    def integrator_for(self, variant: str) -> dict[str, Any]:
+    def integrator_for(self, variant: str, transparent_shadows: bool = False) -> dict[str, Any]:
         """The integrator used in ``variant``: hybridgen's clamped path tracer where it can run (JIT variants)
-        and is needed (clamp on, or per-lobe limits), else :meth:`integrator`."""
+        and is needed (clamp on, per-lobe limits, or ``transparent_shadows`` for a scene with alpha surfaces:
+        :mod:`hybridgen.render.transparent_shadows`), else :meth:`integrator` (``volpath`` in ``scalar_rgb``
+        with ``transparent_shadows``)."""
         limits = self.lobe_limits()
         if not is_jit(variant):
             if limits:
                 raise InputError(f"{', '.join(f'{k} ({v})' for k, v in limits.items())} < max_bounces "
                                  f"({self.max_bounces}) needs a JIT Mitsuba variant (llvm_ad_rgb or cuda_ad_rgb): "
                                  f"{variant}'s path tracer has one depth limit for every lobe")
-            return self.integrator()
-        if self.clamp_indirect <= 0 and not limits:
+            return {**self.integrator(), "type": "volpath"} if transparent_shadows else self.integrator()
+        if self.clamp_indirect <= 0 and not limits and not transparent_shadows:
             return self.integrator()
         clamped_path.register(variant)
         plain = self.integrator()
         keys = {"diffuse_bounces": "max_diffuse", "glossy_bounces": "max_glossy",
                 "transmission_bounces": "max_transmission"}
         return {"type": clamped_path.PLUGIN_NAME, "max_depth": plain["max_depth"], "rr_depth": plain["rr_depth"],
-                "clamp_indirect": float(self.clamp_indirect), **{keys[k]: v for k, v in limits.items()}}
+                "clamp_indirect": float(self.clamp_indirect), **{keys[k]: v for k, v in limits.items()},
+                **({"transparent_shadows": True} if transparent_shadows else {})}
 
 
 def sensor_dict(intr: Intrinsics, cam2world: np.ndarray, variant: str,
@@ -191,7 +194,8 @@ class PathTraceView:
         self.intrinsics = scene.camera.intrinsics
         description = scene_dict(scene)
         self._own_film = integrator is not None  # e.g. AOV integrators: rendered through Mitsuba's film
-        description["integrator"] = integrator or self.settings.integrator_for(self.variant)
+        description["integrator"] = integrator or self.settings.integrator_for(
+            self.variant, transparent_shadows=transparent_shadows.scene_has_masks(scene))
         first = scene.camera.keypoints[0] if scene.camera.keypoints else np.eye(4)
         description["sensor"] = sensor_dict(self.intrinsics, first, self.variant, scene.camera.depth_of_field)
         try:
