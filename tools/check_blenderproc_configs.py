@@ -20,8 +20,8 @@ file of the checkout where the checkout has it (its scene.obj, camera_positions 
 example's own scene; stand-ins fill in the rest (datasets to download, outputs).
 
 Each config gets one line: ``valid``/``ran``, ``unavailable: <why>`` (a module needing Blender or a withdrawn
-dataset) or ``invalid: <the error line>``. Notices are counted, not printed. Exit status 0 always; the
-summary line gives the counts.
+dataset) or ``invalid: <the error line>``. Notices are counted (``--notices`` prints them under the config).
+Exit status 0 always; the summary line gives the counts.
 """
 from __future__ import annotations
 
@@ -96,6 +96,7 @@ class Outcome:
     status: str  # valid | ran | timeout | unavailable | invalid | failed
     detail: str = ""
     notices: int = 0
+    notice_lines: tuple[str, ...] = ()
 
 
 def example_configs(path: Path, tag: str | None, into: Path) -> list[Path]:
@@ -372,21 +373,22 @@ def check(config: Path, root: Path, run: bool, work: Path, output: Path, use_exa
             build_modules(loaded)
         except ConfigError as exc:
             status = "unavailable" if "not available in hybridgen" in exc.detail else "invalid"
-            return Outcome(name, status, str(exc).replace(str(root) + "/", ""), len(lines))
+            return Outcome(name, status, str(exc).replace(str(root) + "/", ""), len(lines), tuple(lines))
         except HybridgenError as exc:
-            return Outcome(name, "invalid", str(exc), len(lines))
+            return Outcome(name, "invalid", str(exc), len(lines), tuple(lines))
         if not run:
-            return Outcome(name, "valid", "", len(lines))
+            return Outcome(name, "valid", "", len(lines), tuple(lines))
         start = time.perf_counter()
         try:
             summary = run_config(config, args)
         except HybridgenError as exc:
-            return Outcome(name, "failed", str(exc).replace(str(root) + "/", ""), len(lines))
+            return Outcome(name, "failed", str(exc).replace(str(root) + "/", ""), len(lines), tuple(lines))
         except Exception as exc:  # a bug, not a config problem: one line naming it and where it was raised
             where = traceback.extract_tb(exc.__traceback__)[-1]
             return Outcome(name, "failed", f"crashed: {type(exc).__name__}: {exc} "
-                           f"({Path(where.filename).name}:{where.lineno})", len(lines))
-        return Outcome(name, "ran", f"{summary.frames} frames in {time.perf_counter() - start:.1f} s", len(lines))
+                           f"({Path(where.filename).name}:{where.lineno})", len(lines), tuple(lines))
+        return Outcome(name, "ran", f"{summary.frames} frames in {time.perf_counter() - start:.1f} s", len(lines),
+                       tuple(lines))
     finally:
         set_sink(None)
 
@@ -418,6 +420,7 @@ def main() -> None:
     parser.add_argument("--only", default="", help="only configs whose path contains this")
     parser.add_argument("--timeout", type=float, default=900.0,
                         help="with --run: seconds one config may run before it counts as 'timeout' (default 900)")
+    parser.add_argument("--notices", action="store_true", help="print every config's notice lines under it")
     parser.add_argument("--example-inputs", action="store_true",
                         help="use the input files the example's README names where the checkout has them "
                         "(stand-ins for the rest)")
@@ -439,6 +442,9 @@ def main() -> None:
                 if ns.run else check(config, base, ns.run, work, output, ns.example_inputs)
             outcomes.append(outcome)
             print(f"{outcome.status:11s} {outcome.config}  [{outcome.notices} notices] {outcome.detail}", flush=True)
+            if ns.notices:
+                for line in dict.fromkeys(outcome.notice_lines):  # once each, in order
+                    print("            " + line.replace(str(base) + "/", ""), flush=True)
     statuses = ("valid", "ran", "timeout", "unavailable", "invalid", "failed")
     counts = {s: sum(o.status == s for o in outcomes) for s in statuses}
     validated = counts["valid"] + counts["ran"] + counts["failed"] + counts["timeout"]
