@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from .closed_volume import is_closed_volume
 from .material import Material
 
 FLOAT32_MAX = float(np.finfo(np.float32).max)
@@ -114,13 +115,10 @@ class MeshObject:
     def is_closed(self) -> bool:
         """True if the mesh is a watertight, consistently wound volume with outward faces.
 
-        Only then can back faces never be the first surface seen from outside it.
+        Only then can back faces never be the first surface seen from outside it. UV and normal seams do not
+        open a volume (vertices at one position are one vertex; :mod:`hybridgen.scene.closed_volume`).
         """
-        import trimesh
-
-        mesh = trimesh.Trimesh(self.vertices, self.faces, process=False)
-        mesh.merge_vertices(merge_tex=True, merge_norm=True)  # UV and normal seams do not open a volume
-        return bool(mesh.is_watertight and mesh.is_winding_consistent and mesh.volume > 0)
+        return is_closed_volume(self.vertices, self.faces)
 
     @property
     def bounds_local(self) -> np.ndarray:
