@@ -2,6 +2,8 @@
 materials and poses/attributes, with values from samplers (drawn per object)."""
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from ..config.displacement_config import displacement_from_config
@@ -11,7 +13,7 @@ from ..config.schema import Param
 from ..errors import InputError
 from ..scene.frames import object_pose
 from ..run.context import RunContext
-from ..scene.material import TEXTURE_SLOTS
+from ..scene.material import TEXTURE_SLOTS, Material
 from ..scene.displacement import displace_objects
 from ..scene.frames import matrix_to_euler_xyz
 from .base import Role
@@ -31,6 +33,9 @@ class MaterialManipulator(SelectingModule):
               "base_color_texture, roughness_texture, metallic_texture, alpha_texture, normal_texture "
               "(normal_y_down), displacement_texture (displacement_scale), specular_texture, emission_texture"),
         Param("randomize_color", "bool", False, doc="a uniform random base color per object"),
+        Param("color_link_to_displacement", "float|null", None, "m", sampleable=True,
+              doc="BlenderProc's cf_color_link_to_displacement: the material's base-color image becomes its "
+                  "displacement (bump) map, scaled by this factor"),
     )
 
     def run(self, context: RunContext) -> None:
@@ -42,6 +47,21 @@ class MaterialManipulator(SelectingModule):
             if mapped and obj.uvs is None:
                 raise InputError(f"object '{obj.name}' has no UVs to map {mapped[0]} with")
             obj.material = apply_material_config(obj.material, values)
+            factor = self.value(context, "color_link_to_displacement")
+            if factor is not None:
+                obj.material = linked_displacement(obj.material, float(factor), obj.name)
+
+
+def linked_displacement(material: Material, factor: float, owner: str) -> Material:
+    """``material`` with its base-color image as displacement map scaled by ``factor`` (BlenderProc's
+    cf_color_link_to_displacement: image color x factor into the material output's displacement, which Cycles
+    renders as a bump; a constant offset changes no bump, so hybridgen's mid-level 0.5 gives the same shading).
+    A material without a base-color image is an error, as in BlenderProc."""
+    if material.base_color_texture is None:
+        raise InputError(f"object '{owner}': material '{material.name}' has no base-color image to link to "
+                         "displacement (color_link_to_displacement)")
+    return dataclasses.replace(material, displacement_texture=material.base_color_texture,
+                               displacement_scale=factor)
 
 
 @register_module("manipulators.EntityManipulator")

@@ -103,6 +103,17 @@ def material(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, An
             if name in _MATERIAL_VALUES:
                 values[_MATERIAL_VALUES[name]] = cfg.pop(key)
                 continue
+        if function == "textures":
+            values.update(_texture_maps(cfg.pop(key), note))
+            continue
+        if function == "color_link_to_displacement":
+            cfg["color_link_to_displacement"] = cfg.pop(key)
+            continue
+        if function == "change_to_vertex_color":
+            pop_ignored(cfg, key, note, "hybridgen keeps the lit principled material with the vertex colors as base "
+                        "color (a mesh with vertex colors has it from loading); BlenderProc renders them unlit "
+                        "(a Background shader)")
+            continue
         if function == "switch_to_emission_shader":
             emission = cfg.pop(key) or {}
             color = emission.get("color", [1.0, 1.0, 1.0, 1.0]) if isinstance(emission, dict) else [1, 1, 1, 1]
@@ -113,6 +124,29 @@ def material(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, An
              "principled material")
     cfg["material"] = values
     return [("manipulators.MaterialManipulator", cfg)]
+
+
+_TEXTURE_INPUTS = {"base color": "base_color_texture", "roughness": "roughness_texture",
+                   "metallic": "metallic_texture", "specular": "specular_texture", "alpha": "alpha_texture",
+                   "emission": "emission_texture"}
+"""Principled BSDF inputs cf_textures links an image to, and the hybridgen map that takes it."""
+
+
+def _texture_maps(textures: Any, note: Note) -> dict[str, Any]:
+    """``cf_textures`` ({Blender input name: image path or sampler}) as hybridgen material maps; inputs
+    without a map in hybridgen are reported."""
+    if not isinstance(textures, dict):
+        raise ConfigError("must be a mapping {principled input name: image path}", key="cf_textures")
+    maps = {}
+    for name, path in textures.items():
+        target = _TEXTURE_INPUTS.get(str(name).replace("_", " ").lower())
+        if target is None:
+            note("ignored: hybridgen maps images to Base Color, Roughness, Metallic, Specular, Alpha and Emission "
+                 "(normal and displacement maps: material normal_texture / displacement_texture)",
+                 f"cf_textures.{name}")
+            continue
+        maps[target] = path
+    return maps
 
 
 def _material_conditions(conditions: Any) -> Any:

@@ -1,0 +1,58 @@
+"""MaterialManipulator's BlenderProc node functions that map onto hybridgen's principled material:
+cf_textures (images linked to principled inputs) and cf_color_link_to_displacement (the base-color image as
+displacement, scaled)."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from PIL import Image
+
+from hybridgen.config.notices import set_sink
+from hybridgen.errors import InputError
+from tests.config.test_blenderproc_modules import run_config_text
+
+
+def _quad(folder: Path, texture: str | None) -> Path:
+    """A textured (or plain) quad named Plane with material 'tiles'."""
+    mtl = "newmtl tiles\nKd 0.5 0.5 0.5\n" + (f"map_Kd {texture}\n" if texture else "")
+    (folder / "quad.mtl").write_text(mtl)
+    path = folder / "quad.obj"
+    path.write_text("mtllib quad.mtl\no Plane\nv 0 0 0\nv 1 0 0\nv 1 0 -1\nv 0 0 -1\nvt 0 0\nvt 1 0\nvt 1 1\n"
+                    "vt 0 1\nusemtl tiles\nf 1/1 2/2 3/3 4/4\n")
+    return path
+
+
+def _run(tmp_path: Path, texture: str | None, functions: dict):
+    for name, color in (("color.png", (200, 100, 50)), ("rough.png", (90, 90, 90))):
+        Image.new("RGB", (4, 4), color).save(tmp_path / name)
+    text = json.dumps({"version": 3, "setup": {"blender_install_path": "/opt/blender"}, "modules": [
+        {"module": "main.Initializer", "config": {"global": {"output_dir": str(tmp_path / "out")}}},
+        {"module": "loader.ObjectLoader", "config": {"path": str(_quad(tmp_path, texture))}},
+        {"module": "manipulators.MaterialManipulator", "config": {
+            "selector": {"provider": "getter.Material", "conditions": {"name": "tiles"}}, **functions}}]})
+    lines: list[str] = []
+    set_sink(lines.append)
+    try:
+        return run_config_text(tmp_path, text).scene.by_name("Plane").material, lines
+    finally:
+        set_sink(None)
+
+
+def test_color_link_to_displacement_bumps_with_the_base_color_image(tmp_path):
+    material, _ = _run(tmp_path, "color.png", {"cf_color_link_to_displacement": 0.2})
+    assert material.base_color_texture is not None  # the OBJ's map_Kd image
+    assert material.displacement_texture is material.base_color_texture and material.displacement_scale == 0.2
+    with pytest.raises(InputError, match="no base-color image to link"):  # BlenderProc fails there too
+        _run(tmp_path, None, {"cf_color_link_to_displacement": 0.2})
+
+
+def test_cf_textures_link_images_to_principled_inputs(tmp_path):
+    material, lines = _run(tmp_path, None, {"cf_textures": {
+        "Base Color": {"provider": "sampler.Path", "path": str(tmp_path / "col*.png")},
+        "Roughness": str(tmp_path / "rough.png"), "Normal": str(tmp_path / "rough.png")}})
+    assert Path(material.base_color_texture).name == "color.png"
+    assert Path(material.roughness_texture).name == "rough.png"
+    assert material.normal_texture is None
+    assert any("cf_textures.Normal" in line and "ignored" in line for line in lines)
