@@ -32,7 +32,7 @@ from ..errors import InputError
 from .atomic import commit, prepare_output_dir, temporary_path
 from .frame_sink import PassLayout
 from .integrity import seal
-from .label_encoding import StoredPass, plan_storage
+from .label_encoding import NARROWED, OCTAHEDRAL, EncodedArray, StoredPass, plan_storage, storage_tag
 
 COMPRESSIONS = ("gzip", "lzf", "none")
 ENCODINGS = ("compact", "plain")
@@ -60,6 +60,14 @@ try:
     from isal import isal_zlib as _isal
 except ImportError:  # pragma: no cover - isal is a dependency; zlib is the fallback of a partial install
     _isal = None
+
+
+def _tag(stored: StoredPass, layout: PassLayout) -> str | None:
+    """The storage tag of a pass stored encoded (octahedral normals, narrowed ids), None otherwise."""
+    encoding = stored.attrs.get("encoding")
+    if stored.encode is None or encoding not in (OCTAHEDRAL, NARROWED):
+        return None
+    return storage_tag(encoding, stored.dtype, np.dtype(layout.dtype))
 
 
 def default_threads() -> int:
@@ -173,6 +181,13 @@ class Hdf5SingleFileWriter:
         """Wait until every queued keypoint is written."""
         self._drain()
 
+    def accepted_encodings(self) -> dict[str, str]:
+        """Output key -> the storage tag (:func:`~hybridgen.io.label_encoding.storage_tag`) of each pass this
+        file stores encoded (asked after ``begin``): a renderer may hand such a pass over already in that form
+        (an :class:`~hybridgen.io.label_encoding.EncodedArray`), which is then stored as it is."""
+        return {key: tag for key, tag in ((key, _tag(stored, self._layouts[key])) for key, stored in self._stored.items())
+                if tag is not None}
+
     # ------------------------------------------------------------------ commit
     def finalize(self, records: dict[str, Any] | None = None,
                  attributes: dict[str, Any] | None = None) -> list[Path]:
@@ -247,12 +262,20 @@ class Hdf5SingleFileWriter:
         """Keypoint ``index``'s stored chunk of ``key`` (runs on the pool): the encoded array, or for gzip
         the shuffled and deflated bytes; None when the pass is derived on read."""
         layout, stored = self._layouts[key], self._stored[key]
-        array = np.asarray(value)
-        if array.shape != layout.shape:
-            raise InputError(f"'{key}' keypoint {index} has shape {array.shape}, expected {layout.shape}")
-        if stored.encode is None:
-            return None
-        encoded = stored.encode(array)
+        if isinstance(value, EncodedArray) and value.tag != _tag(stored, layout):
+            value = value.decode()  # a form this file does not store
+        if isinstance(value, EncodedArray):  # already the stored form (drawn so by the raster pass)
+            if value.stored.shape != stored.shape or value.stored.dtype != stored.dtype:
+                raise InputError(f"'{key}' keypoint {index} holds {value.stored.dtype} {value.stored.shape}, "
+                                 f"expected {stored.dtype} {stored.shape}")
+            encoded = np.ascontiguousarray(value.stored)
+        else:
+            array = np.asarray(value)
+            if array.shape != layout.shape:
+                raise InputError(f"'{key}' keypoint {index} has shape {array.shape}, expected {layout.shape}")
+            if stored.encode is None:
+                return None
+            encoded = stored.encode(array)
         if self.compression == "gzip":
             return deflate(shuffled(encoded) if stored.shuffle else encoded, self.level)
         return encoded

@@ -29,7 +29,6 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..render.passes import exact
 from .frame_sink import PassLayout
 
 NARROWED = "narrowed_integer"
@@ -40,6 +39,31 @@ OCTAHEDRAL_MAX_ERROR_RAD = 1e-4
 """Stated bound on the angle between a normal and its decoded octahedral code (see the module doc)."""
 
 _OCT_SCALE = 32767.0  # q in [-1, 1] -> (q + 1) * 32767 in [0, 65534], + 1: codes 1..65535, 0 = background
+
+
+@dataclass(frozen=True)
+class EncodedArray:
+    """A pass value already in its stored form (made by the raster pass itself, render/label_targets.py):
+    ``stored`` is what a writer stores under ``tag`` (:func:`storage_tag`); renderers hand such values only to
+    sinks that said they store that tag (``accepted_encodings()``). :meth:`decode` gives the documented values."""
+
+    stored: np.ndarray
+    tag: str
+
+    def decode(self) -> np.ndarray:
+        encoding, *dtypes = self.tag.split(":")
+        if encoding == OCTAHEDRAL:
+            return decode_octahedral(self.stored)
+        if encoding == NARROWED:
+            return self.stored.astype(dtypes[0])
+        raise ValueError(f"unknown encoding tag {self.tag!r}")
+
+
+def storage_tag(encoding: str, stored: np.dtype, decoded: np.dtype) -> str:
+    """The tag naming one stored form: ``octahedral_uint16``, or ``narrowed_integer:<stored>:<decoded>``."""
+    if encoding == OCTAHEDRAL:
+        return OCTAHEDRAL
+    return f"{encoding}:{np.dtype(decoded).name}:{np.dtype(stored).name}"
 
 
 def narrowest_integer_dtype(low: int, high: int) -> np.dtype:
@@ -185,6 +209,8 @@ def plan_storage(layout: PassLayout, *, compact: bool, keys: set[str], depth_bac
                        _as_stored(dtype))
     if not compact:
         return plain
+    from ..render.passes import exact  # here: the catalogue's raster passes import this module
+
     entry = exact(layout.key)  # the pass catalogue names each pass's compact encoding
     encoding = entry.hdf5 if entry is not None else ""
     if encoding == "octahedral" and dtype == np.float32 and layout.shape[-1] == 3:

@@ -29,7 +29,8 @@ OCCLUSION_ABSOLUTE = 1e-3  # m
 
 def camera_points(raw: RasterOutput, intr: Intrinsics) -> np.ndarray:
     """(H, W, 3) float64 OpenCV camera coordinates of the surface at every pixel centre (NaN: background)."""
-    points = intr.pixel_rays() * raw.normal_depth[..., 3:4].astype(np.float64)
+    with np.errstate(invalid="ignore"):  # a packed readback holds the depth background (inf) off surfaces
+        points = intr.pixel_rays() * raw.z[..., None].astype(np.float64)
     points[~raw.hit] = np.nan
     return points
 

@@ -26,9 +26,12 @@ class Producer(Protocol):
 
     ``records`` are whole-run datasets (e.g. poses) it adds; ``eye`` is 0, or 1 for a stereo right eye
     (producers with randomness draw a different stream for it). A producer may also have
-    ``prefetch(index, cam2world)``, called one keypoint ahead so that its work can overlap, and
+    ``prefetch(index, cam2world)``, called one keypoint ahead so that its work can overlap,
     ``view_changed()``, called when the scene's objects moved or the camera's intrinsics changed between
-    keypoints (:mod:`hybridgen.scene.object_keyframes`).
+    keypoints (:mod:`hybridgen.scene.object_keyframes`), and ``use_encodings(accepted)``, told before the first
+    keypoint which passes every sink receiving them stores in one encoded form (key -> storage tag, see
+    :func:`_accepted_encodings`): it may hand those over as
+    :class:`~hybridgen.io.label_encoding.EncodedArray` of that tag.
     """
 
     def layouts(self) -> list[PassLayout]: ...
@@ -91,6 +94,9 @@ def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Prod
         focus = _focus(sinks, routes)
         for producer in producers:  # per-object passes only for the objects the sinks read
             getattr(producer, "focus_objects", lambda ids: None)(focus)
+        accepted = _accepted_encodings(sinks, routes)
+        for producer in producers:  # passes the sinks store encoded may be made in that form (label_targets.py)
+            getattr(producer, "use_encodings", lambda accepted: None)(accepted)
         bar = progress(n, what) if progress else None
         prefetching = [p for p in producers if hasattr(p, "prefetch")]
         keypoints = scene.camera.keypoints
@@ -136,6 +142,18 @@ def _focus(sinks: list[FrameSink], routes: list[set[str]]) -> frozenset[int] | N
             return None
         ids.update(int(i) for i in chosen)
     return frozenset(ids)
+
+
+def _accepted_encodings(sinks: list[FrameSink], routes: list[set[str]]) -> dict[str, str]:
+    """Output key -> the storage tag in which every sink that receives the key stores it
+    (``accepted_encodings()`` after ``begin``); keys some receiving sink takes only as documented are left out."""
+    tags: dict[str, set[str | None]] = {}
+    for sink, route in zip(sinks, routes):
+        accepted = getattr(sink, "accepted_encodings", None)
+        given = accepted() if accepted is not None else {}
+        for key in route:
+            tags.setdefault(key, set()).add(given.get(key))
+    return {key: next(iter(found)) for key, found in tags.items() if len(found) == 1 and None not in found}
 
 
 def _route(sink: FrameSink, keys: list[str]) -> set[str]:

@@ -98,7 +98,9 @@ def _raster(function: Callable[[Any], np.ndarray]) -> Compute:
     return lambda frame, key: function(frame.raw)
 
 
-def _segmap(frame: "KeypointFrame", key: str) -> np.ndarray:
+def _segmap(frame: "KeypointFrame", key: str) -> Any:
+    if key == "category_id_segmaps" and frame.raw.category is not None:  # drawn as a target of its own
+        return raster.category_ids(frame.raw)
     return frame.tables.luts[key[: -len("_segmaps")]][frame.raw.instance]
 
 

@@ -22,6 +22,7 @@ from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
 from .alpha_cutout import Cutout, set_cutout_uniforms, upload_cutout
 from .gl_context import shared_context
+from .label_targets import LabelTargets
 from .shared_geometry import geometry_key
 from .raster_passes import RASTER_PASSES
 from .readback import RasterOutput
@@ -36,7 +37,8 @@ class GpuObject:
     """GL resources of one scene object (vertex positions and indices are shared with other passes)."""
 
     instance_id: int
-    vao: Any
+    vao: Any  # drawn by the default label program (or its cut-out variant)
+    content: list[tuple[Any, str, str]]  # (buffer, format, attribute) of every vertex attribute
     positions: Any
     indices: Any
     buffers: list[Any]
@@ -44,6 +46,7 @@ class GpuObject:
     closed: bool
     bounds: np.ndarray  # (2, 3) local box
     cutout: Cutout | None = None  # alpha cut-out of a CLIP material (render/alpha_cutout.py)
+    packed_vaos: dict[Any, Any] = dataclasses.field(default_factory=dict)  # (LabelTargets, cutout) -> vao
 
 
 class RasterView:
@@ -64,6 +67,7 @@ class RasterView:
         self.ctx = ctx if ctx is not None else shared_context(device_index)
         self.program = self._label_program(cutout=False)
         self._cutout_program: Any = None  # built with the first object that cuts out (render/alpha_cutout.py)
+        self._packed_programs: dict[tuple[LabelTargets, bool], Any] = {}  # label_targets.py variants
         self.gpu_objects = self._upload_all(scene.objects)
         try:  # instance id -> category_id, for the category_id_segmaps pass (0 where an object has none)
             self._class_lut = self.category_lut()
@@ -77,16 +81,35 @@ class RasterView:
         self._cached_pose: dict[str, Any] = {}
 
     # ----------------------------------------------------------------- resources
-    def _label_program(self, cutout: bool) -> Any:
+    def _label_program(self, cutout: bool, targets: LabelTargets | None = None) -> Any:
         """The label program; its cut-out variant also interpolates UVs and drops fragments of low alpha (a
-        shader that may discard costs llvmpipe its early depth test and a varying for every object)."""
+        shader that may discard costs llvmpipe its early depth test and a varying for every object);
+        ``targets``: the packed variant writing those targets (render/label_targets.py)."""
         vertex, fragment = shader_source("labels.vert"), shader_source("labels.frag")
         if cutout:
             vertex, fragment = (text.replace("\n", "\n#define ALPHA_CUTOUT\n", 1) for text in (vertex, fragment))
+        if targets is not None:
+            fragment = fragment.replace("\n", f"\n{targets.defines()}\n", 1)
         return self.ctx.program(vertex_shader=vertex, fragment_shader=fragment)
 
     def _programs(self) -> list[Any]:
-        return [p for p in (self.program, self._cutout_program) if p is not None]
+        return [p for p in (self.program, self._cutout_program, *self._packed_programs.values()) if p is not None]
+
+    def _draw_program(self, gpu: GpuObject, targets: LabelTargets | None) -> tuple[Any, Any]:
+        """(program, vertex array) drawing ``gpu`` into ``targets`` (None: the default targets); the packed
+        variants and their vertex arrays are built on first use."""
+        cutout = gpu.cutout is not None
+        if targets is None:
+            return (self._cutout_program if cutout else self.program), gpu.vao
+        key = (targets, cutout)
+        if key not in self._packed_programs:
+            self._packed_programs[key] = self._label_program(cutout, targets)
+        program = self._packed_programs[key]
+        if key not in gpu.packed_vaos:  # attributes a variant does not read (normals) are left out
+            content = [entry for entry in gpu.content if entry[2] in program]
+            gpu.packed_vaos[key] = self.ctx.vertex_array(program, content, index_buffer=gpu.indices,
+                                                         index_element_size=4)
+        return program, gpu.packed_vaos[key]
 
     def _upload_all(self, objects: list[Any]) -> list[GpuObject]:
         """GPU objects of ``objects``; placements of shared geometry (render/shared_geometry.py) draw from the
@@ -95,8 +118,9 @@ class RasterView:
         first: dict[Any, GpuObject] = {}
         for obj in objects:
             key = geometry_key(obj)
-            if key in first:
-                uploaded.append(dataclasses.replace(first[key], instance_id=obj.instance_id, buffers=[]))
+            if key in first:  # shares the first placement's vertex arrays (packed ones included)
+                uploaded.append(dataclasses.replace(first[key], instance_id=obj.instance_id, buffers=[],
+                                                    packed_vaos=first[key].packed_vaos))
                 continue
             uploaded.append(self._upload(obj))
             if key is not None:
@@ -130,20 +154,33 @@ class RasterView:
         vao = ctx.vertex_array(program, content, index_buffer=indices, index_element_size=4)
         extra = cutout.resources() if cutout is not None else []
         # a cut-out volume shows its inside through its holes: never culled
-        return GpuObject(obj.instance_id, vao, positions, indices, [positions, normal_buffer, indices, *extra],
+        return GpuObject(obj.instance_id, vao, content, positions, indices, [positions, normal_buffer, indices, *extra],
                          vertex_order, obj.is_closed and cutout is None, obj.bounds_local, cutout)
 
-    def _framebuffer(self, slot: Any, width: int, height: int) -> Any:
-        key = (slot, width, height)
+    def _framebuffer(self, slot: Any, width: int, height: int, targets: LabelTargets | None = None) -> Any:
+        key = (slot, width, height, targets)
         if key not in self._fbos:
             for old in [k for k in self._fbos if k[0] == slot]:
                 self._release_fbo(self._fbos.pop(old))
             ctx = self.ctx
+            formats = [(4, "f4"), (1, "u4")] if targets is None else [(c, d) for _, c, d in targets.attachments()]
             self._fbos[key] = ctx.framebuffer(
-                color_attachments=[ctx.renderbuffer((width, height), 4, dtype="f4"),
-                                   ctx.renderbuffer((width, height), 1, dtype="u4")],
+                color_attachments=[ctx.renderbuffer((width, height), c, dtype=d) for c, d in formats],
                 depth_attachment=ctx.depth_renderbuffer((width, height)))
         return self._fbos[key]
+
+    def _clear(self, fbo: Any, targets: LabelTargets | None) -> None:
+        """Clear ``fbo``: everything to 0 (depth buffer to 1); packed targets' depth to ``depth_background``
+        (a float clear value is undefined for integer targets: those are masked out of that clear)."""
+        if targets is None:
+            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+            return
+        count = len(targets.attachments())
+        fbo.color_mask = [(False,) * 4] + [(True,) * 4] * (count - 1)
+        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        fbo.color_mask = [(True,) * 4] + [(False,) * 4] * (count - 1)
+        fbo.clear(self.depth_background, 0.0, 0.0, 0.0)
+        fbo.color_mask = [(True,) * 4] * count
 
     @staticmethod
     def _release_fbo(fbo: Any) -> None:
@@ -171,8 +208,10 @@ class RasterView:
 
     # ----------------------------------------------------------------- rendering
     def render_raw(self, cam2world: np.ndarray, intrinsics: Intrinsics | None = None,
-                   hidden: frozenset[int] = frozenset(), normals_space: str | None = None) -> RasterOutput:
-        """Draw one keypoint (OpenCV-axes ``cam2world``) and read back normals+depth and instance ids.
+                   hidden: frozenset[int] = frozenset(), normals_space: str | None = None,
+                   targets: LabelTargets | None = None) -> RasterOutput:
+        """Draw one keypoint (OpenCV-axes ``cam2world``) and read back normals+depth and instance ids (or, with
+        ``targets``, the packed targets of :mod:`hybridgen.render.label_targets`).
 
         Objects whose instance id is in ``hidden`` are left out (rays pass through them). ``intrinsics``
         (default: the scene camera's) and ``normals_space`` (default: the view's) may differ per call: one
@@ -181,25 +220,26 @@ class RasterView:
         """
         intr = intrinsics or self.scene.camera.intrinsics
         slot = ("now", intr.width, intr.height)
-        self.submit(cam2world, intr, hidden, slot=slot, normals_space=normals_space)
+        self.submit(cam2world, intr, hidden, slot=slot, normals_space=normals_space, targets=targets)
         return self.collect(slot)
 
     def submit(self, cam2world: np.ndarray, intrinsics: Intrinsics | None = None,
                hidden: frozenset[int] = frozenset(), slot: Any = 0, normals_space: str | None = None,
-               region: tuple[int, int, int, int] | None = None) -> None:
+               region: tuple[int, int, int, int] | None = None, targets: LabelTargets | None = None) -> None:
         """Issue the draws of one keypoint into framebuffer ``slot`` without waiting for them.
 
         The rasterizer (llvmpipe's threads, or the GPU) works on it while the caller goes on - e.g. turning
         the previous keypoint's readback into passes; :meth:`collect` then reads it back. Two slots give a
         two-deep pipeline. ``region`` ``(x, y, width, height)`` in pixels limits clearing and drawing to that
         rectangle (a scissor: pixels inside it get exactly the values of a full draw, the rest is stale).
+        ``targets``: write the packed targets (:mod:`hybridgen.render.label_targets`) instead of the default.
         """
         intr = intrinsics or self.scene.camera.intrinsics
         width, height = intr.width, intr.height
-        fbo = self._framebuffer(slot, width, height)
+        fbo = self._framebuffer(slot, width, height, targets)
         fbo.scissor = region
         fbo.use()
-        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        self._clear(fbo, targets)
         self.ctx.enable(self.ctx.DEPTH_TEST)
         cam2world = np.asarray(cam2world, dtype=np.float64)
         world2cam = np.eye(4)
@@ -207,16 +247,23 @@ class RasterView:
         world2cam[:3, 3] = -cam2world[:3, :3].T @ cam2world[:3, 3]
         projection = projection_from_K(intr.K, width, height, intr.clip_start, intr.clip_end).T.astype(np.float32)
         to_output = np.eye(3) if (normals_space or self.normals_space) == "camera" else cam2world[:3, :3]
-        for program in self._programs():
-            program["u_projection"].write(projection.tobytes())
-            program["u_cam_to_output"].write(to_output.T.astype(np.float32).tobytes())
         near_reach = near_plane_corner_distance(intr.K, width, height, intr.clip_start)
-        draws = self._object_uniforms(cam2world, world2cam, near_reach, hidden)
-        for gpu, modelview, normal_to_cam, cull, front_face in draws:
-            prog = self.program if gpu.cutout is None else self._cutout_program
+        draws = [(*self._draw_program(draw[0], targets), *draw)
+                 for draw in self._object_uniforms(cam2world, world2cam, near_reach, hidden)]
+        frame_uniforms = {"u_projection": projection.tobytes(),
+                          "u_cam_to_output": to_output.T.astype(np.float32).tobytes()}
+        members = {id(draw[0]): set(draw[0]) for draw in draws}
+        for program in {id(draw[0]): draw[0] for draw in draws}.values():
+            for name, value in frame_uniforms.items():
+                if name in members[id(program)]:  # a packed variant without normals has no normal uniforms
+                    program[name].write(value)
+        for prog, vao, gpu, modelview, normal_to_cam, cull, front_face in draws:
             prog["u_modelview"].write(modelview)
-            prog["u_normal_to_cam"].write(normal_to_cam)
+            if "u_normal_to_cam" in members[id(prog)]:
+                prog["u_normal_to_cam"].write(normal_to_cam)
             prog["u_instance_id"].value = gpu.instance_id
+            if targets is not None and targets.category_dtype is not None:
+                prog["u_category_id"].value = int(self._class_lut[gpu.instance_id])
             if gpu.cutout is not None:
                 set_cutout_uniforms(prog, gpu.cutout)
             # The projection mirrors handedness (and so may the object's transform): front_face is set so
@@ -226,14 +273,22 @@ class RasterView:
                 self.ctx.enable(self.ctx.CULL_FACE)
             else:
                 self.ctx.disable(self.ctx.CULL_FACE)
-            gpu.vao.render()
-        self._submitted[slot] = intr
+            vao.render()
+        self._submitted[slot] = (intr, targets)
 
     def collect(self, slot: Any = 0) -> RasterOutput:
-        """Read back what :meth:`submit` drew into ``slot`` (waits for it to finish)."""
-        intr = self._submitted.pop(slot)
+        """Read back what :meth:`submit` drew into ``slot`` (waits for it to finish); every target is read
+        straight into its own fresh contiguous array."""
+        intr, targets = self._submitted.pop(slot)
         width, height = intr.width, intr.height
-        fbo = self._fbos[(slot, width, height)]
+        fbo = self._fbos[(slot, width, height, targets)]
+        if targets is not None:
+            arrays = targets.empty(height, width)
+            for attachment, (name, components, kind) in enumerate(targets.attachments()):
+                fbo.read_into(arrays[name], attachment=attachment, components=components, dtype=kind)
+            return RasterOutput(None, arrays["instance"], self._rays(intr), self._class_lut, self.depth_background,
+                                depth_image=arrays["depth"], normal_codes=arrays.get("normal_codes"),
+                                category=arrays.get("category"), encoded=dict(targets.encoded))
         normal_depth = np.empty((height, width, 4), dtype=np.float32)
         instance = np.empty((height, width), dtype=np.uint32)
         fbo.read_into(normal_depth, attachment=0, components=4, dtype="f4")
@@ -249,7 +304,7 @@ class RasterView:
         slot = ("now", intr.width, intr.height)
         self.submit(cam2world, intr, hidden, slot=slot, region=region)
         self._submitted.pop(slot)
-        fbo = self._fbos[(slot, intr.width, intr.height)]
+        fbo = self._fbos[(slot, intr.width, intr.height, None)]
         x, y, w, h = region if region is not None else (0, 0, intr.width, intr.height)
         part = np.empty((h, w), dtype=np.uint32)
         fbo.read_into(part, viewport=(x, y, w, h), attachment=1, components=1, dtype="u4")
@@ -311,8 +366,10 @@ class RasterView:
     def release(self) -> None:
         """Free the GL resources of this view (the context stays)."""
         for gpu in self.gpu_objects:
-            if gpu.buffers:  # shared placements own no buffers and share the first placement's vao
+            if gpu.buffers:  # shared placements own no buffers and share the first placement's vaos
                 gpu.vao.release()
+                for vao in gpu.packed_vaos.values():
+                    vao.release()
             for buf in gpu.buffers:
                 buf.release()
         self.gpu_objects = []
@@ -322,4 +379,5 @@ class RasterView:
         for program in self._programs():  # compiled programs per view: leaked ~1.7 MB per scene before
             program.release()
         self.program = self._cutout_program = None
+        self._packed_programs.clear()
 

@@ -1,45 +1,68 @@
 """The passes made from a raster readback alone (:class:`~hybridgen.render.readback.RasterOutput`): depth,
 distance, normals and the two built-in id maps. :meth:`~hybridgen.render.raster.RasterView.render` returns
-them by name; the catalogue (:mod:`hybridgen.render.passes`) binds them to their output keys."""
+them by name; the catalogue (:mod:`hybridgen.render.passes`) binds them to their output keys.
+
+From a packed readback (:mod:`hybridgen.render.label_targets`) depth is the read-back array itself, and normals
+and ids are handed on in their stored form (:class:`~hybridgen.io.label_encoding.EncodedArray`) where the
+readback says the sinks take it (``encoded``); otherwise every pass has its documented dtype.
+"""
 from __future__ import annotations
 
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
+from ..io.label_encoding import NARROWED, OCTAHEDRAL, EncodedArray, decode_octahedral, storage_tag
 from .readback import RasterOutput
 
 
 def depth(out: RasterOutput) -> np.ndarray:
     """Camera z (m), ``depth_background`` where nothing was hit."""
-    values = np.array(out.normal_depth[..., 3], dtype=np.float32)
+    if out.packed:
+        return out.depth_image  # background written by the draw; a fresh array per keypoint
+    values = np.array(out.z, dtype=np.float32)
     values[~out.hit] = out.depth_background
     return values
 
 
 def distance(out: RasterOutput) -> np.ndarray:
     """Euclidean distance from the camera centre (m), ``depth_background`` where nothing was hit."""
-    dist = out.normal_depth[..., 3] * out.ray_lengths
+    dist = out.z * out.ray_lengths
     dist[~out.hit] = out.depth_background
     return dist.astype(np.float32, copy=False)
 
 
-def normals(out: RasterOutput) -> np.ndarray:
-    """Unit normals (a view: writers copy it, off the render thread, when they store it)."""
-    return out.normal_depth[..., :3]
+def normals(out: RasterOutput) -> Any:
+    """Unit normals (a view: writers copy it, off the render thread, when they store it); from a packed
+    readback the octahedral codes (decoded where the sinks do not store them)."""
+    if not out.packed:
+        return out.normal_depth[..., :3]
+    assert out.normal_codes is not None, "normals were not drawn"
+    if out.encoded.get("normals") == OCTAHEDRAL:
+        return EncodedArray(out.normal_codes, OCTAHEDRAL)
+    return decode_octahedral(out.normal_codes)
 
 
-def instance_ids(out: RasterOutput) -> np.ndarray:
+def _ids(out: RasterOutput, key: str, ids: np.ndarray) -> Any:
+    tag = storage_tag(NARROWED, ids.dtype, np.dtype(np.int32))
+    if out.encoded.get(key) == tag:
+        return EncodedArray(ids, tag)
+    return ids.astype(np.int32)
+
+
+def instance_ids(out: RasterOutput) -> Any:
     """Instance ids as int32, 0 where nothing was hit."""
-    return out.instance.astype(np.int32)
+    return _ids(out, "instance_segmaps", out.instance)
 
 
-def category_ids(out: RasterOutput) -> np.ndarray:
+def category_ids(out: RasterOutput) -> Any:
     """The category_id of the object seen at each pixel (0: background, or an object without one)."""
+    if out.category is not None:
+        return _ids(out, "category_id_segmaps", out.category)
     return out.category_lut[out.instance]
 
 
-RASTER_PASSES: dict[str, Callable[[RasterOutput], np.ndarray]] = {
+RASTER_PASSES: dict[str, Callable[[RasterOutput], Any]] = {
     "depth": depth, "distance": distance, "normals": normals,
     "instance_segmaps": instance_ids, "category_id_segmaps": category_ids,
 }

@@ -12,6 +12,7 @@ from ..scene.scene import Scene
 from .keypoint_frame import KeypointFrame
 from .keypoint_loop import ProgressFactory, run_keypoints
 from .label_request import LabelRequest, value_ranges
+from .label_targets import LabelTargets, packed_targets
 from .raster import RasterView
 from .scene_raster import SceneRaster
 
@@ -37,6 +38,12 @@ class LabelProducer:
         self._tables = request.tables(self.view)
         self._pending: dict[int, tuple[int, int, bytes]] = {}
         self._focus: frozenset[int] | None = None
+        self._targets: LabelTargets | None = packed_targets(request, self._tables, scene, {})
+
+    def use_encodings(self, accepted: dict[str, str]) -> None:
+        """Draw the packed targets (:mod:`hybridgen.render.label_targets`) where the passes allow it, handing
+        the sinks the passes they store encoded (``accepted``: key -> storage tag) in that form."""
+        self._targets = packed_targets(self.request, self._tables, self.scene, accepted)
 
     def focus_objects(self, ids: frozenset[int] | None) -> None:
         """Make per-object passes (``amodal_masks``, ...) only for the objects ``ids`` (None: all)."""
@@ -60,7 +67,7 @@ class LabelProducer:
     def prefetch(self, index: int, cam2world: np.ndarray, eye: int = 0) -> None:
         """Start drawing keypoint ``index`` so that it rasterizes while the previous one is processed."""
         slot = index % 2
-        self.view.submit(cam2world, slot=slot)
+        self.view.submit(cam2world, slot=slot, targets=self._targets)
         self._pending[slot] = (index, eye, np.asarray(cam2world).tobytes())
 
     def produce(self, index: int, cam2world: np.ndarray, eye: int = 0) -> dict[str, Any]:
@@ -69,7 +76,7 @@ class LabelProducer:
             del self._pending[slot]
             raw = self.view.collect(slot)
         else:
-            raw = self.view.render_raw(cam2world)
+            raw = self.view.render_raw(cam2world, targets=self._targets)
         frame = KeypointFrame(index, eye, cam2world, raw, self.raster, self._tables,
                               lambda step: self._neighbour(index, step, cam2world), self._focus)
         return self.request.compute(frame)
