@@ -154,12 +154,28 @@ def load_config(path: str | Path, args: Sequence[str] = (), env: Mapping[str, st
         for target, target_config in translated:
             config.modules.append(ModuleEntry(target, target_config, index))
     finish_translation(config.modules, state, config.global_all.get("output_dir"))
+    if blenderproc_form:
+        _keep_renderer_outputs(config.modules, file)
     if blenderproc_form and "output_dir" in config.global_all and not _declared(config.modules, "output_dir"):
         del config.global_all["output_dir"]  # BlenderProc always sets it (also for its temporary files)
     for key in [k for k in config.global_all if k in GLOBAL_IGNORED]:
         notice(f"ignored: {GLOBAL_IGNORED[key]}", file=file, key=f"global.{key}")
         del config.global_all[key]
     return config
+
+
+def _keep_renderer_outputs(modules: list[ModuleEntry], file: str) -> None:
+    """A BlenderProc config that renders without a writer keeps the renderers' own files in BlenderProc
+    (``rgb_0000.png`` ... with ``output_is_temp: false``): hybridgen writes what they render into
+    ``data.hdf5`` instead (a writer.Hdf5Writer after the last renderer, and a notice)."""
+    renderers = [m for m in modules if m.name.startswith("renderer.")]
+    if not renderers or any(m.name.startswith("writer.") for m in modules):
+        return
+    last = renderers[-1]
+    notice("the config renders but has no writer: BlenderProc keeps the renderers' own image files here; "
+           "hybridgen writes them into <output_dir>/data.hdf5 (`hybridgen extract` makes image files of it)",
+           file=file, module=last.name, index=last.index)
+    modules.insert(modules.index(last) + 1, ModuleEntry("writer.Hdf5Writer", {}, last.index))
 
 
 def _sets_up_run(name: str) -> bool:

@@ -112,3 +112,24 @@ def test_each_board_pose_renders_in_its_keypoint(tmp_path):
         assert rows.min() == pytest.approx(max(0, np.ceil(v0)), abs=1) and rows.max() == pytest.approx(
             min(H - 1, np.floor(v1)), abs=1)
     np.testing.assert_allclose(euler_xyz_to_matrix([0, 0, 0]), np.eye(3))
+
+
+def test_a_config_rendering_without_writer_keeps_its_renders(tmp_path):
+    # BlenderProc keeps the renderers' own files when no writer follows (the calibration example):
+    # hybridgen writes them into data.hdf5, with a notice
+    from hybridgen.config.notices import set_sink
+
+    extra = {"z_planes": [-2.0], "small_step_size": 0.9, "big_step_size": 0.9, "x_min": -1, "x_max": 1,
+             "y_min": -1, "y_max": 1}
+    after = [{"module": "renderer.SegMapRenderer", "config": {"map_by": ["instance"]}}]
+    lines: list[str] = []
+    set_sink(lines.append)
+    try:
+        context = run_config_text(tmp_path, _config(tmp_path, [0.0, 0.0, 0.0], extra, after))
+    finally:
+        set_sink(None)
+    import h5py
+
+    with h5py.File(tmp_path / "out" / "data.hdf5") as f:
+        assert len(f["instance_segmaps"]) == len(context.scene.camera) >= 1
+    assert any("has no writer" in line and "data.hdf5" in line for line in lines)
