@@ -14,7 +14,7 @@ _UNIT_KEYS = ("roughness", "metallic", "specular", "transmission", "alpha")
 _COLOR_KEYS = {"base_color": (3, 4), "emission": (3, 3)}
 _TEXTURE_KEYS = TEXTURE_SLOTS
 KNOWN_KEYS = (*_UNIT_KEYS, *_COLOR_KEYS, "emission_strength", "ior", *_TEXTURE_KEYS, "name", "alpha_mode",
-              "normal_y_down", "displacement_scale")
+              "normal_y_down", "displacement_scale", "emission_hidden_from_camera")
 
 
 def _number(value: Any, key: str) -> float:
@@ -59,7 +59,7 @@ def apply_material_config(material: Material, config: dict[str, Any]) -> Materia
             values[key] = number
         elif key == "displacement_scale":
             values[key] = _number(value, key)
-        elif key == "normal_y_down":
+        elif key in ("normal_y_down", "emission_hidden_from_camera"):
             if not isinstance(value, bool):
                 raise ConfigError(f"must be true or false, got {value!r}", key=f"material.{key}")
             values[key] = value

@@ -9,7 +9,7 @@
   as base color. Ceilings emit their color with ``ceiling_light_strength``.
 - ``furniture`` entries: ``<future_path>/<jid>/raw_model.obj`` with ``texture.png`` of the same folder as the
   base color of every part; name = ``category``, else ``title`` up to its first ``/``, else ``others``. Beds
-  and sofas get roughness 0.5, lamps emit their texture's mean color with ``lamp_light_strength``. A missing
+  and sofas get roughness 0.5, lamps emit their texture (per texel) with ``lamp_light_strength``. A missing
   model is skipped, as BlenderProc does (a notice counts them). Each model file is parsed once; every
   placement shares its vertex arrays.
 - ``scene.room[i].children`` with ``furniture`` in ``instanceid`` place the furniture of ``uid == ref``:
@@ -18,8 +18,9 @@
   replaces the axis turn Blender's OBJ import puts on the object); attribute ``room_id`` = i.
 
 Every object gets ``is_3d_front: true`` and ``category_id`` = the label mapping's id of its lower-cased name.
-BlenderProc's emissive ceilings and lamps show their principled surface to camera rays and emit only for other
-rays; hybridgen's emit for all rays (the camera sees them lit).
+Emissive ceilings and lamps show their principled surface to camera rays and emit only for other rays, as
+BlenderProc's (``emission_hidden_from_camera``, :mod:`hybridgen.render.camera_hidden_emission`; in JIT Mitsuba
+variants - ``scalar_rgb`` shows them glowing, with a notice).
 """
 from __future__ import annotations
 
@@ -126,6 +127,7 @@ def _mesh_material(entry: dict[str, Any] | None, name: str, texture_path: Path, 
     if "ceiling" in name.lower():
         material.emission = tuple(material.base_color[:3])  # type: ignore[assignment]
         material.emission_strength = float(ceiling_strength)
+        material.emission_hidden_from_camera = True  # as BlenderProc's make_emissive: the camera sees the ceiling
     return material
 
 

@@ -116,8 +116,10 @@ class Front3DLoader(Module):
                 material.base_color_texture = str(texture)
             if "bed" in name.lower() or "sofa" in name.lower():
                 material.roughness = 0.5
-            if "lamp" in name.lower():
+            if "lamp" in name.lower():  # BlenderProc's make_emissive: the base color (its texture) emits
                 material.emission = mean_linear_color(str(texture)) if texture.is_file() \
                     else tuple(material.base_color[:3])
+                material.emission_texture = str(texture) if texture.is_file() else None
                 material.emission_strength = lamp_strength
+                material.emission_hidden_from_camera = True  # lights the room; the camera sees the lamp's surface
         return parts

@@ -47,6 +47,15 @@ def register(variant: str) -> None:
             self.limits = tuple(int(props.get(k, -1)) for k in ("max_diffuse", "max_glossy", "max_transmission"))
             # hybridgen/render/transparent_shadows.py: shadow rays through masks, null passes cost no bounce
             self.transparent_shadows = bool(props.get("transparent_shadows", False))
+            # hybridgen/render/camera_hidden_emission.py: emitters the camera sees as their BSDF (set after load)
+            self.hidden_shapes: list[Any] = []
+
+        def _camera_hidden(self, si: Any) -> Any:
+            """True where ``si`` lies on one of :attr:`hidden_shapes`."""
+            hidden = mi.Bool(False)
+            for shape in self.hidden_shapes:
+                hidden |= si.shape == mi.ShapePtr(shape)
+            return hidden
 
         @staticmethod
         def _mis_weight(pdf_a: Any, pdf_b: Any) -> Any:
@@ -69,6 +78,8 @@ def register(variant: str) -> None:
 
             mis_weight = self._mis_weight
             transparent = self.transparent_shadows
+            has_hidden = len(self.hidden_shapes) > 0
+            hidden = mi.Bool(False)
             n_transparent = mi.UInt32(0)
             bsdf_ctx = mi.BSDFContext()
             ray = mi.Ray3f(ray)
@@ -95,9 +106,14 @@ def register(variant: str) -> None:
                 em_pdf = scene.pdf_emitter_direction(si_prev, ds, ~bsdf_delta_prev)
                 mis_bsdf = dr.select(depth == 0, 1.0, mis_weight(bsdf_pdf_prev, em_pdf))
                 emitted = throughput * mis_bsdf * ds.emitter.eval(si, active)
+                if has_hidden:  # camera rays see such an emitter's BSDF only, other rays its emission only
+                    hidden = self._camera_hidden(si)
+                    emitted = dr.select(hidden & (depth == 0), 0.0, emitted)
                 radiance += self._clamped(emitted, depth >= 2)
 
                 active_next = active & (depth + 1 < max_depth) & si.is_valid() & ~last_segment
+                if has_hidden:
+                    active_next &= ~(hidden & (depth > 0))
 
                 # Next-event estimation: one emitter sample, MIS-weighted against BSDF sampling.
                 active_em = active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth)

@@ -18,7 +18,7 @@ from ..errors import InputError
 from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
 from ..scene.depth_of_field import DepthOfField
-from . import clamped_path, pinhole_sensor, pixel_filter, thin_lens_sensor, transparent_shadows
+from . import camera_hidden_emission, clamped_path, pinhole_sensor, pixel_filter, thin_lens_sensor, transparent_shadows
 from .adaptive_sampling import PixelTracer, SamplingPlan, render_adaptive
 from .mitsuba_scene import scene_dict
 from .mitsuba_variant import activate, choose_variant, is_jit
@@ -120,11 +120,13 @@ class PathTraceSettings:
         return {name: value for name, value in self._lobe_bounces().items()
                 if value is not None and value < self.max_bounces}
 
-    def integrator_for(self, variant: str, transparent_shadows: bool = False) -> dict[str, Any]:
+    def integrator_for(self, variant: str, transparent_shadows: bool = False,
+                       hidden_emission: bool = False) -> dict[str, Any]:
         """The integrator used in ``variant``: hybridgen's clamped path tracer where it can run (JIT variants)
-        and is needed (clamp on, per-lobe limits, or ``transparent_shadows`` for a scene with alpha surfaces:
-        :mod:`hybridgen.render.transparent_shadows`), else :meth:`integrator` (``volpath`` in ``scalar_rgb``
-        with ``transparent_shadows``)."""
+        and is needed (clamp on, per-lobe limits, ``transparent_shadows`` for a scene with alpha surfaces:
+        :mod:`hybridgen.render.transparent_shadows`, or ``hidden_emission``:
+        :mod:`hybridgen.render.camera_hidden_emission`), else :meth:`integrator` (``volpath`` in
+        ``scalar_rgb`` with ``transparent_shadows``)."""
         limits = self.lobe_limits()
         if not is_jit(variant):
             if limits:
@@ -132,7 +134,7 @@ class PathTraceSettings:
                                  f"({self.max_bounces}) needs a JIT Mitsuba variant (llvm_ad_rgb or cuda_ad_rgb): "
                                  f"{variant}'s path tracer has one depth limit for every lobe")
             return {**self.integrator(), "type": "volpath"} if transparent_shadows else self.integrator()
-        if self.clamp_indirect <= 0 and not limits and not transparent_shadows:
+        if self.clamp_indirect <= 0 and not limits and not transparent_shadows and not hidden_emission:
             return self.integrator()
         clamped_path.register(variant)
         plain = self.integrator()
@@ -194,8 +196,10 @@ class PathTraceView:
         self.intrinsics = scene.camera.intrinsics
         description = scene_dict(scene)
         self._own_film = integrator is not None  # e.g. AOV integrators: rendered through Mitsuba's film
+        hidden = [] if integrator is not None else camera_hidden_emission.hidden_emitter_keys(scene)
         description["integrator"] = integrator or self.settings.integrator_for(
-            self.variant, transparent_shadows=transparent_shadows.scene_has_masks(scene))
+            self.variant, transparent_shadows=transparent_shadows.scene_has_masks(scene),
+            hidden_emission=bool(hidden))
         first = scene.camera.keypoints[0] if scene.camera.keypoints else np.eye(4)
         description["sensor"] = sensor_dict(self.intrinsics, first, self.variant, scene.camera.depth_of_field)
         try:
@@ -208,6 +212,13 @@ class PathTraceView:
             PixelTracer(self.mi_scene, self.sensor, self.mi_scene.integrator(), self.settings.filter_width)
             if is_jit(self.variant) else FullFrameTracer(self))
         self.clamped = description["integrator"]["type"] == clamped_path.PLUGIN_NAME
+        if hidden and self.clamped:
+            self.mi_scene.integrator().hidden_shapes = camera_hidden_emission.hidden_shapes(description, hidden)
+        elif hidden:
+            from ..config.notices import notice
+
+            notice(f"{len(hidden) // 2} emitter(s) hidden from the camera (emission_hidden_from_camera, e.g. 3D-FRONT "
+                   f"ceilings and lamps) glow for the camera too in {self.variant} (needs a JIT variant)")
 
     def set_pose(self, cam2world: np.ndarray) -> None:
         """Move the sensor to an OpenCV-axes ``cam2world`` (nothing else is rebuilt)."""

@@ -39,6 +39,10 @@ class Material:
       ``cycles.displacement_method``, so ambientCG / Poly Haven ``_Displacement`` maps are bumps in its
       renders too. True geometric displacement is the Displace modifier's job
       (:mod:`hybridgen.scene.displacement`, EntityManipulator ``displace``).
+    - ``emission_hidden_from_camera``: the emission lights the scene but the camera does not see it - camera
+      rays see the surface's BSDF without emission, every other ray sees the emission alone (a black
+      emitter). What BlenderProc's ``make_emissive`` builds (a Light Path "Is Camera Ray" mix), used for
+      3D-FRONT ceilings and lamps (:mod:`hybridgen.render.camera_hidden_emission`).
     - ``alpha_mode``: "BLEND" - alpha is a fractional opacity in color, labels see the surface (BlenderProc's
       default, segmentation without ``use_alpha``); "CLIP" - alpha >= 0.5 is opaque, below it the surface is
       cut out of color, albedo and every label (Blender's alpha clip, BlenderProc's ``use_alpha``).
@@ -66,6 +70,7 @@ class Material:
     displacement_scale: float = 0.15  # metres per unit of height (Blender's Displacement node default in BlenderProc)
     specular_texture: Any = None
     emission_texture: Any = None  # path or HxWx{3,4} uint8 array, sRGB encoded, like base_color_texture
+    emission_hidden_from_camera: bool = False
     extra: dict[str, Any] = field(default_factory=dict)
 
     @property
