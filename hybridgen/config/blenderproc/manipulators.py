@@ -52,8 +52,12 @@ def entity(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]
         cfg.pop("mode", None)  # the randomizer draws once for all or for each, as BlenderProc
     pop_mode(cfg, note)
     pop_shading(cfg, note)
-    for key in ("cf_add_modifier", "cf_add_displace_modifier_with_texture", "cf_add_uv_mapping"):
+    for key in ("cf_add_modifier", "cf_add_uv_mapping"):
         pop_ignored(cfg, key, note, "Blender modifiers (displacement, subdivision, UV projection) are not applied")
+    pop_ignored(cfg, "cf_add_displace_modifier_with_texture", note,
+                "Blender's procedural textures are not reproduced, so this displacement is not applied; "
+                "EntityManipulator's displace: {texture: <height image>, strength, mid_level, subdiv_level} "
+                "displaces the geometry")
     out = []
     randomize = cfg.pop("cf_randomize_materials", None)
     if randomize is not None:
