@@ -8,8 +8,8 @@ reads with its green channel inverted). Specular 0.333 as BlenderProc's CC mater
 Poly Haven (texturehaven): ``<asset>/<asset>_diff_<res>.jpg`` with siblings named by replacing ``diff``
 (case-insensitively): ``rough``, ``nor_gl`` / ``nor`` (OpenGL), ``nor_dx`` (DirectX), ``disp``, ``bump`` (used as
 the height map, 1 m per unit like Blender's Bump node, only when there is neither a normal nor a displacement
-map), ``alpha``, ``metal``. ``spec`` and ``ao`` maps are not read (the principled model has a specular value,
-no specular map; ambient occlusion is computed by the path tracer).
+map), ``alpha``, ``metal``, ``spec`` (Principled specular, as BlenderProc links it). ``ao`` maps are not read
+(ambient occlusion is computed by the path tracer).
 
 Displacement maps get BlenderProc's displacement node values: mid level 0.5, scale 0.15 (bump rendering, see
 :class:`~hybridgen.scene.material.Material`).
@@ -79,6 +79,7 @@ def haven_material(asset: Path) -> Material | None:
     material = Material(name=asset.name, base_color_texture=str(diffuse[0]))
     material.roughness_texture = sibling("rough")
     material.metallic_texture = sibling("metal")
+    material.specular_texture = sibling("spec")
     material.alpha_texture = sibling("alpha")
     for kind, y_down in (("nor_gl", False), ("nor", False), ("nor_dx", True)):
         normal = sibling(kind)

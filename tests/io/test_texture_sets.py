@@ -64,6 +64,7 @@ def test_poly_haven_set_and_loader_module(tmp_path):
     assert material.roughness_texture.endswith("rock_wall_rough_2k.jpg")
     assert material.normal_texture.endswith("rock_wall_nor_gl_2k.jpg") and not material.normal_y_down
     assert material.displacement_texture.endswith("rock_wall_disp_2k.jpg") and material.displacement_scale == 0.15
+    assert material.specular_texture.endswith("rock_wall_spec_2k.jpg")  # BlenderProc links it to Specular
     # a bump map is the height map only without normal and displacement maps (1 m per unit: Blender's Bump)
     bumpy = tmp_path / "textures" / "bark"
     for kind in ("diff", "bump", "nor_dx"):
