@@ -9,6 +9,8 @@ The modifier, as Blender applies it:
    becomes a rounded box); hybridgen subdivides linearly (every triangle into four at its edge midpoints,
    UVs, normals and vertex colors interpolated), which keeps the surface where it was - identical to
    Catmull-Clark for flat patches with straight boundaries (planes, floors, walls), not for curved ones.
+   ``subdiv_level`` is applied as given; BlenderProc's RgbRenderer caps render subdivision at its
+   ``simplify_subdivision_render`` (3 by default), so give at most 3 to match its renders.
 2. Every vertex moves along its normal by (h - ``mid_level``) x ``strength`` metres (object units), h the
    height texture's value at the vertex's texture coordinate: ``texture_coords`` "LOCAL" (Blender's default,
    which BlenderProc keeps: local x, y in [-1, 1] span the image once, u = (x + 1) / 2, v = (y + 1) / 2) or
