@@ -9,7 +9,8 @@ Protocol (one JSON object per line): after building the scene the worker answers
 ``{"ready": true, "blender": ..., "setup_s": ...}``; then each request line on stdin,
 ``{"index": i, "light_tree": bool, "seed": int, "save": path-or-null}`` (optionally ``"mode"``:
 ``"blenderproc"`` - BlenderProc 2.8's render defaults, or ``"reference"`` - the same estimator at a fixed
-``"spp"`` without adaptive sampling or denoising), is answered with
+``"spp"`` without adaptive sampling or denoising; ``"cycles"``: a mapping of ``scene.cycles`` attributes set
+after the mode, for experiments), is answered with
 ``{"seconds": wall, "cpu_s": cpu}`` (the time of ``bpy.ops.render.render`` alone); ``{"quit": true}`` ends
 it with its peak RSS. Requests one at a time let the benchmark interleave Cycles with Mitsuba keypoint by
 keypoint, so both see the same machine noise; while waiting the worker is idle.
@@ -200,11 +201,16 @@ def main(path: str) -> None:
         scene.cycles.use_light_tree = bool(request["light_tree"])
         if request.get("mode") in ("blenderproc", "reference"):
             blenderproc_defaults(scene, request.get("mode") == "reference", int(request.get("spp", 1024)))
+        for key, value in request.get("cycles", {}).items():  # experiments: scene.cycles attributes set last
+            setattr(scene.cycles, key, value)
         scene.cycles.seed = int(request.get("seed", 0)) % 2**31  # Cycles' seed is an int32
         cpu, wall = time.process_time(), time.perf_counter()
         bpy.ops.render.render(write_still=False)
         wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
-        if request.get("save"):
+        if request.get("save"):  # PNG (8-bit sRGB, the view transform applied) or, for a .exr path, linear float
+            settings = scene.render.image_settings
+            exr = request["save"].endswith(".exr")
+            settings.file_format, settings.color_depth = ("OPEN_EXR", "32") if exr else ("PNG", "8")
             bpy.data.images["Render Result"].save_render(request["save"], scene=scene)
         protocol.write(json.dumps({"seconds": wall, "cpu_s": cpu}) + "\n")
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024

@@ -14,6 +14,16 @@ only the noise changes. Powers, for a scene whose geometry fits in a sphere of r
 - an emissive mesh side of radiance L and area A: pi L A.
 
 Weights are the mean over RGB; none is below 1e-4 of the largest, so no emitter becomes unreachable.
+
+A **constant-color world** is the exception (as in Cycles, which samples the background as a light only when
+it varies over directions or has portals): next to other emitters it gets weight 0, so next-event estimation
+never picks it and it is found by BSDF sampling alone, with MIS weight 1 - unbiased, and for a constant
+radiance BSDF sampling is the better technique (cosine-distributed for a diffuse surface, where Mitsuba's
+constant emitter samples the whole sphere uniformly, half of it below the surface). It also leaves every
+light sample to the lamps. Measured with tools/color_decompose.py-style runs (160x120, 64 spp, direct light
+only, PSNR against a 2048-spp reference): tabletop 46.1 -> 51.0 dB (Cycles 50.9); window room, where the sky
+shines in through a window, all bounces: 30.5 -> 30.8 dB (256 spp 35.9 -> 36.5). A world that is the only
+emitter keeps its weight (Mitsuba needs one emitter with sampling mass).
 """
 from __future__ import annotations
 
@@ -58,6 +68,12 @@ def mesh_side_power(obj: MeshObject, radiance: np.ndarray) -> float:
     v = obj.world_vertices()[obj.faces]
     area = 0.5 * float(np.linalg.norm(np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]), axis=1).sum())
     return math.pi * float(np.mean(radiance)) * area
+
+
+def constant_world_unsampled(world: World, emitters: int) -> bool:
+    """Whether the world is left to BSDF sampling (weight 0): a constant color next to ``emitters`` other
+    emitters (see the module docstring)."""
+    return world.hdri_path is None and emitters > 0
 
 
 def normalised(weights: dict[str, float]) -> dict[str, float]:

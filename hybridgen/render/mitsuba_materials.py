@@ -34,6 +34,7 @@ from ..input_paths import not_found
 from ..errors import InputError
 from ..io.image_check import check_image_file
 from ..scene.material import ALPHA_MODES, Material
+from .lobe_sampling import principled_sampling_rates
 from .material_textures import data_image
 
 
@@ -170,6 +171,7 @@ def _principled(material: Material, inputs: dict[str, Any], specular: float) -> 
         bsdf["eta"] = float(material.ior)
     else:
         bsdf["specular"] = float(specular)
+    bsdf.update(principled_sampling_rates(material, specular))  # lobes sampled by albedo (render/lobe_sampling.py)
     return bsdf
 
 

@@ -175,6 +175,9 @@ def scene_dict(scene: Scene) -> dict[str, Any]:
         powers[f"light_{index}"] = light_selection.light_power(light, radius)
     weights = light_selection.normalised(powers)
     if world is not None:
+        if light_selection.constant_world_unsampled(scene.world, len(powers) - 1):
+            weights = light_selection.normalised({k: v for k, v in powers.items() if k != "world"})
+            weights["world"] = 0.0
         out["world"] = {**world, "sampling_weight": weights["world"]}
     bsdfs: dict[Any, Any] = {}  # equal materials share one BSDF (textures read once)
     shared, instanced = instanced_entries(scene.objects, lambda o: mesh_shape(o, bsdfs=bsdfs),

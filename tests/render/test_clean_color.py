@@ -165,7 +165,7 @@ def test_clamping_never_changes_direct_light_but_clamps_indirect(variant):
 
 
 def test_emitters_are_sampled_in_proportion_to_their_power(variant, monkeypatch):
-    """A bright lamp next to a dim world: power-proportional emitter selection gives the lamp most light
+    """A bright lamp next to a dim one: power-proportional emitter selection gives the bright lamp most light
     samples. The image is the same estimate (unbiased) with less noise than uniform selection. (Measured with
     independent random samples: the default stratified sampler splits a 50/50 choice exactly in half, which
     hides the selection's own noise.)"""
@@ -175,15 +175,15 @@ def test_emitters_are_sampled_in_proportion_to_their_power(variant, monkeypatch)
     monkeypatch.setattr(path_trace, "SAMPLER", "independent")
     activate(variant)
     scene = _lamp_over_floor(wall=False)
-    scene.world.color, scene.world.strength = (0.005, 0.005, 0.005), 1.0
+    scene.lights.append(hg.Light("dim", "POINT", energy=250.0, local2world=hg.object_pose([6.0, 0.0, 2.0])))
     description = mitsuba_scene.scene_dict(scene)
     radius = light_selection.scene_radius(scene)
     assert radius == pytest.approx(math.sqrt(50 ** 2 + 50 ** 2) / 2)
-    lamp = light_selection.light_power(scene.lights[0], radius)
-    world = light_selection.world_power(scene.world, 0.005, radius)
-    assert lamp == 2000.0 and world == pytest.approx(0.005 * 4 * math.pi ** 2 * radius ** 2)
+    assert [light_selection.light_power(light, radius) for light in scene.lights] == [2000.0, 250.0]
+    assert light_selection.world_power(scene.world, 0.005, radius) == pytest.approx(
+        0.005 * 4 * math.pi ** 2 * radius ** 2)
     assert description["light_0"]["sampling_weight"] == 1.0
-    assert description["world"]["sampling_weight"] == pytest.approx(world / lamp)
+    assert description["light_1"]["sampling_weight"] == pytest.approx(250.0 / 2000.0)
     assert light_selection.normalised({"a": 0.0, "b": 2.0}) == {"a": 1e-4, "b": 1.0}
 
     def noise_and_mean() -> tuple[float, float]:
@@ -196,6 +196,37 @@ def test_emitters_are_sampled_in_proportion_to_their_power(variant, monkeypatch)
     noise_uniform, mean_uniform = noise_and_mean()
     assert noise_power < noise_uniform / 2  # lamp picked with p = 0.89 instead of 0.5: std ratio ~2.8
     assert mean_power == pytest.approx(mean_uniform, rel=0.03)
+
+
+def test_constant_world_is_found_by_bsdf_sampling_only(variant, monkeypatch):
+    """A constant-color world next to a lamp gets no light samples (weight 0, as Cycles leaves a constant
+    background to BSDF sampling): an open Lambertian floor then receives exactly albedo x world radiance from
+    it in every sample (cosine-weighted BSDF samples, MIS weight 1), on top of the lamp's light; sampled as a
+    light, the world also takes most light samples from the lamp (it has the larger power) - much noisier.
+    Direct light only; independent samples (see above)."""
+    from hybridgen.render import light_selection, mitsuba_scene, path_trace
+    from hybridgen.render.mitsuba_variant import activate
+
+    monkeypatch.setattr(path_trace, "SAMPLER", "independent")
+    activate(variant)
+    scene = _lamp_over_floor(wall=False)
+    settings = PathTraceSettings(samples=16, max_bounces=0)
+    lamp_only = PathTraceView(scene, settings, variant=variant).render(scene.camera.keypoints[0], seed=1)
+    scene.world.color, scene.world.strength = (0.5, 0.5, 0.5), 1.0
+    assert mitsuba_scene.scene_dict(scene)["world"]["sampling_weight"] == 0.0
+    alone = hg.Scene(world=scene.world)
+    assert mitsuba_scene.scene_dict(alone)["world"]["sampling_weight"] == 1.0  # the only emitter: sampled
+
+    def two_renders() -> tuple[np.ndarray, np.ndarray]:
+        view = PathTraceView(scene, settings, variant=variant)
+        return view.render(scene.camera.keypoints[0], seed=1), view.render(scene.camera.keypoints[0], seed=2)
+
+    a, b = two_renders()
+    np.testing.assert_allclose(a - lamp_only, 0.6 * 0.5, rtol=1e-3)  # albedo x world radiance, every pixel
+    monkeypatch.setattr(light_selection, "constant_world_unsampled", lambda world, emitters: False)
+    assert mitsuba_scene.scene_dict(scene)["world"]["sampling_weight"] > 0
+    sampled_a, sampled_b = two_renders()
+    assert np.std(a - b) < np.std(sampled_a - sampled_b) / 4
 
 
 def test_adaptive_rounds_reuse_one_compiled_kernel(variant):
