@@ -1,10 +1,16 @@
 """hybridgen's messages through the standard library's ``logging``, under the logger ``hybridgen``.
 
-Library code reports one-line status messages through a ``log(message)`` callback (``RunContext.log``);
-:func:`log_line` is the callback the command line passes: it gives each line its level. A line starting
-with ``warning:`` is a warning (the prefix is dropped, the formatter adds it back); the lines that tell a
-user their run did not start from scratch (:data:`RESUME_MARKERS`) are notices at warning level; everything
-else is information. ``hybridgen -q`` shows warnings and errors only, ``-v`` adds debug lines.
+Library code reports one-line status messages through a ``log(message, level="info")`` callback
+(``RunContext.log``, :class:`Log`); the caller names the level, nothing is guessed from the text:
+
+- ``"info"``: what happened (``-q`` hides it);
+- ``"notice"``: the run did not start from scratch (resumed, nothing to do, a file rendered again) - logged
+  at warning level, shown as ``notice:`` and kept by ``-q``;
+- ``"warning"``: something the user should look at.
+
+:func:`log_line` is the callback the command line passes. ``hybridgen -q`` shows warnings and errors only,
+``-v`` adds debug lines. Pool worker processes log like their parent (:func:`logging_setup` is handed to
+:func:`configure` in each worker).
 
 Applications embedding hybridgen configure the ``hybridgen`` logger as they like; without configuration
 Python shows warnings and errors on stderr.
@@ -13,33 +19,46 @@ from __future__ import annotations
 
 import logging
 import sys
-from typing import TextIO
+from typing import Literal, Protocol, TextIO
 
 LOGGER = logging.getLogger("hybridgen")
 
-_WARNING_PREFIX = "warning: "
-RESUME_MARKERS = ("resumed:", "nothing to do", "rendering it again")
-"""Phrases of the runner's lines saying that a run did not start from scratch: notices, kept by ``-q``."""
+Level = Literal["debug", "info", "notice", "warning"]
+LEVELS: dict[str, int] = {"debug": logging.DEBUG, "info": logging.INFO, "notice": logging.WARNING,
+                          "warning": logging.WARNING}
+"""A status line's level -> the ``logging`` level it is logged at (see the module documentation)."""
+
+NOTICE_ATTR = "hybridgen_notice"
+"""Set (True) on the log records of notices: warning-level records shown as ``notice:``."""
 
 
-def log_line(message: str) -> None:
-    """Log one status line at the level it implies (see the module docstring)."""
-    if message.startswith(_WARNING_PREFIX):
-        LOGGER.warning(message[len(_WARNING_PREFIX):])
-    elif any(marker in message for marker in RESUME_MARKERS):
-        LOGGER.warning(f"notice: {message}")
-    else:
-        LOGGER.info(message)
+class Log(Protocol):
+    """A status-line callback: ``log(message)`` for information, ``log(message, "warning")`` etc."""
+
+    def __call__(self, message: str, level: Level = "info") -> None: ...
+
+
+def log_line(message: str, level: Level = "info") -> None:
+    """Log one status line at ``level`` (see the module documentation)."""
+    if level not in LEVELS:
+        raise ValueError(f"log level must be one of {list(LEVELS)}, got {level!r}")
+    LOGGER.log(LEVELS[level], message, extra={NOTICE_ATTR: level == "notice"})
+
+
+def no_log(message: str, level: Level = "info") -> None:
+    """A :class:`Log` that drops every line (the default of library calls)."""
 
 
 class _LineFormatter(logging.Formatter):
-    """``hybridgen: <message>``, with ``warning:`` / ``error:`` for those levels (notices keep their word)."""
+    """``hybridgen: <message>``, with ``notice:``, ``warning:``, ``error:`` or ``debug:`` for those levels."""
 
     def format(self, record: logging.LogRecord) -> str:
         message = record.getMessage()
         if record.levelno >= logging.ERROR:
             message = f"error: {message}"
-        elif record.levelno >= logging.WARNING and not message.startswith("notice:"):
+        elif getattr(record, NOTICE_ATTR, False):
+            message = f"notice: {message}"
+        elif record.levelno >= logging.WARNING:
             message = f"warning: {message}"
         elif record.levelno < logging.INFO:
             message = f"debug: {message}"
@@ -80,3 +99,11 @@ def configure(level: int) -> None:
     LOGGER.addHandler(handler)
     LOGGER.setLevel(level)
     LOGGER.propagate = False
+
+
+def logging_setup() -> int | None:
+    """The level :func:`configure` gave this process's ``hybridgen`` logger, or None when it was not
+    configured (an application's own setup): handed to worker processes so that they log like this one."""
+    if any(isinstance(h, _StderrHandler) for h in LOGGER.handlers):
+        return LOGGER.level
+    return None

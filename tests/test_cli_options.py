@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+from pathlib import Path
 
 import jsonschema
 import pytest
@@ -66,7 +67,7 @@ def test_quiet_keeps_warnings_and_the_resume_notice(gl_context, tmp_path, run_cl
 def test_log_levels():
     import logging
 
-    from hybridgen.logs import LOGGER, level_for, log_line
+    from hybridgen.logs import LOGGER, _LineFormatter, level_for, log_line
 
     assert level_for(0, True) == logging.WARNING and level_for(1, False) == logging.DEBUG
     assert level_for(0, False) == logging.INFO
@@ -77,16 +78,37 @@ def test_log_levels():
     previous = LOGGER.level
     LOGGER.setLevel(logging.DEBUG)
     try:
-        log_line("warning: camera.CameraSampler 3 of 5 poses")
-        log_line("resumed: 2 unit(s) were already complete and verified")
+        log_line("camera.CameraSampler 3 of 5 poses", "warning")
+        log_line("resumed: 2 unit(s) were already complete and verified", "notice")
         log_line("unit scene_000000_chunk_00000: 4 keypoint(s)")
+        log_line("warning: a line whose text looks like a warning, logged as information")  # no phrase matching
+        with pytest.raises(ValueError, match="log level"):
+            log_line("x", "loud")  # type: ignore[arg-type]
     finally:
         LOGGER.removeHandler(handler)
         LOGGER.setLevel(previous)
     assert [(r.levelname, r.getMessage()) for r in records] == [
         ("WARNING", "camera.CameraSampler 3 of 5 poses"),
-        ("WARNING", "notice: resumed: 2 unit(s) were already complete and verified"),
-        ("INFO", "unit scene_000000_chunk_00000: 4 keypoint(s)")]
+        ("WARNING", "resumed: 2 unit(s) were already complete and verified"),
+        ("INFO", "unit scene_000000_chunk_00000: 4 keypoint(s)"),
+        ("INFO", "warning: a line whose text looks like a warning, logged as information")]
+    formatter = _LineFormatter()  # what the command line prints for each
+    assert [formatter.format(r) for r in records[:3]] == [
+        "hybridgen: warning: camera.CameraSampler 3 of 5 poses",
+        "hybridgen: notice: resumed: 2 unit(s) were already complete and verified",
+        "hybridgen: unit scene_000000_chunk_00000: 4 keypoint(s)"]
+
+
+def test_no_status_line_carries_its_level_in_its_text():
+    """Levels are arguments (log(message, "warning")); a 'warning: ' prefix in the text would print as
+    information ('hybridgen: warning: ...' under -q would vanish)."""
+    import hybridgen
+
+    root = Path(hybridgen.__file__).parent
+    found = [f"{path.relative_to(root)}:{number}" for path in sorted(root.rglob("*.py"))
+             for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
+             if re.search(r"""\blog\(f?["'](warning|notice): """, line)]
+    assert found == [], found
 
 
 def _helps(parser) -> dict[str, str]:

@@ -8,11 +8,11 @@ variable ``HYBRIDGEN_STRICT=1`` that it sets for worker processes) every notice 
 """
 from __future__ import annotations
 
-import logging
 import os
 from typing import Callable
 
 from ..errors import ConfigError
+from ..logs import log_line
 
 STRICT_ENV = "HYBRIDGEN_STRICT"
 _seen: set[str] = set()
@@ -51,4 +51,4 @@ def notice(message: str, *, file: str | None = None, module: str | None = None, 
         return
     if line not in _seen:
         _seen.add(line)
-        logging.getLogger("hybridgen").warning("notice: %s", error)  # the CLI prints "hybridgen: notice: ..."
+        log_line(str(error), "notice")  # the CLI prints "hybridgen: notice: ..."

@@ -95,7 +95,7 @@ class CameraSampler(Module):
                                f"({report.summary()})")
                     if cfg["on_failure"] == "error":
                         raise InputError(message + "; relax the checks or raise max_tries")
-                    context.log(f"warning: {self.module_name} {message}")
+                    context.log(f"{self.module_name} {message}", "warning")
         finally:
             view.release()
         context.log(f"{self.module_name}: {report.summary()}")

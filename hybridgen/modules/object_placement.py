@@ -37,7 +37,7 @@ class _Placer(SelectingModule):
             detail = f"no collision-free pose for {names} in {self.config['max_iterations']} tries"
             if self.config["on_failure"] == "error":
                 raise InputError(detail + "; enlarge the sampling region or raise max_iterations")
-            context.log(f"warning: {self.module_name}: {detail}; left where they were")
+            context.log(f"{self.module_name}: {detail}; left where they were", "warning")
         context.log(message)
 
 

@@ -147,4 +147,4 @@ class ObjectSwapper(SelectingModule):
             if cfg["on_failure"] == "error":
                 raise InputError(detail + "; add pool candidates of that category, raise max_tries or use "
                                  "ignore_collision_with")
-            context.log(f"warning: {self.module_name}: {detail}; kept the original(s)")
+            context.log(f"{self.module_name}: {detail}; kept the original(s)", "warning")

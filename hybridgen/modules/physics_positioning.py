@@ -129,4 +129,4 @@ class PhysicsPositioning(SelectingModule):
             detail = f"not at rest after {result.simulated_time:.2f} s: {names}"
             if self.config["on_not_at_rest"] == "error":
                 raise InputError(detail + "; raise max_simulation_time or loosen the rest thresholds")
-            context.log(f"warning: {self.module_name}: {detail}; they keep their last simulated pose")
+            context.log(f"{self.module_name}: {detail}; they keep their last simulated pose", "warning")

@@ -197,8 +197,8 @@ class RandomRoomConstructor(Module):
             for obj in targets:
                 obj.material = copy.copy(opaque[int(context.rng.integers(len(opaque)))])
         else:
-            context.log(f"warning: {self.module_name}: no opaque CC material in the library (run "
-                        "loader.CCMaterialLoader before): floor, walls and ceiling keep the default material")
+            context.log(f"{self.module_name}: no opaque CC material in the library (run loader.CCMaterialLoader "
+                        "before): floor, walls and ceiling keep the default material", "warning")
         taken = {o.name for o in context.scene.objects}
         for obj in (walls, floor, ceiling):
             if obj is not None:

@@ -80,8 +80,8 @@ class TextureLoader(Module):
         for file in files:
             resolved = str(file.resolve())
             if resolved in loaded:
-                context.log(f"warning: {self.module_name}: '{file}' is loaded already; skipped (load a copy of "
-                            "the file for another colorspace)")
+                context.log(f"{self.module_name}: '{file}' is loaded already; skipped (load a copy of "
+                            "the file for another colorspace)", "warning")
                 continue
             name = unique_blender_name(f"ct_{file.name}", taken)
             textures.append(ImageTexture(name, str(file), self.config["colorspace"], read_image(file),

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..config.config_file import ConfigFile
 from ..io.frame_sink import FrameSink
+from ..logs import Log, no_log
 from ..scene.scene import Scene
 from .units import WorkUnit, scene_seed_sequence
 
@@ -31,7 +32,7 @@ class RunContext:
     frames_rendered: int = 0
     attributes: dict[str, Any] = field(default_factory=dict)
     progress: Callable[[int, str], Any] | None = None
-    log: Callable[[str], None] = field(default=lambda message: None)
+    log: Log = field(default=no_log)  # log(message) or log(message, "warning"), see hybridgen.logs
     cleanups: list[Callable[[], None]] = field(default_factory=list)
 
     def __post_init__(self) -> None:

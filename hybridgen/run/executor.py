@@ -10,6 +10,7 @@ from concurrent.futures import Future
 from typing import TYPE_CHECKING, Any, Callable
 
 if TYPE_CHECKING:  # imported where used: the command line reads EXECUTORS without loading the run machinery
+    from ..logs import Log
     from .unit_task import UnitTask
     from .units import WorkUnit
 
@@ -34,17 +35,18 @@ class InProcessExecutor(Executor):
     consecutive units of one scene build it once (:mod:`hybridgen.run.scene_reuse`)."""
 
     def __init__(self, task: UnitTask, progress: Callable[[int, str], Any] | None = None,
-                 reuse_scenes: bool = False) -> None:
-        self.task = task
+                 reuse_scenes: bool = False, log: Log | None = None) -> None:
         from .scene_reuse import SceneReuse
 
+        self.task = task
         self.progress = progress
+        self.log = log
         self.scenes = SceneReuse() if reuse_scenes else None
 
     def submit(self, unit: WorkUnit) -> Future:
         future: Future = Future()
         try:
-            future.set_result(self.task(unit, self.progress, self.scenes))
+            future.set_result(self.task(unit, self.progress, self.scenes, self.log))
         except BaseException as exc:  # surfaced by the scheduler
             if isinstance(exc, (KeyboardInterrupt, SystemExit)):
                 raise
@@ -57,19 +59,21 @@ class InProcessExecutor(Executor):
 
 
 class PoolExecutor(Executor):
-    """A spawn-context process pool of ``workers`` processes sharing the cores; they die with this process
-    and are replaced after ``max_tasks_per_child`` units."""
+    """A spawn-context process pool of ``workers`` processes sharing the cores; they die with this process,
+    log as it does (:func:`hybridgen.logs.logging_setup`) and are replaced after ``max_tasks_per_child`` units."""
 
     def __init__(self, task: UnitTask, workers: int, max_tasks_per_child: int) -> None:
         from concurrent.futures import ProcessPoolExecutor
         from multiprocessing import get_context
 
-        from .unit_task import limit_threads
+        from ..logs import logging_setup
+        from .unit_task import start_worker
 
         threads = max(1, (os.cpu_count() or 1) // workers)
         self.task = task
-        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"), initializer=limit_threads,
-                                        initargs=(threads, os.getpid()), max_tasks_per_child=max_tasks_per_child)
+        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"), initializer=start_worker,
+                                        initargs=(threads, os.getpid(), logging_setup()),
+                                        max_tasks_per_child=max_tasks_per_child)
 
     def submit(self, unit: WorkUnit) -> Future:
         return self.pool.submit(self.task, unit)

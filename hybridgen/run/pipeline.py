@@ -12,6 +12,7 @@ from ..config.config_file import load_config
 from ..errors import ConfigError, InputError
 from ..io.atomic import prepare_output_dir
 from ..io.output_lock import output_locks
+from ..logs import Log, no_log
 from ..modules.base import Module, Role
 from .executor import DEFAULT_MAX_TASKS_PER_CHILD
 from .fingerprint import FINGERPRINT_ATTR, fingerprint_text, run_fingerprint
@@ -53,12 +54,13 @@ def disk_full_is_one_line(folders: list[Path]) -> Iterator[None]:
 
 def run_config(path: str | Path, args: Sequence[str] = (), *, env: Mapping[str, str] | None = None,
                progress: Callable[[int, str], Any] | None = None,
-               log: Callable[[str], None] | None = None, workers: int = 1, shard: tuple[int, int] | None = None,
+               log: Log | None = None, workers: int = 1, shard: tuple[int, int] | None = None,
                executor: str = "pool", address: str | None = None, restart: bool = False,
                force_resume: bool = False, max_tasks_per_child: int = DEFAULT_MAX_TASKS_PER_CHILD) -> RunSummary:
     """Run the config at ``path`` with command-line ``args`` (``<args:N>``); returns a summary.
 
-    ``progress(total, what)`` makes a progress bar per renderer; ``log`` receives one-line status messages.
+    ``progress(total, what)`` makes a progress bar per renderer; ``log`` receives one-line status messages with
+    their level (:class:`hybridgen.logs.Log`: ``log(message)``, ``log(message, "warning")``).
     A config with several scenes or keypoint chunks (its setup module's ``scene_units``), or ``workers`` > 1, or a
     ``shard`` ``(i, n)`` runs as work units (see :mod:`hybridgen.run.runner`).
 
@@ -72,7 +74,7 @@ def run_config(path: str | Path, args: Sequence[str] = (), *, env: Mapping[str, 
         raise InputError(f"--workers must be an integer >= 1, got {workers!r}")
     if restart and force_resume:
         raise InputError("--restart and --force-resume exclude each other")
-    say = log or (lambda message: None)
+    say = log or no_log
     config = load_config(path, args, env)
     modules = build_modules(config)
     plan = sharding_plan(config, modules, force=workers > 1 or shard is not None)
@@ -89,7 +91,7 @@ def run_config(path: str | Path, args: Sequence[str] = (), *, env: Mapping[str, 
                                max_tasks_per_child=max_tasks_per_child)
         if single is not None and not restart and check_existing(single, policy, say):
             say(f"'{single}' is complete and verified (same config and inputs): nothing to do; "
-                "--restart renders it again")
+                "--restart renders it again", "notice")
             return RunSummary(0, time.perf_counter() - start, [single])
         staged = staged_plan(modules)
         if staged is not None:  # rendered in verified parts, merged into the same bytes: a killed run resumes

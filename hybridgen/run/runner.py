@@ -32,6 +32,7 @@ import h5py
 from ..errors import InputError
 from ..io.atomic import prepare_output_dir
 from ..io.integrity import verify
+from ..logs import Log
 from .executor import (DEFAULT_MAX_TASKS_PER_CHILD, EXECUTORS, Executor, InProcessExecutor, PoolExecutor)
 from .fingerprint import FINGERPRINT_ATTR, describe_difference, differing_keys, parse_fingerprint
 from .plan import ShardingPlan
@@ -69,16 +70,18 @@ def check_executor_options(kind: str, max_tasks_per_child: int) -> None:
 
 def open_executor(kind: str, task: UnitTask, *, workers: int, address: str | None = None,
                   max_tasks_per_child: int = DEFAULT_MAX_TASKS_PER_CHILD,
-                  progress: Callable[[int, str], Any] | None = None, reuse_scenes: bool = False) -> Executor:
+                  progress: Callable[[int, str], Any] | None = None, reuse_scenes: bool = False,
+                  log: Log | None = None) -> Executor:
     """The executor ``kind`` (checked by :func:`check_executor_options`; ``pool``: this process for one
     worker, else a process pool; ``ray``: Ray at ``address`` or a local cluster) for ``workers`` parallel
-    units of ``task``."""
+    units of ``task``. Units run in this process report to ``log``; pool workers log through
+    :func:`hybridgen.logs.log_line`, set up as this process is."""
     if kind == "ray":
         from .executor_ray import RayExecutor
 
         return RayExecutor(task, address, workers)
     if workers == 1:
-        return InProcessExecutor(task, progress, reuse_scenes)
+        return InProcessExecutor(task, progress, reuse_scenes, log)
     return PoolExecutor(task, workers, max_tasks_per_child)
 
 
@@ -87,7 +90,7 @@ def _scene_keypoints(shard: Path) -> int:
         return int(h5.attrs["scene_keypoints"])
 
 
-def check_existing(path: Path, policy: ResumePolicy, log: Callable[[str], None]) -> bool:
+def check_existing(path: Path, policy: ResumePolicy, log: Log) -> bool:
     """Whether the output at ``path`` can be reused: True when it verifies and was made by this run's
     fingerprint (or ``policy.force``); False when it is missing or damaged (it is rendered again); a
     one-line InputError when it is intact but was made by something else."""
@@ -95,7 +98,7 @@ def check_existing(path: Path, policy: ResumePolicy, log: Callable[[str], None])
         return False
     problem = verify(path)
     if problem is not None:
-        log(f"{path}: {problem}; rendering it again")
+        log(f"{path}: {problem}; rendering it again", "notice")
         return False
     with h5py.File(path, "r") as h5:
         stored = parse_fingerprint(h5.attrs.get(FINGERPRINT_ATTR))
@@ -129,7 +132,7 @@ def _scene_units(plan: ShardingPlan, index: int, count: int) -> Iterator[WorkUni
 
 def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: Mapping[str, str] | None, *,
                 workers: int, shard: tuple[int, int] | None, executor: str, address: str | None,
-                log: Callable[[str], None], start: float, policy: ResumePolicy,
+                log: Log, start: float, policy: ResumePolicy,
                 max_tasks_per_child: int = DEFAULT_MAX_TASKS_PER_CHILD,
                 progress: Callable[[int, str], Any] | None = None) -> RunSummary:
     """Execute the plan's missing units, then build the index (or merge a staged plan's parts) when all
@@ -147,7 +150,7 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
             log(f"--restart: discarded {removed} existing file(s)")
     task = UnitTask(str(path), tuple(args), dict(env) if env is not None else None, policy.fingerprint_text)
     pool = open_executor(executor, task, workers=workers, address=address, max_tasks_per_child=max_tasks_per_child,
-                         progress=progress, reuse_scenes=plan.staged)  # a staged run's parts share one scene
+                         progress=progress, reuse_scenes=plan.staged, log=log)  # staged: parts share one scene
     scene_units = _scene_units(plan, index, count)
     ready: deque[WorkUnit] = deque()  # later chunks of scenes whose first chunk is known
     pending: dict[Future, WorkUnit] = {}
@@ -206,7 +209,7 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
     else:
         log(f"shard {index}/{count} done; data.hdf5 is built once every scene's units exist")
     if skipped:
-        log(f"resumed: {skipped} unit(s) were already complete and verified")
+        log(f"resumed: {skipped} unit(s) were already complete and verified", "notice")
     return RunSummary(frames, time.perf_counter() - start, outputs)
 
 

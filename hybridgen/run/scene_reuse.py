@@ -15,6 +15,7 @@ import dataclasses
 from typing import Any, Callable, Mapping, Sequence
 
 from ..config.config_file import ConfigFile, load_config
+from ..logs import Log
 from ..modules.base import Module
 from .context import RunContext
 from .plan import scene_stage
@@ -41,7 +42,7 @@ class SceneReuse:
 
     def execute(self, path: str, args: Sequence[str], env: Mapping[str, str] | None, unit: WorkUnit, *,
                 attributes: Mapping[str, Any] | None = None,
-                progress: Callable[[int, str], Any] | None = None) -> RunContext:
+                progress: Callable[[int, str], Any] | None = None, log: Log | None = None) -> RunContext:
         """Run ``unit`` like :func:`hybridgen.run.steps.execute`, reusing the scene built for the
         previous unit when it is the same config, arguments and scene index."""
         key = (str(path), tuple(args), tuple(sorted((env or {}).items())), unit.scene,
@@ -52,9 +53,11 @@ class SceneReuse:
             modules = build_modules(config)
             stage = scene_stage(modules)
             if stage is None:
-                return execute(config, modules, unit=unit, attributes=attributes, progress=progress)
+                return execute(config, modules, unit=unit, attributes=attributes, progress=progress, log=log)
             base = RunContext(config=config, progress=progress, unit=unit)
             base.attributes.update(attributes or {})
+            if log is not None:
+                base.log = log
             try:
                 run_modules(config, modules[:stage], base)
             except BaseException:

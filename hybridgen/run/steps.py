@@ -10,6 +10,7 @@ from ..config.registry import get_module
 from ..config.schema import validate_config
 from ..errors import ConfigError, HybridgenError, closest
 from ..input_paths import config_folder
+from ..logs import Log
 from ..modules.base import Module
 from .context import RunContext
 from .plan import check_keys, check_order
@@ -39,7 +40,7 @@ def build_modules(config: ConfigFile) -> list[Module]:
 
 def execute(config: ConfigFile, modules: list[Module], *, unit: WorkUnit | None = None,
             progress: Callable[[int, str], Any] | None = None,
-            log: Callable[[str], None] | None = None, attributes: Mapping[str, Any] | None = None) -> RunContext:
+            log: Log | None = None, attributes: Mapping[str, Any] | None = None) -> RunContext:
     """Prepare, then run every module in order (for ``unit``: one work unit of a sharded run).
     ``attributes`` (e.g. the run's ``fingerprint``) are recorded in every output file."""
     context = RunContext(config=config, progress=progress, unit=unit)
