@@ -28,6 +28,7 @@ from .raster_passes import RASTER_PASSES
 from .readback import RasterOutput
 from .projection import near_plane_corner_distance, projection_from_K
 from .shader_source import shader_source
+from .triangle_clusters import TriangleClusters, build_clusters, draw_commands, visible_clusters
 
 NORMAL_SPACES = ("camera", "world")
 
@@ -47,23 +48,27 @@ class GpuObject:
     bounds: np.ndarray  # (2, 3) local box
     cutout: Cutout | None = None  # alpha cut-out of a CLIP material (render/alpha_cutout.py)
     packed_vaos: dict[Any, Any] = dataclasses.field(default_factory=dict)  # (LabelTargets, cutout) -> vao
+    clusters: TriangleClusters | None = None  # large meshes: culled per keypoint (render/triangle_clusters.py)
+    indirect: Any = None  # the draw-command buffer of the kept clusters
 
 
 class RasterView:
     """Renders label passes of ``scene`` for any keypoint of its camera.
 
     ``normals_space`` is "camera" (OpenCV axes) or "world"; ``depth_background`` fills pixels that hit
-    nothing in ``depth`` and ``distance``. Poses of objects are read from the scene at every render, so
+    nothing in ``depth`` and ``distance``; ``cull_clusters``: leave out, per keypoint, the triangle clusters
+    of large meshes that cannot make a fragment (render/triangle_clusters.py; labels are the same without). Poses of objects are read from the scene at every render, so
     moving an object costs nothing; changing its geometry needs a new view.
     """
 
     def __init__(self, scene: Scene, *, normals_space: str = "camera", depth_background: float = float("inf"),
-                 device_index: int | None = None, ctx: Any = None) -> None:
+                 device_index: int | None = None, ctx: Any = None, cull_clusters: bool = True) -> None:
         if normals_space not in NORMAL_SPACES:
             raise InputError(f"normals_space must be one of {NORMAL_SPACES}, got {normals_space!r}")
         self.scene = scene
         self.normals_space = normals_space
         self.depth_background = float(depth_background)
+        self.cull_clusters = cull_clusters  # leave out triangle clusters that make no fragment (exact)
         self.ctx = ctx if ctx is not None else shared_context(device_index)
         self.program = self._label_program(cutout=False)
         self._cutout_program: Any = None  # built with the first object that cuts out (render/alpha_cutout.py)
@@ -153,9 +158,14 @@ class RasterView:
                 content.append((cutout.uv_buffer, "2f", "in_uv"))
         vao = ctx.vertex_array(program, content, index_buffer=indices, index_element_size=4)
         extra = cutout.resources() if cutout is not None else []
+        clusters, indirect = (build_clusters(vertices, faces) if self.cull_clusters else None), None
+        if clusters is not None:
+            indirect = ctx.buffer(reserve=20 * clusters.size)
+            extra.append(indirect)
         # a cut-out volume shows its inside through its holes: never culled
         return GpuObject(obj.instance_id, vao, content, positions, indices, [positions, normal_buffer, indices, *extra],
-                         vertex_order, obj.is_closed and cutout is None, obj.bounds_local, cutout)
+                         vertex_order, obj.is_closed and cutout is None, obj.bounds_local, cutout,
+                         clusters=clusters if indirect is not None else None, indirect=indirect)
 
     def _framebuffer(self, slot: Any, width: int, height: int, targets: LabelTargets | None = None) -> Any:
         key = (slot, width, height, targets)
@@ -257,7 +267,15 @@ class RasterView:
             for name, value in frame_uniforms.items():
                 if name in members[id(program)]:  # a packed variant without normals has no normal uniforms
                     program[name].write(value)
-        for prog, vao, gpu, modelview, normal_to_cam, cull, front_face in draws:
+        for prog, vao, gpu, modelview, normal_to_cam, cull, front_face, placement in draws:
+            commands = None
+            if gpu.clusters is not None:  # leave out the clusters that cannot make a fragment
+                keep = visible_clusters(gpu.clusters, placement[0], intr.K, width, height, intr.clip_start,
+                                        intr.clip_end, placement[1] if cull else None)
+                if not keep.any():
+                    continue
+                if not keep.all():
+                    commands = draw_commands(gpu.clusters, keep)
             prog["u_modelview"].write(modelview)
             if "u_normal_to_cam" in members[id(prog)]:
                 prog["u_normal_to_cam"].write(normal_to_cam)
@@ -273,7 +291,11 @@ class RasterView:
                 self.ctx.enable(self.ctx.CULL_FACE)
             else:
                 self.ctx.disable(self.ctx.CULL_FACE)
-            vao.render()
+            if commands is None:
+                vao.render()
+            else:
+                gpu.indirect.write(commands.tobytes())
+                vao.render_indirect(gpu.indirect, count=len(commands))
         self._submitted[slot] = (intr, targets)
 
     def collect(self, slot: Any = 0) -> RasterOutput:
@@ -312,9 +334,10 @@ class RasterView:
         return part
 
     def _object_uniforms(self, cam2world: np.ndarray, world2cam: np.ndarray, near_reach: float,
-                         hidden: frozenset[int]) -> list[tuple[GpuObject, bytes, bytes, bool, str]]:
-        """Per object to draw: modelview and normal matrix (float32 bytes, column-major), cull flag and the
-        front-face winding - computed for all objects at once from cached per-pose values."""
+                         hidden: frozenset[int]) -> list[tuple[Any, ...]]:
+        """Per object to draw: modelview and normal matrix (float32 bytes, column-major), cull flag, the
+        front-face winding and (float64 modelview, camera centre in object-local coordinates) - computed for
+        all objects at once from cached per-pose values."""
         cache = self._pose_cache()
         if not cache["objects"]:
             return []
@@ -331,7 +354,8 @@ class RasterView:
             if gpu.instance_id in hidden:
                 continue
             draws.append((gpu, modelview_bytes[i].tobytes(), normal_bytes[i].tobytes(),
-                          bool(gpu.closed and outside[i]), "cw" if cache["det"][i] > 0 else "ccw"))
+                          bool(gpu.closed and outside[i]), "cw" if cache["det"][i] > 0 else "ccw",
+                          (modelview[i], cam_local[i])))
         return draws
 
     def _pose_cache(self) -> dict[str, Any]:
