@@ -1,7 +1,7 @@
 """Camera-pose sampling with proximity checks (our raster vs an Embree ray grid) and physics time, on the
 tabletop of configs/tabletop_physics.yaml (20 real meshes from pybullet_data dropped on a table).
 
-Run: .venv/bin/python tools/bench_sampling.py [--candidates 400] [--rounds 3] [--data PYBULLET_DATA]
+Run: .venv/bin/python tools/bench_sampling.py [--candidates 400] [--rounds 3] [--data PYBULLET_DATA] [--no-lenient]
 Needs pybullet (+ pybullet_data), coacd and embreex (the ``bench`` / ``physics`` extras) and EGL.
 
 Camera poses. One scene, one list of candidate poses drawn from the config's CameraSampler entry (shell
@@ -204,7 +204,15 @@ def main() -> None:
     parser.add_argument("--candidates", type=int, default=400, help="candidate camera poses per round")
     parser.add_argument("--rounds", type=int, default=3, help="timed rounds (medians are reported)")
     parser.add_argument("--data", help="pybullet_data folder (default: the installed one)")
+    parser.add_argument("--lenient", action=argparse.BooleanOptionalAction, default=True,
+                        help="load meshes whose MTL or texture files are missing, as `hybridgen run --lenient` does "
+                        "(pybullet_data's lego.obj names a lego.mtl the wheel does not ship; default on); "
+                        "--no-lenient stops on them")
     args = parser.parse_args()
+    if args.lenient:
+        from hybridgen.io.mesh_references import LENIENT_ENV
+
+        os.environ[LENIENT_ENV] = "1"  # read by the mesh loader (a notice per such mesh instead of an error)
     data = _data_path(args.data)
     context, modules = build(data)
     physics_rows = bench_physics(context, modules["object.PhysicsPositioning"], args.rounds)
