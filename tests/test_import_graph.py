@@ -121,3 +121,71 @@ def test_config_uses_sampling_but_sampling_never_imports_config():
                     if target.startswith("hybridgen.config"))
     assert upward == [], "\n".join(upward)
     assert any(t.startswith("hybridgen.sampling") for t in graph["hybridgen.config.schema"])  # the other way is used
+
+
+# ------------------------------------------------------------------ what start-up and a labels-only run load
+
+HEAVY = ("numpy", "h5py", "yaml", "packaging", "moderngl", "mitsuba", "drjit", "trimesh", "scipy", "PIL", "tqdm")
+"""Packages ``import hybridgen`` and ``hybridgen --help`` must not load (each costs 10 ms to 1 s of start-up)."""
+
+COLOR_ONLY = ("mitsuba", "drjit", "pyoidn", "hybridgen.render.path_trace", "hybridgen.render.render_color",
+              "hybridgen.render.mitsuba_scene", "hybridgen.render.mitsuba_variant", "hybridgen.render.denoise")
+"""What only a color (path-traced) run needs: a labels-only run imports none of it."""
+
+LABELS_ONLY_CONFIG = """
+global: {{all: {{output_dir: "<args:0>"}}}}
+modules:
+  - {{name: main.Initializer, config: {{seed: 1}}}}
+  - {{name: loader.ObjLoader, config: {{path: "{mesh}", category_id: 2}}}}
+  - name: camera.CameraLoader
+    config:
+      intrinsics: {{resolution_x: 32, resolution_y: 24}}
+      cam_poses:
+        - {{location: [0, -3, 1.5], rotation: {{format: look_at, value: [0, 0, 0]}}}}
+  - {{name: renderer.SegMapRenderer, config: {{render_depth: true, render_normals: true, map_by: [class, instance]}}}}
+  - {{name: writer.Hdf5Writer}}
+"""
+
+
+def _modules_after(code: str, env: dict[str, str] | None = None) -> set[str]:
+    """The names in ``sys.modules`` after running ``code`` in a fresh interpreter."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    script = f"{code}\nimport json as _json, sys as _sys\nprint(_json.dumps(sorted(_sys.modules)))"
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300,
+                          env={**os.environ, **(env or {})}, cwd=ROOT.parent)
+    assert done.returncode == 0, done.stderr
+    return set(json.loads(done.stdout.splitlines()[-1]))
+
+
+def _loaded(modules: set[str], names: tuple[str, ...]) -> list[str]:
+    return sorted(n for n in names if n in modules or any(m.startswith(n + ".") for m in modules))
+
+
+def test_import_hybridgen_and_help_load_no_heavy_package():
+    """The public names are imported on first use (hybridgen/__init__.py, PEP 562) and the command line
+    parses its arguments before importing what a command needs."""
+    assert _loaded(_modules_after("import hybridgen"), HEAVY) == []
+    help_text = "from hybridgen.cli import build_parser\nbuild_parser().format_help()"
+    assert _loaded(_modules_after(help_text), HEAVY) == []
+    touched = _modules_after("import hybridgen\nhybridgen.Scene")  # a name still works, and loads what it needs
+    assert "numpy" in touched and "hybridgen.scene.scene" in touched
+
+
+def test_labels_only_run_loads_no_color_code_and_a_cached_mesh_no_trimesh(tmp_path):
+    """A labels-only run never imports Mitsuba, Dr.Jit, the denoiser or the path tracer's modules; with its mesh
+    in the cache (second run) it does not import trimesh or SciPy either, nor the physics package."""
+    config = tmp_path / "labels.yaml"
+    config.write_text(LABELS_ONLY_CONFIG.format(mesh=ROOT.parent / "configs/assets/crate.obj"))
+    env = {"HYBRIDGEN_CACHE_DIR": str(tmp_path / "cache")}
+    for run in ("cold", "warm"):
+        code = (f"from hybridgen.cli import main\n"
+                f"assert main(['run', '-q', {str(config)!r}, {str(tmp_path / run)!r}]) == 0")
+        modules = _modules_after(code, env)
+        assert (tmp_path / run / "data.hdf5").is_file()
+        assert "hybridgen.render.render_labels" in modules  # the labels were rendered in this process
+        assert _loaded(modules, COLOR_ONLY) == [], run
+    assert _loaded(modules, ("trimesh", "scipy", "hybridgen.physics")) == []
