@@ -66,12 +66,6 @@ class LabelTargets:
             lines += ["#define CATEGORY_TARGET", f"#define LOCATION_CATEGORY {names.index('category')}"]
         return "\n".join(lines)
 
-    def empty(self, height: int, width: int) -> dict[str, np.ndarray]:
-        """Fresh arrays (one per attachment, by name) to read a ``width`` x ``height`` draw into."""
-        dtypes = {"f4": np.float32, "u1": np.uint8, "u2": np.uint16, "u4": np.uint32}
-        return {name: np.empty((height, width, components) if components > 1 else (height, width), dtypes[kind])
-                for name, components, kind in self.attachments()}
-
 
 def packed_targets(request: Any, tables: Any, scene: Any, accepted: dict[str, str]) -> LabelTargets | None:
     """The packed targets of a :class:`~hybridgen.render.label_request.LabelRequest`'s passes, or None where the

@@ -31,6 +31,10 @@ from .shader_source import shader_source
 from .triangle_clusters import TriangleClusters, build_clusters, draw_commands, visible_clusters
 
 NORMAL_SPACES = ("camera", "world")
+READBACKS = ("direct", "pbo")
+DEFAULT_ATTACHMENTS = [("normal_depth", 4, "f4"), ("instance", 1, "u4")]
+"""(name, components, moderngl dtype) of the default label targets."""
+SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swr", "software")
 
 
 @dataclass
@@ -57,12 +61,19 @@ class RasterView:
 
     ``normals_space`` is "camera" (OpenCV axes) or "world"; ``depth_background`` fills pixels that hit
     nothing in ``depth`` and ``distance``; ``cull_clusters``: leave out, per keypoint, the triangle clusters
-    of large meshes that cannot make a fragment (render/triangle_clusters.py; labels are the same without). Poses of objects are read from the scene at every render, so
+    of large meshes that cannot make a fragment (render/triangle_clusters.py; labels are the same without).
+
+    ``readback``: "direct" reads each target into its array when the keypoint is collected (``glReadPixels``
+    to client memory: with llvmpipe the copy out of its tiles is all the work there is); "pbo" queues the
+    copies into pixel-pack buffers right after the draws, so that a GPU transfers keypoint k while keypoint
+    k - 1 is processed, and collecting only maps them. Default: "direct" on software renderers (there a PBO
+    adds a copy and makes the draw finish before ``submit`` returns), "pbo" on GPUs. Same values either way. Poses of objects are read from the scene at every render, so
     moving an object costs nothing; changing its geometry needs a new view.
     """
 
     def __init__(self, scene: Scene, *, normals_space: str = "camera", depth_background: float = float("inf"),
-                 device_index: int | None = None, ctx: Any = None, cull_clusters: bool = True) -> None:
+                 device_index: int | None = None, ctx: Any = None, cull_clusters: bool = True,
+                 readback: str | None = None) -> None:
         if normals_space not in NORMAL_SPACES:
             raise InputError(f"normals_space must be one of {NORMAL_SPACES}, got {normals_space!r}")
         self.scene = scene
@@ -70,6 +81,12 @@ class RasterView:
         self.depth_background = float(depth_background)
         self.cull_clusters = cull_clusters  # leave out triangle clusters that make no fragment (exact)
         self.ctx = ctx if ctx is not None else shared_context(device_index)
+        renderer = str(self.ctx.info.get("GL_RENDERER", "")).lower()
+        software = any(name in renderer for name in SOFTWARE_RENDERERS)
+        self.readback = readback or ("direct" if software else "pbo")
+        if self.readback not in READBACKS:
+            raise InputError(f"readback must be one of {READBACKS}, got {readback!r}")
+        self._pbos: dict[Any, list[Any]] = {}  # framebuffer key -> a pixel-pack buffer per attachment
         self.program = self._label_program(cutout=False)
         self._cutout_program: Any = None  # built with the first object that cuts out (render/alpha_cutout.py)
         self._packed_programs: dict[tuple[LabelTargets, bool], Any] = {}  # label_targets.py variants
@@ -172,11 +189,15 @@ class RasterView:
         if key not in self._fbos:
             for old in [k for k in self._fbos if k[0] == slot]:
                 self._release_fbo(self._fbos.pop(old))
+                for pbo in self._pbos.pop(old, []):
+                    pbo.release()
             ctx = self.ctx
-            formats = [(4, "f4"), (1, "u4")] if targets is None else [(c, d) for _, c, d in targets.attachments()]
+            formats = [(c, d) for _, c, d in _attachments(targets)]
             self._fbos[key] = ctx.framebuffer(
                 color_attachments=[ctx.renderbuffer((width, height), c, dtype=d) for c, d in formats],
                 depth_attachment=ctx.depth_renderbuffer((width, height)))
+            if self.readback == "pbo":
+                self._pbos[key] = [ctx.buffer(reserve=width * height * c * int(d[1])) for c, d in formats]
         return self._fbos[key]
 
     def _clear(self, fbo: Any, targets: LabelTargets | None) -> None:
@@ -296,26 +317,33 @@ class RasterView:
             else:
                 gpu.indirect.write(commands.tobytes())
                 vao.render_indirect(gpu.indirect, count=len(commands))
-        self._submitted[slot] = (intr, targets)
+        queued = self.readback == "pbo" and region is None
+        if queued:  # the copies run on the GPU after the draws; collect() maps them
+            for attachment, ((_, components, kind), pbo) in enumerate(
+                    zip(_attachments(targets), self._pbos[(slot, width, height, targets)])):
+                fbo.read_into(pbo, attachment=attachment, components=components, dtype=kind)
+        self._submitted[slot] = (intr, targets, queued)
 
     def collect(self, slot: Any = 0) -> RasterOutput:
         """Read back what :meth:`submit` drew into ``slot`` (waits for it to finish); every target is read
         straight into its own fresh contiguous array."""
-        intr, targets = self._submitted.pop(slot)
+        intr, targets, queued = self._submitted.pop(slot)
         width, height = intr.width, intr.height
-        fbo = self._fbos[(slot, width, height, targets)]
+        key = (slot, width, height, targets)
+        dtypes = {"f4": np.float32, "u1": np.uint8, "u2": np.uint16, "u4": np.uint32}
+        arrays = {name: np.empty((height, width, components) if components > 1 else (height, width), dtypes[kind])
+                  for name, components, kind in _attachments(targets)}
+        for attachment, (name, components, kind) in enumerate(_attachments(targets)):
+            if queued:
+                self._pbos[key][attachment].read_into(arrays[name])
+            else:
+                self._fbos[key].read_into(arrays[name], attachment=attachment, components=components, dtype=kind)
         if targets is not None:
-            arrays = targets.empty(height, width)
-            for attachment, (name, components, kind) in enumerate(targets.attachments()):
-                fbo.read_into(arrays[name], attachment=attachment, components=components, dtype=kind)
             return RasterOutput(None, arrays["instance"], self._rays(intr), self._class_lut, self.depth_background,
                                 depth_image=arrays["depth"], normal_codes=arrays.get("normal_codes"),
                                 category=arrays.get("category"), encoded=dict(targets.encoded))
-        normal_depth = np.empty((height, width, 4), dtype=np.float32)
-        instance = np.empty((height, width), dtype=np.uint32)
-        fbo.read_into(normal_depth, attachment=0, components=4, dtype="f4")
-        fbo.read_into(instance, attachment=1, components=1, dtype="u4")
-        return RasterOutput(normal_depth, instance, self._rays(intr), self._class_lut, self.depth_background)
+        return RasterOutput(arrays["normal_depth"], arrays["instance"], self._rays(intr), self._class_lut,
+                            self.depth_background)
 
     def render_ids(self, cam2world: np.ndarray, intrinsics: Intrinsics | None = None,
                    hidden: frozenset[int] = frozenset(), region: tuple[int, int, int, int] | None = None
@@ -400,8 +428,16 @@ class RasterView:
         for fbo in self._fbos.values():
             self._release_fbo(fbo)
         self._fbos.clear()
+        for pbos in self._pbos.values():
+            for pbo in pbos:
+                pbo.release()
+        self._pbos.clear()
         for program in self._programs():  # compiled programs per view: leaked ~1.7 MB per scene before
             program.release()
         self.program = self._cutout_program = None
         self._packed_programs.clear()
 
+
+def _attachments(targets: LabelTargets | None) -> list[tuple[str, int, str]]:
+    """(name, components, moderngl dtype) of each colour attachment of a label draw into ``targets``."""
+    return DEFAULT_ATTACHMENTS if targets is None else targets.attachments()

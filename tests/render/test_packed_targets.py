@@ -153,3 +153,28 @@ def test_encoded_arrays_decode_and_target_widths():
     targets = LabelTargets(True, np.dtype(np.uint16), np.dtype(np.uint8))
     assert [name for name, _, _ in targets.attachments()] == ["depth", "normal_codes", "instance", "category"]
     assert "#define LOCATION_CATEGORY 3" in targets.defines()
+
+
+def test_pixel_pack_buffer_readback_gives_the_same_values(gl_context):
+    """readback="pbo" (the GPU path: copies queued after the draws, mapped on collect) through the two-slot
+    pipeline equals direct readback, default and packed targets; software renderers default to direct."""
+    scene = _scene()
+    direct, queued = hg.RasterView(scene), hg.RasterView(scene, readback="pbo")
+    assert direct.readback == "direct"  # llvmpipe here
+    request = hg.LabelRequest(map_by=["class", "instance"])
+    targets = packed_targets(request, request.tables(direct), scene, {"normals": OCTAHEDRAL})
+    poses = scene.camera.keypoints
+    for chosen in (None, targets):
+        queued.submit(poses[0], slot=0, targets=chosen)
+        for i, pose in enumerate(poses):
+            if i + 1 < len(poses):  # the next keypoint is drawn (and its copies queued) before this one is read
+                queued.submit(poses[i + 1], slot=(i + 1) % 2, targets=chosen)
+            got, expected = queued.collect(i % 2), direct.render_raw(pose, targets=chosen)
+            for name in ("normal_depth", "instance", "depth_image", "normal_codes", "category"):
+                a, b = getattr(got, name), getattr(expected, name)
+                assert (a is None) == (b is None), name
+                if a is not None:
+                    assert a.dtype == b.dtype and a.flags.c_contiguous, name
+                    np.testing.assert_array_equal(a, b, err_msg=name)
+    with pytest.raises(hg.InputError):
+        hg.RasterView(scene, readback="mapped")
