@@ -1,7 +1,10 @@
 """Time to first keypoint of a labels-only ``hybridgen run``, and the start-up cost of ``import hybridgen``.
 
 Run: .venv/bin/python tools/bench_startup.py [--rounds 5] [--scenes monastery 1.4M] [--profile] [--importtime]
+                                            [--baseline OTHER_CHECKOUT]
 Needs pybullet (its ``pybullet_data`` meshes) and trimesh (the 1.4M scene is written once as a binary PLY).
+``--baseline`` also times another checkout of hybridgen (e.g. ``git archive <commit> | tar -x -C /tmp/base``)
+with the same interpreter, round by round alternating with this one, so that machine load hits both alike.
 
 Every figure is a whole process, started by this script: wall seconds and CPU seconds (user + system of every
 thread; ``wait4``), medians over ``--rounds``. CPU seconds are the steadier figure while other processes share
@@ -114,6 +117,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=5, help="runs per row (medians)")
     parser.add_argument("--scenes", nargs="+", default=["monastery", "1.4M"], choices=list(SCENE_NAMES))
+    parser.add_argument("--baseline", type=Path, help="another hybridgen checkout to time alongside this one")
     parser.add_argument("--no-bytecode", action="store_true", help="children run with PYTHONDONTWRITEBYTECODE=1")
     parser.add_argument("--profile", action="store_true", help="cProfile of one warm run per scene")
     parser.add_argument("--importtime", action="store_true", help="python -X importtime of one warm run per scene")
@@ -122,49 +126,63 @@ def main() -> None:
 
     import bench_labels as bl
 
+    checkouts = {"this": TOOLS.parent} | ({"baseline": args.baseline.resolve()} if args.baseline else {})
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
-        env = dict(os.environ, HYBRIDGEN_CACHE_DIR=str(work / "cache"))
+        base_env = dict(os.environ)
         if args.no_bytecode:
-            env["PYTHONDONTWRITEBYTECODE"] = "1"
+            base_env["PYTHONDONTWRITEBYTECODE"] = "1"
         else:
-            env.pop("PYTHONDONTWRITEBYTECODE", None)
-            env["PYTHONPYCACHEPREFIX"] = str(work / "pycache")
-        hybridgen = [sys.executable, "-m", "hybridgen"]
-        timed([*hybridgen, "--help"], env)  # untimed: compiles bytecode into the private prefix
+            base_env.pop("PYTHONDONTWRITEBYTECODE", None)
+        envs = {}
+        for name, root in checkouts.items():  # each its own caches and bytecode; the checkout first on sys.path
+            envs[name] = dict(base_env, PYTHONPATH=str(root), HYBRIDGEN_CACHE_DIR=str(work / name / "cache"))
+            if not args.no_bytecode:
+                envs[name]["PYTHONPYCACHEPREFIX"] = str(work / name / "pycache")
+            timed([sys.executable, "-m", "hybridgen", "--help"], envs[name])  # untimed: compiles bytecode
+        os.chdir(work)  # not a checkout: '' on sys.path finds no hybridgen
         print(f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f} (others' processes skew wall times); "
-              f"bytecode {'not cached' if args.no_bytecode else 'cached'}; medians of {args.rounds} whole processes")
-        print(f"{'what':<40} {'wall s':>8} {'cpu s':>8}")
-        for label, command in (("python -c 'import numpy'", [sys.executable, "-c", "import numpy"]),
-                               ("python -c 'import hybridgen'", [sys.executable, "-c", "import hybridgen"]),
-                               ("hybridgen --help", [*hybridgen, "--help"])):
-            runs = [timed(command, env)[1:] for _ in range(args.rounds)]
-            print(f"{label:<40} {statistics.median(r[0] for r in runs):>8.3f} "
-                  f"{statistics.median(r[1] for r in runs):>8.3f}", flush=True)
-        print(f"\nlabels-only run, 640x480, 1 keypoint: 1st kp = process start -> first keypoint handed to the "
-              "writer; whole = the process")
-        print(f"{'scene':<22} {'cache':<6} {'1st kp wall':>11} {'1st kp cpu':>11} {'whole wall':>11} {'whole cpu':>10}")
-        for short in args.scenes:
-            name = SCENE_NAMES[short]
-            config, _ = bl.write_configs(name, "640x480", 1, work / "configs")
-            out, stamp = work / "out", work / "stamp"
-            cold = []
+              f"bytecode {'not cached' if args.no_bytecode else 'cached'}; medians of {args.rounds} whole processes, "
+              f"checkouts alternating: " + ", ".join(f"{k} = {v}" for k, v in checkouts.items()))
+        print(f"{'what':<32} {'checkout':<9} {'wall s':>8} {'cpu s':>8}")
+        for label, code in (("python -c 'import numpy'", ["-c", "import numpy"]),
+                            ("python -c 'import hybridgen'", ["-c", "import hybridgen"]),
+                            ("hybridgen --help", ["-m", "hybridgen", "--help"])):
+            runs: dict[str, list[tuple[float, float]]] = {name: [] for name in checkouts}
             for r in range(args.rounds):
-                shutil.rmtree(work / "cache", ignore_errors=True)
-                cold.append(first_keypoint(config, out, env, stamp))
-            warm = [first_keypoint(config, out, env, stamp) for _ in range(args.rounds)]
-            for kind, rows in (("cold", cold), ("warm", warm)):
-                m = median_row(rows)
-                print(f"{short:<22} {kind:<6} {m['first_wall']:>10.3f}s {m['first_cpu']:>10.3f}s "
+                for name in (list(checkouts) if r % 2 == 0 else list(checkouts)[::-1]):
+                    runs[name].append(timed([sys.executable, *code], envs[name])[1:])
+            for name, values in runs.items():
+                print(f"{label:<32} {name:<9} {statistics.median(v[0] for v in values):>8.3f} "
+                      f"{statistics.median(v[1] for v in values):>8.3f}", flush=True)
+        print(f"\nlabels-only run, 640x480, 1 keypoint: 1st kp = process start -> first keypoint handed to the "
+              "writer; whole = the process; cold = empty cache folder (mesh cache, input hashes)")
+        print(f"{'scene':<10} {'cache':<6} {'checkout':<9} {'1st kp wall':>11} {'1st kp cpu':>11} {'whole wall':>11} "
+              f"{'whole cpu':>10}")
+        for short in args.scenes:
+            config, _ = bl.write_configs(SCENE_NAMES[short], "640x480", 1, work / "configs")
+            out, stamp = work / "out", work / "stamp"
+            rows: dict[tuple[str, str], list[dict[str, float]]] = {}
+            for kind in ("cold", "warm"):
+                for r in range(args.rounds):
+                    for name in (list(checkouts) if r % 2 == 0 else list(checkouts)[::-1]):
+                        if kind == "cold":
+                            shutil.rmtree(work / name / "cache", ignore_errors=True)
+                        rows.setdefault((kind, name), []).append(first_keypoint(config, out, envs[name], stamp))
+            for (kind, name), values in rows.items():
+                m = median_row(values)
+                print(f"{short:<10} {kind:<6} {name:<9} {m['first_wall']:>10.3f}s {m['first_cpu']:>10.3f}s "
                       f"{m['wall']:>10.3f}s {m['cpu']:>9.3f}s", flush=True)
             command = ["-m", "hybridgen", "run", "-q", str(config), str(out)]
-            if args.profile:
-                shutil.rmtree(out, ignore_errors=True)
-                print(f"\ncProfile of one warm run ({short}):")
-                profile(command, env, args.limit)
-            if args.importtime:
-                shutil.rmtree(out, ignore_errors=True)
-                importtime(command, env, args.limit)
+            for name in checkouts:
+                if args.profile:
+                    shutil.rmtree(out, ignore_errors=True)
+                    print(f"\ncProfile of one warm run ({short}, {name}):")
+                    profile(command, envs[name], args.limit)
+                if args.importtime:
+                    shutil.rmtree(out, ignore_errors=True)
+                    print(f"\n{name}: ", end="")
+                    importtime(command, envs[name], args.limit)
         print(f"\nload average at the end: {os.getloadavg()[0]:.1f}")
 
 

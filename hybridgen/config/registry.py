@@ -7,7 +7,6 @@ ever names a registered module: nothing in a config is imported as Python.
 from __future__ import annotations
 
 import importlib
-from importlib import metadata
 from typing import TYPE_CHECKING, Callable, TypeVar
 
 from ..errors import ConfigError, closest
@@ -130,6 +129,8 @@ def _load_all() -> None:
     _loaded = True
     for package in _BUILTIN_PACKAGES:
         importlib.import_module(package)
+    from importlib import metadata  # here: a run that names its modules never scans the installed packages
+
     for entry in metadata.entry_points(group=ENTRY_POINT_GROUP):
         if entry.name not in MODULES:
             cls = entry.load()

@@ -7,11 +7,6 @@ hybridgen checks them against the installed distributions and never installs any
 from __future__ import annotations
 
 from dataclasses import dataclass
-from importlib import metadata
-
-from packaging.requirements import InvalidRequirement, Requirement
-from packaging.utils import canonicalize_name
-from packaging.version import InvalidVersion, Version
 
 MET = "met"
 MISSING = "missing"
@@ -39,6 +34,12 @@ class RequirementCheck:
 
 def check_requirement(spec: str) -> RequirementCheck:
     """Check one specifier. A requirement whose environment marker is false here counts as met."""
+    from importlib import metadata  # here: only configs with setup.pip pay for packaging (~10 ms)
+
+    from packaging.requirements import InvalidRequirement, Requirement
+    from packaging.utils import canonicalize_name
+    from packaging.version import InvalidVersion, Version
+
     text = spec.strip()
     try:
         requirement = Requirement(text)
