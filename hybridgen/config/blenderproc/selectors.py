@@ -7,13 +7,22 @@ from ...errors import ConfigError
 from .common import Note, as_number
 
 
+_SELECTOR_KEYS = ("provider", "conditions", "random_samples", "index", "check_empty")
+
+
 def selector(value: Any, note: Note, key: str = "selector") -> Any:
     """A BlenderProc ``getter.Entity`` selector in hybridgen's terms: ``type: MESH`` always holds."""
     if isinstance(value, dict):
         out = dict(value)
-        if not any(k in out for k in ("provider", "conditions", "random_samples", "index", "check_empty")):
+        if not any(k in out for k in _SELECTOR_KEYS):
             out = {"conditions": out}
         out.setdefault("check_empty", False)  # BlenderProc: an empty selection does nothing
+        for extra in [k for k in out if k not in _SELECTOR_KEYS]:
+            # BlenderProc's getter reads its own keys and skips others (the random_room_constructor example
+            # puts SurfaceLighting's emission_strength into the selector: BlenderProc uses the default)
+            out.pop(extra)
+            note("ignored: BlenderProc's getter.Entity does not read this key (a module key inside the selector "
+                 "has no effect there)", f"{key}.{extra}")
         if "conditions" in out:
             out["conditions"] = _conditions(out["conditions"], note, f"{key}.conditions")
         provider = out.get("provider")
