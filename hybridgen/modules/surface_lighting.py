@@ -17,7 +17,12 @@ def _color(value: list) -> str | None:
 
 @register_module("lighting.SurfaceLighting")
 class SurfaceLighting(SelectingModule):
-    """Selected objects emit ``emission_color`` x ``emission_strength`` (radiance, both sides)."""
+    """Selected objects emit ``emission_color`` x ``emission_strength`` (radiance, both sides).
+
+    As BlenderProc's ``make_emissive`` (a mix on Light Path 'Is Camera Ray'), the emission lights the scene
+    but the camera sees the surface's own material (``Material.emission_hidden_from_camera``);
+    ``visible_to_camera: true`` (hybridgen only) shows the camera the glow as well.
+    """
 
     role = Role.MANIPULATOR
 
@@ -28,6 +33,8 @@ class SurfaceLighting(SelectingModule):
         Param("emission_color", "list|null", None, doc="linear RGB; null: the object's base color",
               sampleable=True, check=lambda v: None if v is None else _color(v)),
         Param("keep_using_base_color", "bool", False, doc="when emission_color is null, emit the base color"),
+        Param("visible_to_camera", "bool", False,
+              doc="hybridgen only: the camera sees the emission too (BlenderProc: it sees the surface's material)"),
     )
 
     def run(self, context: RunContext) -> None:
@@ -36,4 +43,5 @@ class SurfaceLighting(SelectingModule):
             if color is None:
                 color = obj.material.base_color[:3] if self.config["keep_using_base_color"] else (1.0, 1.0, 1.0)
             obj.material = dataclasses.replace(obj.material, emission=tuple(float(c) for c in color[:3]),
-                                               emission_strength=float(self.value(context, "emission_strength")))
+                                               emission_strength=float(self.value(context, "emission_strength")),
+                                               emission_hidden_from_camera=not self.config["visible_to_camera"])

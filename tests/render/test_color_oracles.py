@@ -74,7 +74,8 @@ modules:
   - name: loader.PrimitiveLoader
     config: {shape: plane, size: 20, name: panel, category_id: 1, color: [0.3, 0.6, 0.9]}
   - name: lighting.SurfaceLighting
-    config: {selector: {conditions: {name: panel}}, emission_color: %s, emission_strength: %s}
+    config: {selector: {conditions: {name: panel}}, emission_color: %s, emission_strength: %s,
+             visible_to_camera: true}
   - name: camera.CameraLoader
     config:
       intrinsics: {resolution_x: 8, resolution_y: 6, fov: 0.5}
@@ -127,6 +128,18 @@ def test_emitter_seen_directly_is_emission_times_strength_in_every_output(emitte
         values = np.array(bitmap, copy=False).astype(np.float64)
         rgb = np.stack([values[..., names.index(c)] for c in "RGB"], axis=-1)
         np.testing.assert_allclose(rgb, np.broadcast_to(DECODED, rgb.shape), rtol=1e-3)
+
+
+def test_surface_lighting_hides_its_glow_from_the_camera_by_default(tmp_path, gl_context):
+    """BlenderProc's make_emissive mixes on 'Is Camera Ray': without ``visible_to_camera`` the camera sees the
+    panel's own (unlit, 0 bounces) material, black, where the same run with it sees the emission."""
+    config = tmp_path / "config.yaml"
+    config.write_text(EMITTER_CONFIG.replace(",\n             visible_to_camera: true}", "}"))
+    assert "visible_to_camera" not in config.read_text()
+    hg.run_config(config, [str(tmp_path / "out")])
+    with h5py.File(tmp_path / "out/data.hdf5") as f:
+        hdr = f["colors_hdr"][()]
+    assert hdr.shape == (2, 6, 8, 3) and float(np.abs(hdr).max()) == 0.0
 
 
 def test_emitter_radiance_is_exact_on_both_sides_with_a_non_grey_color(variant):
