@@ -106,7 +106,8 @@ def example_configs(path: Path, tag: str | None, into: Path) -> list[Path]:
     if tag is None:
         raise SystemExit(f"{path} has no examples/ folder; for a bare git mirror give --tag (e.g. v1.12.0)")
     names = subprocess.run(["git", "-C", str(path), "ls-tree", "-r", "--name-only", tag, "examples",
-                            "resources/id_mappings"],  # label mappings dataset loaders read by default
+                            "resources/id_mappings",  # label mappings dataset loaders read by default
+                            "resources/front_3D", "resources/replica", "resources/replica-dataset"],
                            check=True, capture_output=True, text=True).stdout.split()
     configs = []
     for name in names:  # every example file the mirror holds (inputs a config names by path, too)
@@ -285,6 +286,68 @@ def dataset_standins(text: str, work: Path) -> dict[int, str]:
             Image.new("RGB", (8, 8), (120, 100, 80)).save(textures / folder / f"{folder}_0.jpg")
         out.update({i: str(room) for i in _args_of(text, "file_path")})
         out.update({i: str(textures) for i in _args_of(text, "texture_folder")})
+    out.update(room_dataset_standins(text, work))
+    return out
+
+
+def room_dataset_standins(text: str, work: Path) -> dict[int, str]:
+    """Stand-ins for the indoor dataset loaders and their room camera samplers: a 3D-FRONT house (house.json,
+    3D-FUTURE-model/<jid>/raw_model.obj, 3D-FRONT-texture/) of one 6 x 5 x 2.8 m room with three pieces of
+    furniture on its floor, and a Replica scene (<data_path>/<data_set_name>/mesh.ply: a 7 x 6 x 2.8 m room,
+    one mesh, its floor at the scene's first height of the checkout's height list). Returns {argument index: path}."""
+    import json
+
+    import numpy as np
+    import trimesh
+
+    out: dict[int, str] = {}
+    if "loader.Front3DLoader" in text:
+        root = work / "front3d"
+        (root / "3D-FRONT-texture").mkdir(parents=True, exist_ok=True)
+        # world axes (z up), faces wound to face into the room; 3D-FRONT files are y up: y and z exchanged
+        quads = {"Floor": [[(0, 0, 0), (6, 0, 0), (6, 5, 0), (0, 5, 0)]],
+                 "Ceiling": [[(0, 0, 2.8), (0, 5, 2.8), (6, 5, 2.8), (6, 0, 2.8)]],
+                 "WallInner": [[(x0, y0, 0), (x0, y0, 2.8), (x1, y1, 2.8), (x1, y1, 0)]
+                               for (x0, y0), (x1, y1) in (((0, 0), (6, 0)), ((6, 0), (6, 5)), ((6, 5), (0, 5)),
+                                                          ((0, 5), (0, 0)))]}
+        meshes = []
+        for kind, faces in quads.items():
+            corners = np.array([c for quad in faces for c in quad], dtype=float)
+            normals = np.repeat([np.cross(q[1] - q[0], q[2] - q[0]) / np.linalg.norm(np.cross(q[1] - q[0], q[2] - q[0]))
+                                 for q in corners.reshape(-1, 4, 3)], 4, axis=0)
+            meshes.append({"uid": kind, "type": kind, "material": "m", "xyz": corners[:, [0, 2, 1]].ravel().tolist(),
+                           "normal": normals[:, [0, 2, 1]].ravel().tolist(),
+                           "uv": [0, 0, 1, 0, 1, 1, 0, 1] * len(faces),
+                           "faces": [i + 4 * q for q in range(len(faces)) for i in (0, 1, 2, 0, 2, 3)]})
+        furniture = [("bed", "Bed", (2.0, 0.6, 1.6), (1.5, 1.5)), ("sofa", "sofa", (1.8, 0.8, 0.8), (4.5, 4.2)),
+                     ("armchair", "armchair", (0.8, 0.9, 0.8), (4.8, 1.0))]
+        for jid, _, size, _ in furniture:
+            _box_obj(root / "3D-FUTURE-model" / jid / "raw_model.obj", size)
+        house = {"uid": "standin", "material": [{"uid": "m", "texture": "", "normaltexture": "",
+                                                "color": [200, 190, 180, 255]}], "mesh": meshes,
+                 "furniture": [{"uid": jid, "jid": jid, "category": category} for jid, category, _, _ in furniture],
+                 "scene": {"room": [{"instanceid": "LivingRoom-1", "children": [
+                     {"ref": jid, "instanceid": f"furniture/{i}", "pos": [x, 0, y], "rot": [0, 0, 0, 1],
+                      "scale": [1, 1, 1]} for i, (jid, _, _, (x, y)) in enumerate(furniture)]}]}}
+        (root / "house.json").write_text(json.dumps(house))
+        for key, path in (("json_path", root / "house.json"), ("3D_future_model_path", root / "3D-FUTURE-model"),
+                          ("3D_front_texture_path", root / "3D-FRONT-texture")):
+            out.update({i: str(path) for i in _args_of(text, key)})
+    if "loader.ReplicaLoader" in text or "is_replica_object" in text:
+        name = (re.findall(r'"data_set_name"\s*:\s*"(\w+)"', text) or ["office_1"])[0]
+        levels = [Path(f"resources/{folder}/height_levels/{name}/height_list_values.txt")
+                  for folder in ("replica", "replica-dataset")]
+        floor = next((float(json.loads(p.read_text())[0]) for p in levels if p.is_file()), 0.0)
+        room = trimesh.creation.box(extents=[7, 6, 2.8])
+        room.apply_translation([3.5, 3.0, floor + 1.4])
+        room.invert()  # faces into the room
+        table = trimesh.creation.box(extents=[1.2, 0.8, 0.75])
+        table.apply_translation([2.0, 2.0, floor + 0.375])
+        scene_mesh = trimesh.util.concatenate([room, table])
+        scene_mesh.visual.vertex_colors = np.tile([180, 170, 160, 255], (len(scene_mesh.vertices), 1))
+        (work / "replica" / name).mkdir(parents=True, exist_ok=True)
+        scene_mesh.export(work / "replica" / name / "mesh.ply")
+        out.update({i: str(work / "replica") for i in _args_of(text, "data_path")})
     return out
 
 

@@ -72,6 +72,8 @@ class ReplicaCameraSampler(CameraSampler):
         Param("data_set_name", "str|null", None, doc="the Replica scene (e.g. office_1), for is_replica_object"),
         Param("mesh_name", "str", "mesh", doc="the scene mesh's object (loader.ReplicaLoader names it mesh)"),
         Param("floor_name", "str", "floor", doc="the floor object (object.FloorExtractor's name_for_split_obj)"),
+        Param("height_levels", "path", REPLICA_HEIGHT_LEVELS, doc="folder of <data_set_name>/height_list_values.txt "
+              "for is_replica_object (BlenderProc 1.0: resources/replica-dataset/height_levels)"),
     )
 
     def _height_list(self) -> Path:
@@ -84,7 +86,7 @@ class ReplicaCameraSampler(CameraSampler):
         if not cfg["data_set_name"]:
             raise ConfigError("is_replica_object needs the Replica scene's name (e.g. office_1)",
                               key="data_set_name")
-        relative = f"{REPLICA_HEIGHT_LEVELS}/{cfg['data_set_name']}/height_list_values.txt"
+        relative = f"{cfg['height_levels']}/{cfg['data_set_name']}/height_list_values.txt"
         return Path(resolve_input(relative, "data_set_name", noun="Replica height list (from a BlenderProc "
                                                                   "checkout's resources/)"))
 

@@ -156,3 +156,112 @@ def test_front3d_room_threshold_counts_objects_on_each_floor(tmp_path, house):
     with pytest.raises(ConfigError) as info:
         _front_run(tmp_path, house, amount_of_objects_needed_per_room=-1)
     assert info.value.key == "amount_of_objects_needed_per_room" and "\n" not in str(info.value)
+
+
+# ---------------------------------------------------------------------------------------------- Replica
+@pytest.fixture
+def replica(tmp_path: Path) -> Path:
+    """<tmp>/replica/office_1/mesh.ply: one mesh, a 6 x 5 x 2.8 m room (floor at z = 0) with a table, in Replica's
+    layout; BlenderProc's height list at resources/replica/height_levels/office_1 lists the floor (0.0) and a
+    level 5 m up that this scene has no floor at."""
+    room = trimesh.creation.box(extents=[6, 5, 2.8])
+    room.apply_translation([3.0, 2.5, 1.4])
+    room.invert()
+    table = trimesh.creation.box(extents=[1.2, 0.8, 0.75])
+    table.apply_translation([2.0, 2.0, 0.375])
+    mesh = trimesh.util.concatenate([room, table])
+    mesh.visual.vertex_colors = np.tile([180, 170, 160, 255], (len(mesh.vertices), 1))
+    (tmp_path / "replica" / "office_1").mkdir(parents=True)
+    mesh.export(tmp_path / "replica" / "office_1" / "mesh.ply")
+    levels = tmp_path / "resources" / "replica" / "height_levels" / "office_1"
+    levels.mkdir(parents=True)
+    (levels / "height_list_values.txt").write_text("[0.0, 5.0]")
+    return tmp_path / "replica"
+
+
+def _replica_config(tmp_path: Path, replica: Path, seed: int = 2, **sampler) -> str:
+    return json.dumps({"version": 3, "setup": {"blender_install_path": "/opt/blender/"}, "modules": [
+        {"module": "main.Initializer", "config": {"global": {
+            "output_dir": str(tmp_path / "out"), "data_set_name": "office_1", "data_path": str(replica)}, "seed": seed}},
+        {"module": "loader.ReplicaLoader", "config": {"use_smooth_shading": True}},
+        {"module": "object.FloorExtractor", "config": {"selector": {"provider": "getter.Entity",
+                                                                     "conditions": {"name": "mesh"}},
+                                                        "compare_angle_degrees": 7.5, "compare_height": 0.15,
+                                                        "name_for_split_obj": "floor"}},
+        {"module": "camera.ReplicaCameraSampler", "config": {
+            "intrinsics": {"resolution_x": 64, "resolution_y": 48, "pixel_aspect_x": 1.333333333},
+            "cam_poses": [{"number_of_samples": 6, "clip_start": 0.01, "proximity_checks": {"min": 0.8},
+                           "location": [0, 0, 1.55],
+                           "rotation": {"value": {"provider": "sampler.Uniform3d", "min": [1.3734, 0, 0],
+                                                  "max": [1.3734, 0, 6.283185307]}}}], **sampler}}]})
+
+
+def test_replica_cameras_above_the_extracted_floor_at_a_listed_height(tmp_path, replica, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # BlenderProc runs from its checkout: resources/ is found from there
+    context = run_config_text(tmp_path, _replica_config(tmp_path, replica, is_replica_object=True))
+    scene = context.scene
+    floor = scene.by_name("floor")
+    poses = scene.camera.keypoints
+    assert len(poses) == 6
+    for pose in poses:
+        below, height = _first_hit_below(scene, pose[:3, 3])
+        assert below is floor and height == pytest.approx(0.0, abs=1e-9)
+        assert pose[2, 3] == pytest.approx(1.55)  # the 5 m level has no floor below it: never accepted
+        _check_distances(scene, pose, 0.8)
+    # pixel_aspect_x 4/3 as Blender: the fov spans the width, pixels 4/3 as wide as high
+    K = scene.camera.intrinsics.K
+    assert K[0, 0] == pytest.approx(64 / (2 * np.tan(0.691111 / 2))) and K[1, 1] == pytest.approx(K[0, 0] * 4 / 3)
+    again = run_config_text(tmp_path, _replica_config(tmp_path, replica, is_replica_object=True))
+    np.testing.assert_array_equal(np.array(again.scene.camera.keypoints), np.array(poses))
+    # the same with the file named directly
+    direct = run_config_text(tmp_path, _replica_config(
+        tmp_path, replica, height_list_path="resources/replica/height_levels/office_1/height_list_values.txt"))
+    np.testing.assert_array_equal(np.array(direct.scene.camera.keypoints), np.array(poses))
+
+
+def test_replica_errors_name_the_key(tmp_path, replica, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ConfigError) as info:
+        run_config_text(tmp_path, _replica_config(tmp_path, replica))
+    assert info.value.key == "height_list_path" and "\n" not in str(info.value)
+    (tmp_path / "bad.txt").write_text("floor at zero")
+    with pytest.raises(ConfigError, match="not a list of numbers") as info:
+        run_config_text(tmp_path, _replica_config(tmp_path, replica, height_list_path=str(tmp_path / "bad.txt")))
+    assert info.value.key == "height_list_path"
+    with pytest.raises(ConfigError, match="no object named 'ground'") as info:
+        run_config_text(tmp_path, _replica_config(tmp_path, replica, is_replica_object=True, floor_name="ground"))
+    assert info.value.key == "floor_name" and "module 'camera.ReplicaCameraSampler'" in str(info.value)
+
+
+def test_replica_v1_config_form(tmp_path, replica, monkeypatch):
+    """BlenderProc 1.0's replica-dataset keys: PlyLoader with is_replica_object, FloorExtractor obj_name, the
+    sampler's sample_amount, degrees and its height list folder (resources/replica-dataset)."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "resources" / "replica").rename(tmp_path / "resources" / "replica-dataset")
+    config = {"setup": {"blender_install_path": "/opt/blender/", "pip": ["h5py"]},
+              "global": {"all": {"output_dir": str(tmp_path / "out"), "data_set_name": "office_1",
+                                 "data_path": str(replica)}},
+              "modules": [{"name": "main.Initializer", "config": {"seed": 5}},
+                          {"name": "loader.PlyLoader", "config": {"is_replica_object": "True",
+                                                                  "use_smooth_shading": "True",
+                                                                  "use_ambient_occlusion": "True"}},
+                          {"name": "manipulators.FloorExtractor", "config": {
+                              "is_replica_object": "True", "obj_name": "mesh", "compare_angle_degrees": 7.5,
+                              "compare_height": 0.15}},
+                          {"name": "camera.ReplicaCameraSampler", "config": {
+                              "is_replica_object": "True", "sqrt_number_of_rays": 10, "near_clipping": 0.01,
+                              "sample_amount": 4, "resolution_x": 64, "resolution_y": 48,
+                              "rotation_range_z": [0, 90], "proximity_checks": {"min": 0.8}}}]}
+    context = run_config_text(tmp_path, json.dumps(config))
+    scene = context.scene
+    poses = scene.camera.keypoints
+    assert len(poses) == 4 and scene.camera.intrinsics.width == 64
+    for pose in poses:
+        assert _first_hit_below(scene, pose[:3, 3])[0] is scene.by_name("floor")
+        assert pose[2, 3] == pytest.approx(1.55)
+        # Blender Euler XYZ (78.6901 deg, 0, z in 0..90 deg): the camera's -Z (its view) 11.31 deg below the
+        # horizon, heading +Y turned about +Z by z: (-sin z, cos z)
+        forward = pose[:3, 2]
+        assert forward[2] == pytest.approx(-np.cos(np.radians(78.6901)), abs=1e-9)
+        heading = np.degrees(np.arctan2(-forward[0], forward[1]))
+        assert 0 <= heading <= 90

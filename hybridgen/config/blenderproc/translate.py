@@ -14,6 +14,7 @@ from .names import ALIASES
 from .objects import (bop_loader, camera_loader, camera_sampler, loader, mesh_initializer, passthrough, physics,
                       pose_sampler, replacer)
 from .renderers import rgb, segmap, single_pass
+from .room_cameras import floor_extractor, ply_loader, room_sampler
 from .room import random_room
 from .selectors import samplers_as_blenderproc
 from .writers import writer
@@ -22,7 +23,7 @@ from .writers import writer
 TRANSLATORS: dict[str, Callable[..., list[tuple[str, dict[str, Any]]]]] = {
     "loader.ObjectLoader": lambda c, n: loader("loader.ObjectLoader", c, n),
     "loader.ObjLoader": lambda c, n: loader("loader.ObjLoader", c, n),
-    "loader.PlyLoader": lambda c, n: loader("loader.PlyLoader", c, n),
+    "loader.PlyLoader": ply_loader,  # v1.0: is_replica_object loads a Replica scene
     "renderer.RgbRenderer": rgb,
     "renderer.SegMapRenderer": segmap,
     "renderer.NormalRenderer": single_pass("render_normals"),
@@ -44,7 +45,9 @@ TRANSLATORS: dict[str, Callable[..., list[tuple[str, dict[str, Any]]]]] = {
     "object.ObjectReplacer": replacer,
     "object.FloorExtractor": passthrough("object.FloorExtractor", "selector"),
     "object.Hide": passthrough("object.Hide", "selector"),
-    "manipulators.FloorExtractor": passthrough("object.FloorExtractor", "selector"),
+    "manipulators.FloorExtractor": floor_extractor,  # v1.0: obj_name
+    "camera.Front3DCameraSampler": room_sampler("camera.Front3DCameraSampler"),
+    "camera.ReplicaCameraSampler": room_sampler("camera.ReplicaCameraSampler"),
 }
 KEYS_ONLY_BLENDERPROC = ("constructor.BasicMeshInitializer", "object.ObjectReplacer", "renderer.NormalRenderer",
                          "renderer.DepthRenderer", "renderer.DistanceRenderer", "renderer.FlowRenderer",
