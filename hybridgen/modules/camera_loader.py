@@ -18,7 +18,8 @@ class CameraLoader(Module):
 
     params = (
         Param("intrinsics", "dict", {}, doc="resolution_x/y [px], cam_K (9 numbers) or fov [rad] + fov_axis, "
-              "clip_start/clip_end [m]; defaults 512x512, fov 0.691111, clip 0.1..1000"),
+              "clip_start/clip_end [m]; defaults 512x512, fov 0.691111, clip 0.1..1000; depth_of_field: {fstop "
+              "(2.4), focal_object (a selector of one object or empty) | depth_of_field_dist [m]} (color only)"),
         Param("cam_poses", "list", [], sampleable=True,
               doc="pose entries: {location [m], rotation: {format: euler|look_at|forward_vec, value, inplane_rot "
                   "[rad]}} or {cam2world_matrix, source_frame}"),
