@@ -1,7 +1,7 @@
 """Validate (and run) every example config of a BlenderProc checkout with hybridgen, unchanged.
 
     .venv/bin/python tools/check_blenderproc_configs.py PATH [--tag v1.12.0] [--run] [--only SUBSTRING]
-        [--example-inputs]
+        [--example-inputs] [--notices] [--max-samples N]
 
 PATH is a BlenderProc working tree (its ``examples/`` is read) or a bare git mirror, read at ``--tag``
 (``git ls-tree`` + ``git show`` into a temporary folder; nothing of BlenderProc is stored in this
@@ -13,7 +13,8 @@ large blobs), the stand-in OBJ or a box PLY at that path; then
 
 - validates: hybridgen reads the config and every module's keys (``load_config`` + ``build_modules``);
 - with ``--run``, runs the valid ones end to end on the stand-ins, each in its own process stopped after
-  ``--timeout`` seconds.
+  ``--timeout`` seconds (``--max-samples N``: renderers' ``samples`` above N lowered to N, on a hidden copy of
+  the config next to it).
 
 With ``--example-inputs`` an argument the example's README passes (``python run.py <config> <args>``) is that
 file of the checkout where the checkout has it (its scene.obj, camera_positions ...): the run then builds the
@@ -443,7 +444,9 @@ def check(config: Path, root: Path, run: bool, work: Path, output: Path, use_exa
             return Outcome(name, "valid", "", len(lines), tuple(lines))
         start = time.perf_counter()
         try:
-            summary = run_config(config, args)
+            summary = run_config(config, args) if MAX_SAMPLES is None else run_capped(config, args, MAX_SAMPLES)
+            capped = f"/.{config.stem}.capped{config.suffix}"  # the capped copy's notices are the config's
+            lines[:] = list(dict.fromkeys(line.replace(capped, f"/{config.name}") for line in lines))
         except HybridgenError as exc:
             return Outcome(name, "failed", str(exc).replace(str(root) + "/", ""), len(lines), tuple(lines))
         except Exception as exc:  # a bug, not a config problem: one line naming it and where it was raised
@@ -454,6 +457,25 @@ def check(config: Path, root: Path, run: bool, work: Path, output: Path, use_exa
                        tuple(lines))
     finally:
         set_sink(None)
+
+
+MAX_SAMPLES: int | None = None
+"""``--max-samples``: renderers' ``samples`` above it are lowered to it for the run (None: as the config says)."""
+
+
+def run_capped(config: Path, args: list[str], max_samples: int) -> object:
+    """Run a copy of ``config`` (a hidden sibling, so relative paths resolve alike, removed afterwards) whose
+    ``samples`` values above ``max_samples`` are ``max_samples``."""
+    from hybridgen.run.pipeline import run_config
+
+    text = re.sub(r'("samples"\s*:\s*)(\d+)', lambda m: m.group(1) + str(min(int(m.group(2)), max_samples)),
+                  config.read_text())
+    capped = config.with_name(f".{config.stem}.capped{config.suffix}")
+    capped.write_text(text)
+    try:
+        return run_config(capped, args)
+    finally:
+        capped.unlink(missing_ok=True)
 
 
 def check_in_process(config: Path, root: Path, run: bool, work: Path, output: Path, timeout: float,
@@ -484,10 +506,15 @@ def main() -> None:
     parser.add_argument("--timeout", type=float, default=900.0,
                         help="with --run: seconds one config may run before it counts as 'timeout' (default 900)")
     parser.add_argument("--notices", action="store_true", help="print every config's notice lines under it")
+    parser.add_argument("--max-samples", type=int, default=None,
+                        help="with --run: lower renderers' samples above this to it (path tracing time on a slow "
+                        "machine; the configs' other keys unchanged)")
     parser.add_argument("--example-inputs", action="store_true",
                         help="use the input files the example's README names where the checkout has them "
                         "(stand-ins for the rest)")
     ns = parser.parse_args()
+    global MAX_SAMPLES
+    MAX_SAMPLES = ns.max_samples
     with tempfile.TemporaryDirectory(prefix="bp-configs-") as tmp:
         root = Path(tmp) / "checkout"
         configs = example_configs(ns.path, ns.tag, root)
