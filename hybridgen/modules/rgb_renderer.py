@@ -48,6 +48,9 @@ class RgbRenderer(Module):
         Param("clamp_indirect", "float", 10.0, doc="firefly control, Cycles' sample_clamp_indirect: indirect "
               "light of one sample is scaled down to at most this linear radiance (direct light never); 0: off",
               check=_non_negative),
+        Param("filter_glossy", "float", 1.0, doc="firefly control, Cycles' blur_glossy (1.0, Cycles' default): "
+              "glossy lobes are roughened after rough bounces (a highlight seen via a diffuse bounce is blurred); "
+              "0: off. JIT variants", check=_non_negative),
         Param("filter_width", "float", 1.5, "px", "pixel filter, Cycles' Blackman-Harris filter_width (1.5, Cycles' "
               "default): samples are spread over +-filter_width px around the pixel centre (importance-sampled); "
               "0: one-pixel box. JIT variants (scalar_rgb: box)", check=_non_negative),
@@ -95,7 +98,7 @@ class RgbRenderer(Module):
                                      noise_threshold=threshold, min_samples=cfg["min_samples"],
                                      clamp_indirect=cfg["clamp_indirect"], diffuse_bounces=cfg["diffuse_bounces"],
                                      transmission_bounces=cfg["transmission_bounces"],
-                                     filter_width=cfg["filter_width"])
+                                     filter_width=cfg["filter_width"], filter_glossy=cfg["filter_glossy"])
         plan = settings.plan()
         variant = choose_variant(cfg["variant"])
         sampling = (f"adaptive {plan.min_samples}..{plan.max_samples} spp (noise threshold {plan.noise_threshold})"

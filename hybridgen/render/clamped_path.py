@@ -11,6 +11,10 @@ Clamping removes the rare, very bright samples (fireflies: caustics of glossy ob
 surface) at the price of a small downward bias of bright indirect light; ``tools/bench_color.py`` measures
 it against an unclamped reference.
 
+``filter_glossy`` (Cycles' ``blur_glossy``; 0 = off): glossy lobes roughened after rough bounces, see
+:mod:`hybridgen.render.glossy_filter` (the integrator tracks the path's smallest BSDF-sampling pdf and hands
+each vertex its roughness floor).
+
 Per-lobe bounce limits as Cycles' ``diffuse_bounces`` / ``glossy_bounces`` / ``transmission_bounces``
 (``max_diffuse`` / ``max_glossy`` / ``max_transmission``; -1 = only ``max_depth`` limits): a path that
 exceeds one still collects the emission its last BSDF sample finds (so MIS with next-event estimation
@@ -27,7 +31,7 @@ from __future__ import annotations
 from functools import lru_cache
 from typing import Any
 
-from . import transparent_shadows
+from . import glossy_filter, transparent_shadows
 
 PLUGIN_NAME = "hybridgen_clamped_path"
 
@@ -47,6 +51,7 @@ def register(variant: str) -> None:
             self.limits = tuple(int(props.get(k, -1)) for k in ("max_diffuse", "max_glossy", "max_transmission"))
             # hybridgen/render/transparent_shadows.py: shadow rays through masks, null passes cost no bounce
             self.transparent_shadows = bool(props.get("transparent_shadows", False))
+            self.filter_glossy = float(props.get("filter_glossy", 0.0))  # Cycles' blur_glossy (render/glossy_filter.py)
             # hybridgen/render/camera_hidden_emission.py: emitters the camera sees as their BSDF (set after load)
             self.hidden_shapes: list[Any] = []
 
@@ -96,9 +101,13 @@ def register(variant: str) -> None:
             max_diffuse, max_glossy, max_transmission = (mi.UInt32(big if v < 0 else v) for v in self.limits)
             n_diffuse, n_glossy, n_transmission = mi.UInt32(0), mi.UInt32(0), mi.UInt32(0)
             last_segment = mi.Bool(False)  # a lobe limit was exceeded: collect emission, then stop
+            filter_glossy = self.filter_glossy
+            min_ray_pdf = mi.Float(dr.inf)  # smallest BSDF-sampling pdf of the path so far (filter glossy)
 
             while dr.hint(active, max_iterations=-1, label="hybridgen clamped path"):
                 si = scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=depth == 0, active=active)
+                if filter_glossy > 0:  # roughness floor for the wrapped principled roughness (glossy_filter.py)
+                    si.time = glossy_filter.roughness_floor(filter_glossy, min_ray_pdf)
                 bsdf = si.bsdf(ray)
 
                 # Emission found by the previous BSDF sample (or seen directly), MIS-weighted against NEE.
@@ -153,6 +162,9 @@ def register(variant: str) -> None:
                 bsdf_delta_prev = dr.select(null_pass, bsdf_delta_prev,
                                             mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta))
                 depth[si.is_valid() & ~null_pass] += 1
+                if filter_glossy > 0:
+                    rough = active_next & ~null_pass & ~mi.has_flag(sampled, mi.BSDFFlags.Delta)
+                    min_ray_pdf = dr.select(rough, dr.minimum(min_ray_pdf, bsdf_sample.pdf), min_ray_pdf)
 
                 # Russian roulette from rr_depth on (survivors are reweighted: unbiased).
                 throughput_max = dr.max(mi.unpolarized_spectrum(throughput))

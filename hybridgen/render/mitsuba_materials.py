@@ -34,6 +34,7 @@ from ..input_paths import not_found
 from ..errors import InputError
 from ..io.image_check import check_image_file
 from ..scene.material import ALPHA_MODES, Material
+from .glossy_filter import filtered_roughness
 from .lobe_sampling import principled_sampling_rates
 from .material_textures import data_image
 
@@ -146,7 +147,8 @@ def _specular_bsdf(material: Material, owner: str, base: dict[str, Any],
                    levels: list[float], weights: list[np.ndarray]) -> dict[str, Any]:
     """The principled BSDF of ``material``: a chain of blends over ``levels`` (:func:`specular_levels`);
     the levels' BSDFs share one loaded copy of each texture."""
-    inputs: dict[str, Any] = {"base_color": base, "roughness": _scalar_or_map(material, "roughness", owner),
+    inputs: dict[str, Any] = {"base_color": base,
+                              "roughness": filtered_roughness(_scalar_or_map(material, "roughness", owner)),
                               "metallic": _scalar_or_map(material, "metallic", owner)}
     if material.transmission > 0:  # defined by its IOR; specular does not apply (Blender likewise)
         levels, weights = levels[:1], []

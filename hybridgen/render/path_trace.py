@@ -18,7 +18,8 @@ from ..errors import InputError
 from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
 from ..scene.depth_of_field import DepthOfField
-from . import camera_hidden_emission, clamped_path, pinhole_sensor, pixel_filter, thin_lens_sensor, transparent_shadows
+from . import (camera_hidden_emission, clamped_path, glossy_filter, pinhole_sensor, pixel_filter, thin_lens_sensor,
+               transparent_shadows)
 from .adaptive_sampling import PixelTracer, SamplingPlan, render_adaptive
 from .mitsuba_scene import scene_dict
 from .mitsuba_variant import activate, choose_variant, is_jit
@@ -69,6 +70,9 @@ class PathTraceSettings:
     ``filter_width`` (px): the pixel filter, Cycles' Blackman-Harris of that ``filter_width`` (default 1.5,
     Cycles'), importance-sampled (:mod:`hybridgen.render.pixel_filter`); 0 is the one-pixel box. JIT variants
     only; ``scalar_rgb`` renders through Mitsuba's film with the box filter.
+
+    ``filter_glossy``: Cycles' ``blur_glossy`` (default 1.0, Cycles' and BlenderProc's; 0 = off), glossy lobes
+    roughened after rough bounces (:mod:`hybridgen.render.glossy_filter`); JIT variants only.
     """
 
     samples: int | None = None
@@ -81,6 +85,7 @@ class PathTraceSettings:
     diffuse_bounces: int | None = None
     transmission_bounces: int | None = None
     filter_width: float = pixel_filter.DEFAULT_WIDTH
+    filter_glossy: float = glossy_filter.DEFAULT_FILTER_GLOSSY
 
     def __post_init__(self) -> None:
         if self.samples is not None and self.samples < 1:
@@ -92,6 +97,8 @@ class PathTraceSettings:
                 raise InputError(f"{name} must be >= 0, got {value}")
         if not (math.isfinite(self.clamp_indirect) and self.clamp_indirect >= 0):
             raise InputError(f"clamp_indirect must be >= 0 (0 = off), got {self.clamp_indirect}")
+        if not (math.isfinite(self.filter_glossy) and self.filter_glossy >= 0):
+            raise InputError(f"filter_glossy must be >= 0 (0 = off), got {self.filter_glossy}")
         if not (math.isfinite(self.filter_width) and 0 <= self.filter_width <= 10):
             raise InputError(f"filter_width must be in 0..10 px (0 = one-pixel box), got {self.filter_width}")
         self.plan()  # validates the sampling knobs
@@ -134,14 +141,16 @@ class PathTraceSettings:
                                  f"({self.max_bounces}) needs a JIT Mitsuba variant (llvm_ad_rgb or cuda_ad_rgb): "
                                  f"{variant}'s path tracer has one depth limit for every lobe")
             return {**self.integrator(), "type": "volpath"} if transparent_shadows else self.integrator()
-        if self.clamp_indirect <= 0 and not limits and not transparent_shadows and not hidden_emission:
+        if self.clamp_indirect <= 0 and self.filter_glossy <= 0 and not limits and not transparent_shadows \
+                and not hidden_emission:
             return self.integrator()
         clamped_path.register(variant)
         plain = self.integrator()
         keys = {"diffuse_bounces": "max_diffuse", "glossy_bounces": "max_glossy",
                 "transmission_bounces": "max_transmission"}
         return {"type": clamped_path.PLUGIN_NAME, "max_depth": plain["max_depth"], "rr_depth": plain["rr_depth"],
-                "clamp_indirect": float(self.clamp_indirect), **{keys[k]: v for k, v in limits.items()},
+                "clamp_indirect": float(self.clamp_indirect), "filter_glossy": float(self.filter_glossy),
+                **{keys[k]: v for k, v in limits.items()},
                 **({"transparent_shadows": True} if transparent_shadows else {})}
 
 
@@ -208,11 +217,12 @@ class PathTraceView:
             raise InputError(f"Mitsuba could not build the scene: {str(exc).splitlines()[-1]}") from None
         self.sensor = self.mi_scene.sensors()[0]
         self._sensor_params = None if is_jit(self.variant) else mi.traverse(self.sensor)
+        self.own_integrator = description["integrator"]["type"] == clamped_path.PLUGIN_NAME
+        self.clamped = self.own_integrator and self.settings.clamp_indirect > 0
         self._tracer: PixelTracer | FullFrameTracer = (
             PixelTracer(self.mi_scene, self.sensor, self.mi_scene.integrator(), self.settings.filter_width)
             if is_jit(self.variant) else FullFrameTracer(self))
-        self.clamped = description["integrator"]["type"] == clamped_path.PLUGIN_NAME
-        if hidden and self.clamped:
+        if hidden and self.own_integrator:
             self.mi_scene.integrator().hidden_shapes = camera_hidden_emission.hidden_shapes(description, hidden)
         elif hidden:
             from ..config.notices import notice

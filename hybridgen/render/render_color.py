@@ -58,6 +58,7 @@ class ColorProducer:
                 "min_samples": plan.min_samples if plan.adaptive else plan.max_samples,
                 "noise_threshold": plan.noise_threshold, "adaptive_sampling": plan.adaptive,
                 "clamp_indirect": s.clamp_indirect if self.view.clamped else 0.0,
+                "filter_glossy": s.filter_glossy if self.view.own_integrator else 0.0,
                 "pixel_filter": (f"Blackman-Harris, filter_width {self.view.filter_width} px" if self.view.filter_width
                                  else "box, 1 px"),
                 "min_bounces": s.min_bounces, "max_bounces": s.max_bounces, "mitsuba_max_depth": s.max_bounces + 2,
