@@ -126,7 +126,7 @@ def test_one_small_executor_interface():
     for implementation in (InProcessExecutor, PoolExecutor, RayExecutor):
         assert issubclass(implementation, Executor) and not implementation.__abstractmethods__
 
-    def task(unit: WorkUnit, progress=None, scenes=None) -> tuple[int, int]:
+    def task(unit: WorkUnit, progress=None, scenes=None, log=None) -> tuple[int, int]:
         if unit.scene == 1:
             raise ValueError("scene 1 fails")
         return unit.chunk, 7
