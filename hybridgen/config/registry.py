@@ -50,6 +50,7 @@ _BUILTIN_PACKAGES = (
     "hybridgen.modules.empty_initializer",
     "hybridgen.modules.calibration_board",
     "hybridgen.modules.texture_loader",
+    "hybridgen.modules.shading",
 )
 
 _BUILTIN_NAMES = {
@@ -96,6 +97,7 @@ _BUILTIN_NAMES = {
     "constructor.BasicEmptyInitializer": "hybridgen.modules.empty_initializer",
     "object.CalibrationboardSampler": "hybridgen.modules.calibration_board",
     "loader.TextureLoader": "hybridgen.modules.texture_loader",
+    "object.Shading": "hybridgen.modules.shading",
 }
 """Built-in module name -> the file registering it: :func:`get_module` imports that file alone (importing all
 of them costs ~0.2 s of every run's start); a name missing here, or a plugin's, loads every module first."""

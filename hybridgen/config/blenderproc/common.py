@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
+from ...errors import ConfigError
+
 Note = Callable[[str, str], None]
 """``note(message, key)``: report one difference (a notice line, or an error in strict mode)."""
 
@@ -40,10 +42,23 @@ def custom_properties(values: dict[str, Any], config: dict[str, Any]) -> None:
             config.setdefault("attributes", {})[name] = as_number(value)
 
 
-def pop_shading(cfg: dict[str, Any], note: Note) -> None:
-    pop_ignored(cfg, "cf_set_shading", note, "Blender's smooth/flat shading switch; hybridgen shades with the mesh's "
-         "own normals (vertex normals smooth, none flat)")
-    pop_ignored(cfg, "cf_shading_auto_smooth_angle_in_deg", note, "Blender's auto-smooth angle")
+def take_shading(cfg: dict[str, Any]) -> dict[str, Any] | None:
+    """``cf_set_shading`` (and its auto-smooth angle) taken out of ``cfg`` as object.Shading's keys, or None."""
+    if "cf_set_shading" not in cfg:
+        cfg.pop("cf_shading_auto_smooth_angle_in_deg", None)  # BlenderProc reads it only with a mode
+        return None
+    mode = cfg.pop("cf_set_shading")
+    if not isinstance(mode, str) or mode.upper() not in ("FLAT", "SMOOTH", "AUTO"):
+        raise ConfigError(f"must be FLAT, SMOOTH or AUTO, got {mode!r}", key="cf_set_shading")
+    return {"mode": mode.upper(), "auto_smooth_angle": cfg.pop("cf_shading_auto_smooth_angle_in_deg", 30.0)}
+
+
+def shaded(entries: list[tuple[str, dict[str, Any]]], shading: dict[str, Any] | None) -> \
+        list[tuple[str, dict[str, Any]]]:
+    """Loader entries wrapped in object.Shading when the BlenderProc loader set ``cf_set_shading``."""
+    if shading is None:
+        return entries
+    return [("object.Shading", {**shading, "loader": {"module": name, "config": cfg}}) for name, cfg in entries]
 
 
 def pop_mode(cfg: dict[str, Any], note: Note) -> None:

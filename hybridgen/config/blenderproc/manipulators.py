@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from ...errors import ConfigError
-from .common import Note, custom_properties, pop_ignored, pop_mode, pop_shading
+from .common import Note, custom_properties, pop_ignored, pop_mode, take_shading
 from .selectors import selector
 
 
@@ -51,7 +51,7 @@ def entity(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]
     if "cf_randomize_materials" in cfg:
         cfg.pop("mode", None)  # the randomizer draws once for all or for each, as BlenderProc
     pop_mode(cfg, note)
-    pop_shading(cfg, note)
+    shading = take_shading(cfg)
     for key in ("cf_add_modifier", "cf_add_uv_mapping"):
         pop_ignored(cfg, key, note, "Blender modifiers (displacement, subdivision, UV projection) are not applied")
     pop_ignored(cfg, "cf_add_displace_modifier_with_texture", note,
@@ -75,6 +75,8 @@ def entity(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]
             "selector": cfg.get("selector", {"conditions": {}}),
             "randomization_level": randomize.get("randomization_level", 0.2),
             "materials_to_replace_with": source, "mode": mode or "once_for_each"}))
+    if shading is not None:
+        out.append(("object.Shading", {**shading, "selector": cfg.get("selector", {"conditions": {}})}))
     if set(cfg) - {"selector"} or not out:
         out.insert(0, ("manipulators.EntityManipulator", cfg))
     return out

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any, Callable
 
 from ...errors import ConfigError
-from .common import Note, custom_properties, pop_ignored, pop_shading
+from .common import Note, custom_properties, pop_ignored, shaded, take_shading
 from .selectors import selector
 
 
@@ -51,8 +51,7 @@ def mesh_initializer(config: dict[str, Any], note: Note) -> list[tuple[str, dict
 
 def bop_loader(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]]]:
     cfg = dict(config)
-    pop_shading(cfg, note)
-    return [("loader.BopLoader", cfg)]
+    return shaded([("loader.BopLoader", cfg)], take_shading(cfg))
 
 
 def replacer(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]]]:
@@ -85,9 +84,9 @@ def loader(name: str, config: dict[str, Any], note: Note) -> list[tuple[str, dic
                      ("use_ambient_occlusion", "Replica's baked AO; hybridgen path-traces occlusion"),
                      ("is_replica_object", "a Replica-only flag")):
         pop_ignored(cfg, key, note, why)
-    pop_shading(cfg, note)
+    shading = take_shading(cfg)
     entries = [dict(cfg, path=p) for p in paths] if isinstance(paths, list) else [cfg]
-    return [("loader.ObjLoader", e) for e in entries]
+    return shaded([("loader.ObjLoader", e) for e in entries], shading)
 
 
 _SHAPES = {"CONVEX_HULL": "convex_hull", "MESH": "mesh", "CONVEX_DECOMPOSITION": "convex_decomposition",
