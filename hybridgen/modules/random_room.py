@@ -172,7 +172,8 @@ class RandomRoomConstructor(Module):
         floor, walls, ceiling = self._build(context, pieces)
         placer = _Placer(context, [walls] + ([ceiling] if ceiling is not None else []),
                          cfg["placement_tries_per_face"])
-        self._fill(context, pieces, _group_models(loaded), placer)
+        models = _group_models(loaded)
+        self._fill(context, pieces, models, placer)
         taken = {o.name for o in scene.objects}
         for group in placer.placed:
             name = unique_blender_name(group[0].name, taken)
@@ -181,7 +182,7 @@ class RandomRoomConstructor(Module):
                 part.name = name
                 scene.add(part)
         context.log(f"{self.module_name}: room of {len(pieces)} pieces, {cfg['floor_area']} m^2; placed "
-                    f"{len(placer.placed)} object(s) from {len(_group_models(loaded))} loaded")
+                    f"{len(placer.placed)} object(s) from {len(models)} loaded")
 
     def _build(self, context: RunContext, pieces: list[Rect]) -> tuple[MeshObject, MeshObject, MeshObject | None]:
         meshes = room_meshes(pieces, self.config["wall_height"])
