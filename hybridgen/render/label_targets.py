@@ -74,7 +74,7 @@ def packed_targets(request: Any, tables: Any, scene: Any, accepted: dict[str, st
     ``tables``: the request's :class:`~hybridgen.render.keypoint_frame.LabelTables`; ``accepted``: output key ->
     the storage tag every sink receiving it stores (octahedral normals, narrowed ids): those passes are handed
     on as drawn."""
-    from ..io.label_encoding import NARROWED, OCTAHEDRAL, storage_tag
+    from ..io.array_encoding import NARROWED, OCTAHEDRAL, storage_tag
 
     if request.normals and accepted.get("normals") != OCTAHEDRAL:
         return None
