@@ -437,7 +437,8 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
                         else:
                             e2es.append(ask("ours", "hdf5", name, resolution, 16, "default")[0])
                 raw, e2e = statistics.median(raws), statistics.median(e2es)
-                print(f"{name:<20} {resolution:<10} {raw:>8.1f} {e2e:>8.1f} {e2e / raw:>7.2f} {count / med['ours']:>8.1f} "
+                print(f"{name:<20} {resolution:<10} {raw:>8.1f} {e2e:>8.1f} {e2e / raw:>7.2f} "
+                      f"{count / med['ours']:>8.1f} "
                       f"{count / med['theirs']:>9.1f} {med['theirs'] / med['ours']:>6.2f} "
                       f"{statistics.median(cpu['theirs']) / statistics.median(cpu['ours']):>9.2f} {size / count / 1e6:>6.2f} "
                       f"{med['ours1']:>10.2f}s {cold:>10.2f}s {med['theirs1']:>10.2f}s", flush=True)

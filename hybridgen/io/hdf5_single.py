@@ -185,8 +185,8 @@ class Hdf5SingleFileWriter:
         """Output key -> the storage tag (:func:`~hybridgen.io.label_encoding.storage_tag`) of each pass this
         file stores encoded (asked after ``begin``): a renderer may hand such a pass over already in that form
         (an :class:`~hybridgen.io.label_encoding.EncodedArray`), which is then stored as it is."""
-        return {key: tag for key, tag in ((key, _tag(stored, self._layouts[key])) for key, stored in self._stored.items())
-                if tag is not None}
+        tags = {key: _tag(stored, self._layouts[key]) for key, stored in self._stored.items()}
+        return {key: tag for key, tag in tags.items() if tag is not None}
 
     # ------------------------------------------------------------------ commit
     def finalize(self, records: dict[str, Any] | None = None,

@@ -67,8 +67,10 @@ class RasterView:
     to client memory: with llvmpipe the copy out of its tiles is all the work there is); "pbo" queues the
     copies into pixel-pack buffers right after the draws, so that a GPU transfers keypoint k while keypoint
     k - 1 is processed, and collecting only maps them. Default: "direct" on software renderers (there a PBO
-    adds a copy and makes the draw finish before ``submit`` returns), "pbo" on GPUs. Same values either way. Poses of objects are read from the scene at every render, so
-    moving an object costs nothing; changing its geometry needs a new view.
+    adds a copy and makes the draw finish before ``submit`` returns), "pbo" on GPUs. Same values either way.
+
+    Poses of objects are read from the scene at every render, so moving an object costs nothing; changing
+    its geometry needs a new view.
     """
 
     def __init__(self, scene: Scene, *, normals_space: str = "camera", depth_background: float = float("inf"),

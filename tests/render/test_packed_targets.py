@@ -26,7 +26,8 @@ def _scene(category: int = 2) -> hg.Scene:
                                 local2world=hg.object_pose([0.9, -0.6, 0.4])))
     scene.add(hg.make_primitive("cube", 0.8, name="box2", category_id=3,
                                 local2world=hg.object_pose([-1.2, 0.9, 0.4], [0, 0, 0.5])))
-    scene.add(hg.make_primitive("sphere", 0.9, name="ball", category_id=4, local2world=hg.object_pose([0.8, 0.8, 0.45])))
+    scene.add(hg.make_primitive("sphere", 0.9, name="ball", category_id=4,
+                                local2world=hg.object_pose([0.8, 0.8, 0.45])))
     for obj in hg.load_objects(REPO / "configs/assets/knot.obj", name="knot", category_id=5,
                                local2world=hg.object_pose([-0.5, -0.5, 0.6], [0.3, 0.2, 0.1], 0.35)):
         scene.add(obj)
