@@ -35,9 +35,28 @@ def require_oidn() -> Any:
     return pyoidn
 
 
+BORDER_PAD = 8
+"""Pixels of mirrored image (and guides) added around each side before denoising, cropped after.
+
+Open Image Denoise treats the image border poorly: on the tabletop scene of tools/color_quality.py (160x120,
+against a 2048-spp reference) the outermost ring of denoised floor pixels was off by 1.9 % on average (the raw
+input there: 0.44 %), about a quarter of the whole image's squared error. With the image mirrored outwards
+(``numpy.pad`` mode ``symmetric``) the ring is off by 0.14 % and the 8-bit MSE of the whole image drops
+1.72 -> 1.53 (64 spp) and 0.84 -> 0.72 (256 spp); 4 / 8 / 16 / 32 px of padding: 0.73 / 0.72 / 0.72 / 0.72."""
+
+
 def denoise(linear: np.ndarray, albedo: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """Denoised linear HDR RGB (float32, H x W x 3) from noisy ``linear`` and clean guides."""
+    """Denoised linear HDR RGB (float32, H x W x 3) from noisy ``linear`` and clean guides (each mirrored
+    outwards by :data:`BORDER_PAD` px for the denoiser)."""
     oidn = require_oidn()
-    out = oidn.denoise(np.ascontiguousarray(linear, np.float32), np.ascontiguousarray(albedo, np.float32),
-                       np.ascontiguousarray(normals, np.float32), hdr=True, clean_aux=True)
-    return np.asarray(out, dtype=np.float32)
+
+    if BORDER_PAD == 0:
+        return np.asarray(oidn.denoise(*(np.ascontiguousarray(x, np.float32) for x in (linear, albedo, normals)),
+                                       hdr=True, clean_aux=True), dtype=np.float32)
+
+    def padded(image: np.ndarray) -> np.ndarray:
+        pad = ((BORDER_PAD, BORDER_PAD), (BORDER_PAD, BORDER_PAD), (0, 0))
+        return np.ascontiguousarray(np.pad(np.asarray(image, np.float32), pad, mode="symmetric"))
+
+    out = oidn.denoise(padded(linear), padded(albedo), padded(normals), hdr=True, clean_aux=True)
+    return np.asarray(out, dtype=np.float32)[BORDER_PAD:-BORDER_PAD, BORDER_PAD:-BORDER_PAD].copy()

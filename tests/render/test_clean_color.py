@@ -107,7 +107,9 @@ def _plane_under_sky(albedo: float, radiance: float, width: int, height: int) ->
 def test_denoised_flat_plane_stays_within_one_percent_of_the_analytic_radiance(gl_context, variant):
     """A Lambertian plane under a constant sky of radiance L has radiance albedo * L everywhere. At 4 spp the
     raw pixels are off by 6 % on average; denoised, the image mean is within 0.5 % and 90 % of the pixels
-    within 1 % (OIDN leaves a few percent at the image corners, so not every pixel)."""
+    within 1 % (OIDN leaves a little more at the image border, so not every pixel). The border ring itself,
+    denoised with the image mirrored outwards (render/denoise.py), is within 0.8 % on average and every
+    pixel within 5 % (unpadded: 1.4 % and 10 %)."""
     pytest.importorskip("pyoidn")
     albedo, radiance = 0.7, 0.5
     scene = _plane_under_sky(albedo, radiance, 64, 48)
@@ -121,6 +123,9 @@ def test_denoised_flat_plane_stays_within_one_percent_of_the_analytic_radiance(g
     assert raw_error.mean() > 0.04  # the input is really noisy
     assert abs(frame["colors_hdr"].astype(np.float64).mean() / (albedo * radiance) - 1) < 0.005
     assert np.percentile(error, 90) < 0.01 and np.median(error) < 0.005
+    ring = np.zeros(error.shape[:2], bool)
+    ring[[0, -1]], ring[:, [0, -1]] = True, True
+    assert error[ring].mean() < 0.008 and error.max() < 0.05
     assert error.mean() < raw_error.mean() / 5
     assert frame["colors_raw"].shape == frame["colors"].shape and (frame["colors_raw"] != frame["colors"]).any()
 
