@@ -40,7 +40,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-STANDIN_OBJ = """# stand-in scene: a floor and two objects, +Y up as OBJ files are
+STANDIN_OBJ = """# stand-in scene: a floor and three objects (one named as the examples' Suzanne), +Y up as OBJ files are
 mtllib scene.mtl
 o Plane
 v -5 0 5
@@ -85,6 +85,19 @@ f 13 14 17
 f 14 15 17
 f 15 16 17
 f 16 13 17
+o Suzanne
+v -2.3 0 0.3
+v -1.7 0 0.3
+v -1.7 0 -0.3
+v -2.3 0 -0.3
+v -2 0.6 0
+usemtl red
+f 18 20 19
+f 18 21 20
+f 18 19 22
+f 19 20 22
+f 20 21 22
+f 21 18 22
 """
 STANDIN_MTL = "newmtl floor\nKd 0.6 0.6 0.6\nnewmtl red\nKd 0.8 0.1 0.1\n"
 
