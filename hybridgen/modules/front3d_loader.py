@@ -61,7 +61,8 @@ class Front3DLoader(Module):
         for obj in objects + [part for group in placements for part in group]:
             obj.attributes["is_3d_front"] = True
             add_properties([obj], cfg["add_properties"])
-        add_with_blender_names(context, objects, renamed=True)
+        for obj in objects:  # one Blender object per mesh entry: a second 'Floor' becomes 'Floor.001'
+            add_with_blender_names(context, [obj], renamed=True)
         for group in placements:  # the parts of one placement share a name; another placement gets .001 ...
             add_with_blender_names(context, group, renamed=True)
 

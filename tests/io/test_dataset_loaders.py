@@ -159,6 +159,18 @@ def _blenderproc_pose(child: dict) -> np.ndarray:
     return pose
 
 
+def test_front3d_house_meshes_of_one_type_get_blenders_names(tmp_path, front):
+    """BlenderProc makes one Blender object per mesh entry, named by its type: a second Floor is Floor.001."""
+    house = json.loads(front["json_path"].read_text())
+    second = dict(house["mesh"][0], uid="mesh-floor-2", xyz=[4, 0, 0, 6, 0, 0, 6, 0, 3, 4, 0, 3])
+    house["mesh"].insert(1, second)
+    front["json_path"].write_text(json.dumps(house))
+    objects = _run(tmp_path, "loader.Front3DLoader", _front_config(front)).scene.objects
+    assert [o.name for o in objects][:4] == ["Floor", "Floor.001", "WallInner", "Ceiling"]
+    np.testing.assert_allclose(objects[1].world_vertices()[:, 0], [4, 6, 6, 4])
+    assert objects[0].category_id == objects[1].category_id == 1
+
+
 def test_front3d_house_rooms_furniture_categories_and_poses(tmp_path, front):
     lines: list[str] = []
     set_sink(lines.append)

@@ -151,7 +151,7 @@ def test_front3d_room_threshold_counts_objects_on_each_floor(tmp_path, house):
     # as BlenderProc counts: every 3D-FRONT object but walls and ceilings, by the ray from its origin - room A
     # holds its 3 pieces of furniture and room B's floor, whose origin (the world origin) lies on room A's floor
     with pytest.raises(InputError, match=r"no room has more than 4 objects standing on its floor \(Floor: 4, "
-                                         r"Floor: 1\)"):
+                                         r"Floor.001: 1\)"):
         _front_run(tmp_path, house, amount_of_objects_needed_per_room=4)
     with pytest.raises(ConfigError) as info:
         _front_run(tmp_path, house, amount_of_objects_needed_per_room=-1)
