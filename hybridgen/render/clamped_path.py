@@ -1,7 +1,12 @@
 """A unidirectional path tracer with Cycles-style indirect clamping (firefly control), as a Mitsuba plugin.
 
 Mitsuba's ``path`` integrator has no clamp. This one is the same estimator (next-event estimation of one
-emitter per vertex, BSDF sampling, power-heuristic MIS between them, Russian roulette from ``rr_depth``)
+emitter per vertex, BSDF sampling, power-heuristic MIS between them, Russian roulette from ``rr_depth`` -
+with Cycles' continuation probability ``min(sqrt(max throughput), 1)`` instead of Mitsuba's
+``min(max throughput x eta^2, 0.95)``, which ended too many paths: window room of tools/color_quality.py,
+160x120, glossy/transmission bounces 0, PSNR against a 2048-spp reference at 64 / 256 spp 30.8 / 36.5 dB
+-> 31.8 / 37.7 dB for ~the same CPU time (no roulette at all: 32.6 / 38.4 dB for 15-20 % more; Cycles at
+BlenderProc's defaults: 32.1 / 38.6 dB))
 with one addition, ``clamp_indirect`` (linear radiance, W sr^-1 m^-2; 0 = off), which has the meaning of
 Cycles' ``sample_clamp_indirect``: every *indirect* contribution of a sample - light that reached the
 camera after at least one bounce, i.e. next-event estimation at the second or later path vertex and
@@ -166,9 +171,10 @@ def register(variant: str) -> None:
                     rough = active_next & ~null_pass & ~mi.has_flag(sampled, mi.BSDFFlags.Delta)
                     min_ray_pdf = dr.select(rough, dr.minimum(min_ray_pdf, bsdf_sample.pdf), min_ray_pdf)
 
-                # Russian roulette from rr_depth on (survivors are reweighted: unbiased).
+                # Russian roulette from rr_depth on (survivors are reweighted: unbiased), with Cycles' gentler
+                # continuation probability sqrt(max throughput) (Mitsuba's path: min(throughput eta^2, 0.95)).
                 throughput_max = dr.max(mi.unpolarized_spectrum(throughput))
-                rr_prob = dr.minimum(throughput_max * dr.square(eta), 0.95)
+                rr_prob = dr.minimum(dr.sqrt(throughput_max), 1.0)
                 rr_active = depth >= rr_depth
                 throughput[rr_active] *= dr.rcp(rr_prob)
                 rr_continue = sampler.next_1d() < rr_prob

@@ -334,3 +334,26 @@ def test_denoiser_import_does_not_pull_in_torch():
             "assert abs(float(denoise(x, x, x).mean()) - 0.5) < 0.01\n")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr[-2000:]
+
+
+def test_russian_roulette_keeps_the_mean(variant):
+    """Russian roulette (Cycles' continuation probability sqrt(max throughput) in hybridgen's path tracer) ends
+    paths early but reweights survivors: a floor and a diffuse wall lit by a lamp, up to 3 bounces between
+    them, have the same mean with roulette from the first bounce as without any."""
+    scene = _lamp_over_floor(wall=False)
+    wall = hg.make_primitive("plane", 2.0, name="wall", category_id=2, color=(0.8, 0.8, 0.8),
+                             local2world=hg.object_pose([0.8, 0, 1.0], [0, math.pi / 2, 0]))
+    wall.material.specular = 0.0
+    scene.add(wall)
+    scene.camera.intrinsics = hg.Intrinsics.from_fov(0.9, 24, 16)
+    scene.camera.keypoints[0] = hg.look_at([-1.5, -0.3, 1.2], [0.8, 0.0, 0.5])
+    pose = scene.camera.keypoints[0]
+
+    def mean(min_bounces: int, max_bounces: int = 3) -> float:
+        settings = PathTraceSettings(samples=256, min_bounces=min_bounces, max_bounces=max_bounces,
+                                     clamp_indirect=0.0, filter_glossy=0.0)
+        return float(PathTraceView(scene, settings, variant=variant).render(pose, seed=5).mean())
+
+    without_roulette = mean(3)
+    assert without_roulette > 1.15 * mean(0, max_bounces=0)  # bounced light is ~20 % of the image
+    assert mean(0) == pytest.approx(without_roulette, rel=0.01)  # measured: 0.04 % apart
