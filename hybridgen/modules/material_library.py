@@ -4,9 +4,11 @@
 ``loader.CCMaterialLoader`` reads an ambientCG (cc0textures) folder: one sub-folder per asset holding
 ``<asset>_2K_Color.jpg`` and its PBR maps (roughness, metalness, opacity, normal, displacement - see
 :mod:`hybridgen.io.texture_sets` for the names). Each asset becomes a principled material named after the
-folder, kept with the custom properties ``is_cc_texture: true`` and ``asset_path`` that getter.Material
-conditions (``cp_is_cc_texture``) select by. ``loader.HavenMaterialLoader``
-(:mod:`hybridgen.modules.haven_loaders`) fills the same library from Poly Haven folders.
+folder, kept with the custom properties ``is_cc_texture: true``, ``asset_name`` (the folder's name, as
+BlenderProc names it) and ``asset_path`` that getter.Material conditions (``cp_is_cc_texture``,
+``cp_asset_name: "Marble.*"`` - text values are regular expressions the whole value must match) select by.
+``loader.HavenMaterialLoader`` (:mod:`hybridgen.modules.haven_loaders`) fills the same library from Poly Haven
+folders.
 """
 from __future__ import annotations
 
@@ -52,7 +54,10 @@ def material_matches(entry: LibraryMaterial, conditions: Any) -> bool:
                 return False
             continue
         actual = entry.properties.get(key[3:] if key.startswith("cp_") else key)
-        if actual != wanted:
+        if isinstance(actual, str) and isinstance(wanted, str):  # BlenderProc: a regular expression, whole value
+            if re.fullmatch(wanted, actual) is None:
+                return False
+        elif actual != wanted:
             return False
     return True
 
@@ -71,7 +76,8 @@ def asset_materials(folder: Path, used_assets: list[str], read: Callable[[Path],
             continue
         material = read(asset)
         if material is not None:
-            materials.append(LibraryMaterial(material, {**properties, "asset_path": str(asset)}))
+            materials.append(LibraryMaterial(material, {**properties, "asset_name": asset.name,
+                                                        "asset_path": str(asset)}))
     return materials
 
 

@@ -56,3 +56,23 @@ def test_cf_textures_link_images_to_principled_inputs(tmp_path):
     assert Path(material.roughness_texture).name == "rough.png"
     assert material.normal_texture is None
     assert any("cf_textures.Normal" in line and "ignored" in line for line in lines)
+
+
+def test_cc_materials_are_selected_by_asset_name_patterns(tmp_path):
+    # BlenderProc's CC materials carry cp_asset_name (the asset folder); text conditions are regular expressions
+    cc = tmp_path / "cc"
+    for asset, color in (("Marble003", (230, 230, 230)), ("Wood002", (120, 80, 40))):
+        (cc / asset).mkdir(parents=True)
+        Image.new("RGB", (4, 4), color).save(cc / asset / f"{asset}_2K_Color.jpg")
+    text = json.dumps({"version": 3, "setup": {"blender_install_path": "/opt/blender"}, "modules": [
+        {"module": "main.Initializer", "config": {"global": {"output_dir": str(tmp_path / "out")}}},
+        {"module": "loader.ObjectLoader", "config": {"path": str(_quad(tmp_path, None))}},
+        {"module": "loader.CCMaterialLoader", "config": {"folder_path": str(cc)}},
+        {"module": "manipulators.EntityManipulator", "config": {
+            "selector": {"provider": "getter.Entity", "conditions": {"name": "Plane"}},
+            "cf_randomize_materials": {"randomization_level": 1.0, "materials_to_replace_with": {
+                "provider": "getter.Material", "random_samples": 1,
+                "conditions": {"cp_is_cc_texture": True, "cp_asset_name": "Marble.*"}}}}}]})
+    for seed in range(3):
+        context = run_config_text(tmp_path, text.replace('"global"', f'"seed": {seed}, "global"', 1))
+        assert context.scene.by_name("Plane").material.name == "Marble003"
