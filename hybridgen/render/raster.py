@@ -21,6 +21,7 @@ from ..errors import InputError
 from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
 from .alpha_cutout import Cutout, set_cutout_uniforms, upload_cutout
+from .gl_calls import gl_calls
 from .gl_context import shared_context
 from .label_targets import LabelTargets
 from .shared_geometry import geometry_key
@@ -75,7 +76,7 @@ class RasterView:
 
     def __init__(self, scene: Scene, *, normals_space: str = "camera", depth_background: float = float("inf"),
                  device_index: int | None = None, ctx: Any = None, cull_clusters: bool = True,
-                 readback: str | None = None) -> None:
+                 readback: str | None = None, gil_free: bool = True) -> None:
         if normals_space not in NORMAL_SPACES:
             raise InputError(f"normals_space must be one of {NORMAL_SPACES}, got {normals_space!r}")
         self.scene = scene
@@ -89,6 +90,7 @@ class RasterView:
         if self.readback not in READBACKS:
             raise InputError(f"readback must be one of {READBACKS}, got {readback!r}")
         self._pbos: dict[Any, list[Any]] = {}  # framebuffer key -> a pixel-pack buffer per attachment
+        self._gl = gl_calls() if gil_free else None  # draws and reads that release the GIL (gl_calls.py)
         self.program = self._label_program(cutout=False)
         self._cutout_program: Any = None  # built with the first object that cuts out (render/alpha_cutout.py)
         self._packed_programs: dict[tuple[LabelTargets, bool], Any] = {}  # label_targets.py variants
@@ -314,11 +316,14 @@ class RasterView:
                 self.ctx.enable(self.ctx.CULL_FACE)
             else:
                 self.ctx.disable(self.ctx.CULL_FACE)
-            if commands is None:
-                vao.render()
-            else:
+            if commands is not None:
                 gpu.indirect.write(commands.tobytes())
-                vao.render_indirect(gpu.indirect, count=len(commands))
+            if self._gl is None:
+                vao.render() if commands is None else vao.render_indirect(gpu.indirect, count=len(commands))
+            elif commands is None:  # the same calls without holding the GIL (render/gl_calls.py)
+                self._gl.draw(prog, vao)
+            else:
+                self._gl.draw_indirect(prog, vao, gpu.indirect, len(commands))
         queued = self.readback == "pbo" and region is None
         if queued:  # the copies run on the GPU after the draws; collect() maps them
             for attachment, ((_, components, kind), pbo) in enumerate(
@@ -338,6 +343,8 @@ class RasterView:
         for attachment, (name, components, kind) in enumerate(_attachments(targets)):
             if queued:
                 self._pbos[key][attachment].read_into(arrays[name])
+            elif self._gl is not None:  # waits for the rasterizer without holding the GIL
+                self._gl.read_into(arrays[name], self._fbos[key], attachment, components, kind)
             else:
                 self._fbos[key].read_into(arrays[name], attachment=attachment, components=components, dtype=kind)
         if targets is not None:

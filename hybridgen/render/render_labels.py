@@ -95,10 +95,19 @@ class LabelProducer:
 
 def render_labels(scene: Scene, sinks: Iterable[FrameSink], request: LabelRequest | None = None, *,
                   default_category_id: int | None = None, view: RasterView | None = None,
-                  progress: ProgressFactory | None = None, indices: Sequence[int] | None = None) -> int:
+                  progress: ProgressFactory | None = None, indices: Sequence[int] | None = None,
+                  render_threads: int = 1) -> int:
     """Render the label passes of the keypoints ``indices`` (default: all) of ``scene.camera`` into ``sinks``
-    (plus the on-request passes they ask for); returns how many."""
+    (plus the on-request passes they ask for); returns how many. ``render_threads`` > 1: that many raster
+    threads, each with its own GL context (render/threaded_labels.py; same values, same order; ``view``
+    then unused)."""
     sinks = list(sinks)
     request = (request or LabelRequest()).with_sinks(sinks)
-    producer = LabelProducer(scene, request, default_category_id=default_category_id, view=view)
+    producer: Any
+    if render_threads > 1:
+        from .threaded_labels import ThreadedLabelProducer
+
+        producer = ThreadedLabelProducer(scene, request, render_threads, default_category_id=default_category_id)
+    else:
+        producer = LabelProducer(scene, request, default_category_id=default_category_id, view=view)
     return run_keypoints(scene, sinks, [producer], progress=progress, what="labels", indices=indices)

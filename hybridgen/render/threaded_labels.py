@@ -1,0 +1,156 @@
+"""Label keypoints on several raster threads of one process, each with its own GL context (``render_threads``).
+
+llvmpipe shades vertices and bins triangles on the thread that issues the draws, so on vertex-bound scenes
+one thread keeps one core busy while the rasterizer threads idle. :class:`ThreadedLabelProducer` gives each
+of N worker threads its own headless EGL context and its own upload of the scene (one copy of the geometry
+per context: contexts do not share objects), hands them keypoints in turn as :func:`run_keypoints` asks for
+them (``prefetch`` one ahead, ``produce`` in keypoint order) and returns each keypoint's values in the order
+asked, so the sinks receive the same values in the same order as from one :class:`LabelProducer`. The GL
+calls that do the work release the GIL (:mod:`hybridgen.render.gl_calls`), so the threads overlap.
+
+An exception on a worker is raised again, unchanged, by the ``produce`` that asked for that keypoint (or by
+the constructor, for context creation and upload); a worker that does not answer within ``timeout`` seconds
+raises :class:`~hybridgen.errors.SystemSetupError` instead of hanging.
+"""
+from __future__ import annotations
+
+import queue
+import threading
+from concurrent.futures import Future
+from typing import Any, Callable
+
+import numpy as np
+
+from ..errors import InputError, SystemSetupError
+from ..io.frame_sink import PassLayout
+from ..scene.scene import Scene
+from .gl_context import create_context
+from .label_request import LabelRequest
+from .raster import RasterView
+from .render_labels import LabelProducer
+
+DEFAULT_TIMEOUT_S = 600.0
+"""Longest wait for one keypoint (or for a worker's context and upload) before giving up, seconds."""
+
+
+class _Worker:
+    """One thread owning a GL context, a raster view of the scene and a :class:`LabelProducer` on it."""
+
+    def __init__(self, build: Callable[[Any], LabelProducer], name: str) -> None:
+        self.jobs: queue.Queue[tuple[Callable[[LabelProducer], Any], Future] | None] = queue.Queue()
+        self.ready: Future = Future()
+        self.thread = threading.Thread(target=self._run, args=(build,), name=name, daemon=True)
+        self.thread.start()
+
+    def _run(self, build: Callable[[Any], LabelProducer]) -> None:
+        ctx = producer = None
+        try:
+            ctx = create_context()
+            producer = build(ctx)
+            self.ready.set_result(producer)
+        except BaseException as exc:  # noqa: BLE001 - handed to the thread that waits for it
+            self.ready.set_exception(exc)
+        try:
+            while producer is not None:
+                job = self.jobs.get()
+                if job is None:
+                    break
+                work, result = job
+                if not result.set_running_or_notify_cancel():
+                    continue
+                try:
+                    result.set_result(work(producer))
+                except BaseException as exc:  # noqa: BLE001
+                    result.set_exception(exc)
+        finally:
+            if producer is not None:
+                producer.close()
+                producer.view.release()
+            if ctx is not None:
+                ctx.release()
+
+    def submit(self, work: Callable[[LabelProducer], Any]) -> Future:
+        result: Future = Future()
+        self.jobs.put((work, result))
+        return result
+
+
+class ThreadedLabelProducer:
+    """The producer of :class:`LabelProducer` (same passes, same values, same order) on ``threads`` raster
+    threads, each with its own context and upload of ``scene``. ``view_options``: keyword arguments of every
+    worker's :class:`RasterView`."""
+
+    def __init__(self, scene: Scene, request: LabelRequest, threads: int, *, default_category_id: int | None = None,
+                 timeout: float = DEFAULT_TIMEOUT_S, **view_options: Any) -> None:
+        if threads < 1:
+            raise InputError(f"render_threads must be >= 1, got {threads}")
+        self.timeout = float(timeout)
+
+        def build(ctx: Any) -> LabelProducer:
+            view = RasterView(scene, normals_space=request.normals_space, depth_background=request.depth_background,
+                              ctx=ctx, **view_options)
+            try:
+                return LabelProducer(scene, request, default_category_id=default_category_id, view=view)
+            except BaseException:
+                view.release()
+                raise
+
+        self.workers = [_Worker(build, f"hybridgen-raster-{i}") for i in range(threads)]
+        self._pending: dict[tuple[int, int, bytes], Future] = {}
+        self._turn = 0
+        try:
+            self.producers = [self._wait(worker.ready, "its GL context and upload") for worker in self.workers]
+        except BaseException:
+            self.close()
+            raise
+
+    def _wait(self, result: Future, what: str) -> Any:
+        try:
+            return result.result(timeout=self.timeout)
+        except TimeoutError as exc:
+            raise SystemSetupError(f"a raster thread gave no answer for {what} within {self.timeout:g} s") from exc
+
+    # the run-wide answers are the same on every worker: the first one gives them (no GL calls)
+    def layouts(self) -> list[PassLayout]:
+        return self.producers[0].layouts()
+
+    def attributes(self) -> dict[str, Any]:
+        return self.producers[0].attributes()
+
+    def records(self) -> dict[str, np.ndarray]:
+        return self.producers[0].records()
+
+    def use_encodings(self, accepted: dict[str, str]) -> None:
+        for worker in self.workers:  # queued: runs on the worker before any keypoint given to it after
+            worker.submit(lambda producer: producer.use_encodings(accepted))
+
+    def focus_objects(self, ids: frozenset[int] | None) -> None:
+        for worker in self.workers:
+            worker.submit(lambda producer: producer.focus_objects(ids))
+
+    def prefetch(self, index: int, cam2world: np.ndarray, eye: int = 0) -> None:
+        """Give keypoint ``index`` to the next worker in turn; :meth:`produce` collects it."""
+        key = (index, eye, np.asarray(cam2world).tobytes())
+        if key not in self._pending:
+            self._pending[key] = self._dispatch(index, cam2world, eye)
+
+    def _dispatch(self, index: int, cam2world: np.ndarray, eye: int) -> Future:
+        worker = self.workers[self._turn % len(self.workers)]
+        self._turn += 1
+        pose = np.array(cam2world, dtype=np.float64)
+        return worker.submit(lambda producer: producer.produce(index, pose, eye))
+
+    def produce(self, index: int, cam2world: np.ndarray, eye: int = 0) -> dict[str, Any]:
+        key = (index, eye, np.asarray(cam2world).tobytes())
+        result = self._pending.pop(key, None) or self._dispatch(index, cam2world, eye)
+        return self._wait(result, f"keypoint {index}")
+
+    def close(self) -> None:
+        """Stop the workers (each releases its view and context) and wait for them."""
+        for result in self._pending.values():
+            result.cancel()
+        self._pending.clear()
+        for worker in self.workers:
+            worker.jobs.put(None)
+        for worker in self.workers:
+            worker.thread.join(timeout=self.timeout)

@@ -1,0 +1,94 @@
+"""Label keypoints on several raster threads (render/threaded_labels.py) and the GIL-free GL calls
+(render/gl_calls.py): a threaded run gives the sinks the same values, in the same order, as one thread - the
+HDF5 file byte for byte - and a failure on a worker thread surfaces as the same exception, without hanging."""
+from __future__ import annotations
+
+import hashlib
+
+import numpy as np
+import pytest
+
+import hybridgen as hg
+from hybridgen.errors import InputError
+from hybridgen.io.memory_sink import MemorySink
+from hybridgen.render.render_labels import LabelProducer, render_labels
+from hybridgen.render.threaded_labels import ThreadedLabelProducer
+from tests.render.test_packed_targets import _scene
+
+
+def _frames(threads: int, request: hg.LabelRequest) -> list[dict]:
+    sink = MemorySink()
+    assert render_labels(_scene(), [sink], request, render_threads=threads) == 5
+    return sink.frames
+
+
+@pytest.mark.parametrize("threads", [2, 3])
+def test_threaded_run_equals_one_thread_in_values_and_order(gl_context, threads):
+    request = hg.LabelRequest(depth=True, normals=True, map_by=["class", "instance"])
+    single, threaded = _frames(1, request), _frames(threads, request)
+    assert len(single) == len(threaded) == 5
+    for one, many in zip(single, threaded):
+        assert one.keys() == many.keys()
+        for key in one:
+            a, b = one[key], many[key]
+            if isinstance(a, np.ndarray):
+                assert a.dtype == b.dtype and np.array_equal(a, b, equal_nan=a.dtype.kind == "f"), key
+            else:
+                assert a == b, key
+    # keypoints differ from each other, so equal order is checked, not just equal content
+    assert not np.array_equal(single[0]["depth"], single[1]["depth"])
+
+
+def test_threaded_hdf5_file_is_byte_identical(gl_context, tmp_path):
+    digests = []
+    for threads in (1, 2):
+        path = tmp_path / f"t{threads}.hdf5"
+        writer = hg.Hdf5SingleFileWriter(path)
+        scene = _scene()
+        render_labels(scene, [writer], hg.LabelRequest(depth=True, normals=True, map_by=["class", "instance"]),
+                      render_threads=threads)
+        writer.finalize({})
+        digests.append(hashlib.sha256(path.read_bytes()).hexdigest())
+    assert digests[0] == digests[1]
+
+
+def test_worker_error_surfaces_unchanged_and_does_not_hang(gl_context):
+    scene = _scene()
+    request = hg.LabelRequest(depth=True)
+    single = LabelProducer(scene, request)
+    try:
+        with pytest.raises(IndexError) as expected:
+            single.produce(0, np.zeros((3, 3)))  # not a 4x4 pose: fails inside the view's submit
+    finally:
+        single.close()
+    producer = ThreadedLabelProducer(scene, request, 2, timeout=60)
+    try:
+        with pytest.raises(IndexError) as raised:
+            producer.produce(0, np.zeros((3, 3)))  # the same, on a worker thread
+        assert str(raised.value) == str(expected.value)
+        producer.prefetch(1, scene.camera.keypoints[1])  # the workers still serve keypoints after an error
+        assert producer.produce(1, scene.camera.keypoints[1])["depth"].shape == (60, 80)
+    finally:
+        producer.close()
+    assert not any(worker.thread.is_alive() for worker in producer.workers)
+
+
+def test_construction_error_surfaces_as_the_same_one_line_error(gl_context):
+    with pytest.raises(InputError, match="no objects") as single:
+        render_labels(hg.Scene(), [MemorySink()], hg.LabelRequest(depth=True))
+    with pytest.raises(InputError, match="no objects") as threaded:
+        render_labels(hg.Scene(), [MemorySink()], hg.LabelRequest(depth=True), render_threads=2)
+    assert str(single.value) == str(threaded.value)
+    with pytest.raises(InputError, match="render_threads"):
+        ThreadedLabelProducer(_scene(), hg.LabelRequest(depth=True), 0)
+
+
+def test_a_worker_that_never_answers_raises_instead_of_hanging(gl_context):
+    producer = ThreadedLabelProducer(_scene(), hg.LabelRequest(depth=True), 1, timeout=0.5)
+    try:
+        blocker = producer.workers[0].submit(lambda _: __import__("time").sleep(3))
+        with pytest.raises(hg.errors.SystemSetupError, match="no answer for keypoint 0"):
+            producer.produce(0, producer.producers[0].scene.camera.keypoints[0])
+        blocker.result(timeout=10)
+    finally:
+        producer.close()
