@@ -48,7 +48,7 @@ def register(variant: str) -> None:
             self.radius = float(props.get("aperture_radius"))
             self.fixed_focus = float(props.get("focus_distance"))
             self.focus_point = (np.array([float(props.get(f"focus_{axis}")) for axis in "xyz"])
-                                if props.has_property("focus_x") else None)
+                                if "focus_x" in props else None)
             self.m_needs_sample_3 = True  # the aperture sample
             self.set_pose(np.eye(4))
 
