@@ -33,7 +33,10 @@ class SegMapRenderer(Module):
               Param("blenderproc_segmap", "dict|null", None, check=_segmap_check,
                     doc="also store BlenderProc's one segmap, {key, default_values}: a channel per numeric map_by "
                     "attribute in order (text attributes only in instance_attribute_maps); objects lacking an "
-                    "attribute get its default value (set by BlenderProc configs)"))
+                    "attribute get its default value (set by BlenderProc configs)"),
+              Param("render_threads", "int", 1, check=lambda v: None if v >= 1 else f"must be >= 1, got {v}",
+                    doc="raster threads, each with its own GL context and copy of the geometry "
+                    "(docs/label_pipeline.md); same bytes as 1"))
 
     def produces(self) -> frozenset[str] | None:
         segmap = self.config["blenderproc_segmap"]
@@ -50,4 +53,5 @@ class SegMapRenderer(Module):
         context.frames_rendered += render_labels(context.scene, sinks, label_request(config),
                                                  default_category_id=context.default_category_id,
                                                  progress=context.progress,
-                                                 indices=context.keypoint_indices())
+                                                 indices=context.keypoint_indices(),
+                                                 render_threads=config["render_threads"])

@@ -92,3 +92,42 @@ def test_a_worker_that_never_answers_raises_instead_of_hanging(gl_context):
         blocker.result(timeout=10)
     finally:
         producer.close()
+
+
+CONFIG = """
+global: {all: {output_dir: "<args:0>"}}
+modules:
+  - {name: loader.ObjLoader, config: {path: %s, name: knot, category_id: 2}}
+  - name: camera.CameraLoader
+    config:
+      intrinsics: {resolution_x: 40, resolution_y: 30}
+      cam_poses:
+        - {location: [2, -2, 1.5], rotation: {format: look_at, value: [0, 0, 0.3]}}
+        - {location: [-2, 1, 1.0], rotation: {format: look_at, value: [0, 0, 0.3]}}
+        - {location: [0.5, 2.5, 2.0], rotation: {format: look_at, value: [0, 0, 0.3]}}
+  - {name: renderer.SegMapRenderer, config: {render_threads: %d}}
+  - {name: writer.Hdf5Writer}
+"""
+
+
+def test_segmap_renderer_render_threads_writes_the_same_datasets(run_cli, tmp_path):
+    import h5py
+
+    from tests.conftest import REPO
+
+    stored = []
+    for threads in (1, 2):
+        config = tmp_path / f"t{threads}.yaml"
+        config.write_text(CONFIG % (REPO / "configs/assets/knot.obj", threads))
+        code, _, err = run_cli("run", "--quiet", str(config), str(tmp_path / f"out{threads}"))
+        assert code == 0, err
+        with h5py.File(tmp_path / f"out{threads}" / "data.hdf5") as h5:
+            stored.append({key: h5[key][()] for key in h5 if isinstance(h5[key], h5py.Dataset)})
+    assert stored[0].keys() == stored[1].keys() and {"depth", "normals", "instance_segmaps"} <= stored[0].keys()
+    for key in stored[0]:
+        one, two = np.asarray(stored[0][key]), np.asarray(stored[1][key])
+        assert np.array_equal(one, two, equal_nan=one.dtype.kind == "f"), key
+    config = tmp_path / "bad.yaml"
+    config.write_text(CONFIG % (REPO / "configs/assets/knot.obj", 0))
+    code, _, err = run_cli("run", "--quiet", str(config), str(tmp_path / "bad"))
+    assert code == 2 and "render_threads" in err and len(err.strip().splitlines()) == 1, err
