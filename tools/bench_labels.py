@@ -303,9 +303,9 @@ def export_assets(name: str, folder: Path) -> list[dict[str, Any]]:
     return entries
 
 
-def write_configs(name: str, resolution: str, count: int, folder: Path) -> tuple[Path, Path]:
-    """A labels-only hybridgen config (depth + normals + class + instance, default HDF5 writer) and the
-    pyrender script's spec: the same meshes, intrinsics and ``count`` poses."""
+def write_configs(name: str, resolution: str, count: int, folder: Path, render_threads: int = 1) -> tuple[Path, Path]:
+    """A labels-only hybridgen config (depth + normals + class + instance, default HDF5 writer, ``render_threads``
+    raster threads) and the pyrender script's spec: the same meshes, intrinsics and ``count`` poses."""
     import json
 
     import bench_scenes as bs
@@ -329,10 +329,10 @@ def write_configs(name: str, resolution: str, count: int, folder: Path) -> tuple
         # source_frame as in BlenderProc: the OpenCV camera's axes in Blender camera axes
         lines.append(f"        - {{cam2world_matrix: {[float(v) for v in pose.ravel()]}, source_frame: [X, -Y, -Z]}}")
     lines.append("  - {name: renderer.SegMapRenderer, config: {render_depth: true, render_normals: true, "
-                 "map_by: [class, instance]}}")
+                 f"map_by: [class, instance], render_threads: {render_threads}}}}}")
     lines.append("  - {name: writer.Hdf5Writer}")
     folder.mkdir(parents=True, exist_ok=True)
-    stem = f"{name.split()[0]}_{resolution}_{count}"
+    stem = f"{name.split()[0]}_{resolution}_{count}_{render_threads}t"
     config = folder / f"{stem}.yaml"
     config.write_text("\n".join(lines) + "\n")
     spec = folder / f"{stem}.json"
@@ -379,7 +379,7 @@ def run_timed(command: list[str], env: dict[str, str], cpu: list[float] | None =
 
 
 def whole_process_table(names: list[str], resolutions: list[str], count: int, rounds: int,
-                        ask: Any, cache_dir: Path) -> None:
+                        ask: Any, cache_dir: Path, render_threads: int = 1) -> None:
     """The issue's table: whole ``hybridgen run`` vs the pyrender script, alternating, plus raw / in-process
     end-to-end label fps (alternating, 16 keypoints, medians of ``rounds``) and their ratio, bytes per keypoint
     and time to first keypoint (1-keypoint runs)."""
@@ -402,6 +402,7 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
             for resolution in resolutions:
                 config, spec = write_configs(name, resolution, count, work / "configs")
                 config1, spec1 = write_configs(name, resolution, 1, work / "configs")
+                threaded = write_configs(name, resolution, count, work / "configs", render_threads)[0]
                 out = work / "out"
                 ours_cmd = [*hybridgen, "run", "--quiet", str(config), str(out)]
                 theirs_cmd = [sys.executable, __file__, PYRENDER_SCRIPT, str(spec)]
@@ -410,13 +411,20 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
                 cold = run_timed([*hybridgen, "run", "--quiet", str(config1), str(work / "warm")], cold_env)
                 shutil.rmtree(work / "warm", ignore_errors=True)
                 run_timed([*hybridgen, "run", "--quiet", str(config1), str(work / "warm")], env)  # warms caches
-                times: dict[str, list[float]] = {"ours": [], "theirs": [], "ours1": [], "theirs1": []}
-                cpu: dict[str, list[float]] = {"ours": [], "theirs": []}
+                times: dict[str, list[float]] = {"ours": [], "theirs": [], "ours1": [], "theirs1": [], "threads": []}
+                cpu: dict[str, list[float]] = {"ours": [], "theirs": [], "threads": []}
                 size = 0
                 for r in range(rounds):
                     order = ("ours", "theirs") if r % 2 == 0 else ("theirs", "ours")
+                    if render_threads > 1:  # the same config on render_threads raster threads, same rounds
+                        order = ("threads", *order) if r % 2 == 0 else (*order, "threads")
                     for engine in order:
-                        if engine == "ours":
+                        if engine == "threads":
+                            shutil.rmtree(out, ignore_errors=True)
+                            times["threads"].append(run_timed([*hybridgen, "run", "--quiet", str(threaded), str(out)],
+                                                              env, cpu["threads"]))
+                            check_output(out / "data.hdf5", spec)
+                        elif engine == "ours":
                             shutil.rmtree(out, ignore_errors=True)
                             times["ours"].append(run_timed(ours_cmd, env, cpu["ours"]))
                             size = sum(f.stat().st_size for f in out.rglob("*.hdf5"))
@@ -442,6 +450,10 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
                       f"{count / med['theirs']:>9.1f} {med['theirs'] / med['ours']:>6.2f} "
                       f"{statistics.median(cpu['theirs']) / statistics.median(cpu['ours']):>9.2f} {size / count / 1e6:>6.2f} "
                       f"{med['ours1']:>10.2f}s {cold:>10.2f}s {med['theirs1']:>10.2f}s", flush=True)
+                if render_threads > 1:
+                    print(f"{'':<20} {'':<10} render_threads {render_threads}: run fps {count / med['threads']:.1f}, "
+                          f"ratio {med['theirs'] / med['threads']:.2f}, cpu ratio "
+                          f"{statistics.median(cpu['theirs']) / statistics.median(cpu['threads']):.2f}", flush=True)
 
 
 def main() -> None:
@@ -458,6 +470,8 @@ def main() -> None:
     parser.add_argument("--breakdown", action="store_true", help="also time our stages serially per keypoint")
     parser.add_argument("--skip-pyrender", action="store_true", help="only the HDF5 end-to-end part")
     parser.add_argument("--keypoints", type=int, default=120, help="keypoints of the whole-process runs")
+    parser.add_argument("--render-threads", type=int, default=1, help="also time the whole-process runs with "
+                        "this many raster threads (SegMapRenderer render_threads), in the same rounds")
     parser.add_argument("--whole-rounds", type=int, default=3, help="alternating rounds of the whole-process runs")
     parser.add_argument("--inner", action="store_true", help="also the in-process sections: raster pass vs "
                         "pyrender, --breakdown, --check, end to end per compression")
@@ -497,7 +511,8 @@ def main() -> None:
           f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f} (other processes skew absolute numbers)")
     with tempfile.TemporaryDirectory() as cache:
         whole_process_table(names, resolutions, 20 if args.quick else args.keypoints,
-                            2 if args.quick else args.whole_rounds, ask, args.cache_dir or Path(cache))
+                            2 if args.quick else args.whole_rounds, ask, args.cache_dir or Path(cache),
+                            args.render_threads)
     if not args.inner:
         for conn, process in workers.values():
             conn.send(None)

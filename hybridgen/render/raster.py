@@ -70,6 +70,10 @@ class RasterView:
     k - 1 is processed, and collecting only maps them. Default: "direct" on software renderers (there a PBO
     adds a copy and makes the draw finish before ``submit`` returns), "pbo" on GPUs. Same values either way.
 
+    ``gil_free``: issue the draws and the direct readback through :mod:`hybridgen.render.gl_calls` (the same
+    GL calls without holding the GIL, so compressor threads and other raster threads run meanwhile); False:
+    through moderngl.
+
     Poses of objects are read from the scene at every render, so moving an object costs nothing; changing
     its geometry needs a new view.
     """
