@@ -44,12 +44,19 @@ class GlCalls:
         egl = ctypes.CDLL("libEGL.so.1")
         get_proc = egl.eglGetProcAddress
         get_proc.restype, get_proc.argtypes = ctypes.c_void_p, [ctypes.c_char_p]
+        self._current = egl.eglGetCurrentContext
+        self._current.restype, self._current.argtypes = ctypes.c_void_p, []
         self.functions: dict[str, Any] = {}
         for name, args in _SIGNATURES.items():
             address = get_proc(name.encode())
             if not address:
                 raise OSError(f"eglGetProcAddress found no {name}")
             self.functions[name] = ctypes.CFUNCTYPE(None, *args)(address)  # CFUNCTYPE calls release the GIL
+
+    def egl_context_current(self) -> bool:
+        """Whether an EGL context is current on this thread (a context made otherwise, e.g. OSMesa, is not
+        reached by these entry points)."""
+        return bool(self._current())
 
     def draw(self, program: Any, vao: Any) -> None:
         """``vao.render()`` of an indexed (uint32) triangle vertex array, without the GIL."""
@@ -85,7 +92,8 @@ _tried = False
 
 
 def gl_calls() -> GlCalls | None:
-    """The process's :class:`GlCalls`, or None where EGL gives no entry points."""
+    """The process's :class:`GlCalls` when an EGL context is current on this thread, else None (no EGL entry
+    points, or the current context is not EGL's): then callers use moderngl."""
     global _calls, _tried
     if not _tried:
         _tried = True
@@ -93,4 +101,4 @@ def gl_calls() -> GlCalls | None:
             _calls = GlCalls()
         except (OSError, AttributeError):
             _calls = None
-    return _calls
+    return _calls if _calls is not None and _calls.egl_context_current() else None

@@ -131,3 +131,27 @@ def test_segmap_renderer_render_threads_writes_the_same_datasets(run_cli, tmp_pa
     config.write_text(CONFIG % (REPO / "configs/assets/knot.obj", 0))
     code, _, err = run_cli("run", "--quiet", str(config), str(tmp_path / "bad"))
     assert code == 2 and "render_threads" in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_gil_free_calls_give_the_same_readback_as_moderngl(gl_context):
+    from hybridgen.io.label_encoding import OCTAHEDRAL
+    from hybridgen.render.label_targets import packed_targets
+
+    scene = _scene()
+    free, held = hg.RasterView(scene, ctx=gl_context), hg.RasterView(scene, ctx=gl_context, gil_free=False)
+    try:
+        assert free._gl is not None and held._gl is None  # the EGL context of the tests is current here
+        request = hg.LabelRequest(map_by=["class", "instance"])
+        targets = packed_targets(request, request.tables(free), scene, {"normals": OCTAHEDRAL})
+        assert targets is not None and targets.octahedral_normals
+        for pose in scene.camera.keypoints:
+            for chosen in (None, targets):
+                a, b = free.render_raw(pose, targets=chosen), held.render_raw(pose, targets=chosen)
+                for name in ("normal_depth", "instance", "depth_image", "normal_codes", "category"):
+                    x, y = getattr(a, name, None), getattr(b, name, None)
+                    assert (x is None) == (y is None), name
+                    if x is not None:
+                        assert x.dtype == y.dtype and x.tobytes() == y.tobytes(), name
+    finally:
+        free.release()
+        held.release()
