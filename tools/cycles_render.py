@@ -10,7 +10,8 @@ Protocol (one JSON object per line): after building the scene the worker answers
 ``{"index": i, "light_tree": bool, "seed": int, "save": path-or-null}`` (optionally ``"mode"``:
 ``"blenderproc"`` - BlenderProc 2.8's render defaults, or ``"reference"`` - the same estimator at a fixed
 ``"spp"`` without adaptive sampling or denoising; ``"cycles"``: a mapping of ``scene.cycles`` attributes set
-after the mode, for experiments), is answered with
+after the mode, for experiments; ``"sample_counts"``: a ``.npy`` path that receives the samples each pixel got,
+float32 H x W, from Cycles' "Debug Sample Count" pass), is answered with
 ``{"seconds": wall, "cpu_s": cpu}`` (the time of ``bpy.ops.render.render`` alone); ``{"quit": true}`` ends
 it with its peak RSS. Requests one at a time let the benchmark interleave Cycles with Mitsuba keypoint by
 keypoint, so both see the same machine noise; while waiting the worker is idle.
@@ -185,6 +186,90 @@ def blenderproc_defaults(scene: bpy.types.Scene, reference: bool, spp: int) -> N
     cycles.filter_width = 1.5
 
 
+def _exr_header(raw: bytes, position: int) -> tuple[dict[str, bytes], int]:
+    """One OpenEXR header's attributes (name -> value bytes) and the position after its closing null byte."""
+    attributes = {}
+    while raw[position] != 0:  # name, type, size, value
+        end = raw.index(b"\0", position)
+        type_end = raw.index(b"\0", end + 1)
+        size = int.from_bytes(raw[type_end + 1:type_end + 5], "little")
+        attributes[raw[position:end].decode()] = raw[type_end + 5:type_end + 5 + size]
+        position = type_end + 5 + size
+    return attributes, position + 1
+
+
+def _exr_channel_list(value: bytes) -> list[tuple[str, int]]:
+    """(name, pixel type) of each entry of an EXR ``chlist`` attribute, in file order."""
+    channels, at = [], 0
+    while value[at] != 0:
+        end = value.index(b"\0", at)
+        channels.append((value[at:end].decode(), int.from_bytes(value[end + 1:end + 5], "little")))
+        at = end + 17  # pixel type, pLinear + 3 reserved bytes, x and y sampling
+    return channels
+
+
+def read_exr_channels(path: str) -> dict[str, np.ndarray]:
+    """Channels (float32 H x W, top row first) of an uncompressed scanline OpenEXR file, single- or multi-part,
+    as Blender writes a multilayer EXR with ``exr_codec = "NONE"`` (names ``layer.pass.channel``; Blender 5
+    writes one part per pass). The pip ``bpy`` wheel has no Python EXR reader, and a render result's passes
+    are not readable from Python otherwise."""
+    raw = open(path, "rb").read()
+    if int.from_bytes(raw[:4], "little") != 20000630:
+        raise ValueError(f"{path}: not an OpenEXR file")
+    multipart = bool(raw[5] & 0x10)
+    headers, position = [], 8
+    while True:
+        header, position = _exr_header(raw, position)
+        headers.append(header)
+        if not multipart or raw[position] == 0:
+            position += multipart  # the empty header that ends a multi-part file's list
+            break
+    out: dict[str, np.ndarray] = {}
+    dtypes = {0: "<u4", 1: "<f2", 2: "<f4"}
+    for part, header in enumerate(headers):
+        if header["compression"][0] != 0:
+            raise ValueError(f"{path}: only uncompressed EXR files are read here")
+        window = np.frombuffer(header["dataWindow"], "<i4")
+        width, height = int(window[2] - window[0] + 1), int(window[3] - window[1] + 1)
+        channels = _exr_channel_list(header["channels"])
+        images = {name: np.zeros((height, width), np.float32) for name, _ in channels}
+        offsets = np.frombuffer(raw, "<u8", height, position)  # one scanline per chunk when uncompressed
+        position += 8 * height
+        for offset in map(int, offsets):  # [part number,] y, byte count, then each channel's row in turn
+            offset += 4 * multipart
+            y = int.from_bytes(raw[offset:offset + 4], "little", signed=True) - int(window[1])
+            at = offset + 8
+            for name, pixel_type in channels:
+                row = np.frombuffer(raw, dtypes[pixel_type], width, at)
+                images[name][y] = row
+                at += row.nbytes
+        out.update(images)
+    return out
+
+
+def save_sample_counts(scene: bpy.types.Scene, path: str) -> None:
+    """The finished render's "Debug Sample Count" pass (enabled before rendering) as samples per pixel
+    (float32 H x W) in ``path``
+    (.npy): written through an uncompressed multilayer EXR next to it, which is removed."""
+    settings = scene.render.image_settings
+    saved = (settings.media_type, settings.exr_codec, settings.color_depth)
+    exr = path + ".exr"
+    settings.media_type = "MULTI_LAYER_IMAGE"
+    settings.exr_codec, settings.color_depth = "NONE", "32"
+    try:
+        bpy.data.images["Render Result"].save_render(exr, scene=scene)
+    finally:
+        settings.media_type = saved[0]
+        settings.exr_codec, settings.color_depth = saved[1], saved[2]
+    channels = read_exr_channels(exr)
+    os.remove(exr)
+    names = [name for name in channels if "Sample Count" in name or "SampleCount" in name]
+    if not names:
+        raise RuntimeError(f"no sample-count channel among {sorted(channels)}")
+    # Cycles writes each pixel's count divided by the render's sample count (1.0 = scene.cycles.samples)
+    np.save(path, np.rint(channels[names[0]] * scene.cycles.samples).astype(np.float32))
+
+
 def main(path: str) -> None:
     protocol = os.fdopen(os.dup(1), "w", buffering=1)
     os.dup2(2, 1)  # Blender's progress lines go to stderr
@@ -204,6 +289,7 @@ def main(path: str) -> None:
         for key, value in request.get("cycles", {}).items():  # experiments: scene.cycles attributes set last
             setattr(scene.cycles, key, value)
         scene.cycles.seed = int(request.get("seed", 0)) % 2**31  # Cycles' seed is an int32
+        scene.view_layers[0].cycles.pass_debug_sample_count = bool(request.get("sample_counts"))
         cpu, wall = time.process_time(), time.perf_counter()
         bpy.ops.render.render(write_still=False)
         wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
@@ -212,6 +298,8 @@ def main(path: str) -> None:
             exr = request["save"].endswith(".exr")
             settings.file_format, settings.color_depth = ("OPEN_EXR", "32") if exr else ("PNG", "8")
             bpy.data.images["Render Result"].save_render(request["save"], scene=scene)
+        if request.get("sample_counts"):
+            save_sample_counts(scene, request["sample_counts"])
         protocol.write(json.dumps({"seconds": wall, "cpu_s": cpu}) + "\n")
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     protocol.write(json.dumps({"peak_rss_mib": peak}) + "\n")
