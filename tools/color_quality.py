@@ -12,7 +12,7 @@ Scenes (built here from pybullet_data meshes, primitives and generated textures;
 - ``hdri_tabletop``: objects on a floor under a generated HDRI (sky gradient with a small, bright sun).
 
 For each scene: hybridgen's defaults (``PathTraceSettings()`` + denoising, as ``renderer.RgbRenderer``
-with no color options: stratified samples, Blackman-Harris 1.5 px pixel filter, adaptive 16..1024 spp at
+with no color options: stratified samples, Blackman-Harris 1.5 px pixel filter, adaptive 64..1024 spp at
 noise threshold 0.01 in Cycles' meaning, indirect clamp 10, filter glossy 1.0, principled lobes sampled by
 albedo, a constant world left to BSDF sampling, Cycles' roulette, 3 bounces for every lobe, OIDN; with
 ``--blenderproc-lobes`` glossy and transmission bounces 0 as Cycles renders at BlenderProc's defaults)

@@ -43,8 +43,9 @@ class RgbRenderer(Module):
               check=_optional_non_negative),
         Param("use_adaptive_sampling", "float|null", None, doc="BlenderProc 1.x's name of noise_threshold",
               check=_optional_non_negative),
-        Param("min_samples", "int", 16, "spp", "samples every pixel gets before adaptive sampling judges it "
-              "(Cycles' Min Samples)", check=positive),
+        Param("min_samples", "int", 0, "spp", "samples every pixel gets before adaptive sampling judges it "
+              "(Cycles' Min Samples); 0: Cycles' automatic value, 64 at noise threshold 0.01",
+              check=_non_negative),
         Param("clamp_indirect", "float", 10.0, doc="firefly control, Cycles' sample_clamp_indirect: indirect "
               "light of one sample is scaled down to at most this linear radiance (direct light never); 0: off",
               check=_non_negative),

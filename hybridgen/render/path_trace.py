@@ -20,7 +20,7 @@ from ..scene.scene import Scene
 from ..scene.depth_of_field import DepthOfField
 from . import (camera_hidden_emission, clamped_path, glossy_filter, pinhole_sensor, pixel_filter, thin_lens_sensor,
                transparent_shadows)
-from .adaptive_sampling import PixelTracer, SamplingPlan, render_adaptive
+from .adaptive_sampling import PixelTracer, SamplingPlan, automatic_min_samples, render_adaptive
 from .mitsuba_scene import scene_dict
 from .mitsuba_variant import activate, choose_variant, is_jit
 
@@ -57,7 +57,8 @@ class PathTraceSettings:
     ``path``, one depth limit for all lobes) rejects a value below ``max_bounces`` rather than ignoring it.
 
     Sampling (see :mod:`hybridgen.render.adaptive_sampling`): with ``samples`` not given, every pixel is
-    sampled adaptively from ``min_samples`` until its noise estimate is below ``noise_threshold`` (default
+    sampled adaptively from ``min_samples`` (0, the default: Cycles' automatic minimum for the threshold, 64 at
+    0.01) until its noise estimate is below ``noise_threshold`` (default
     :data:`DEFAULT_NOISE_THRESHOLD`) or it has :data:`DEFAULT_MAX_SAMPLES`. An explicit ``samples: N`` is a
     plain N-spp estimate in every pixel, unless ``noise_threshold`` is given too: then N is the maximum
     (Cycles' meaning of samples with adaptive sampling on).
@@ -80,7 +81,7 @@ class PathTraceSettings:
     max_bounces: int = 3
     glossy_bounces: int | None = None
     noise_threshold: float | None = None
-    min_samples: int = 16
+    min_samples: int = 0
     clamp_indirect: float = 10.0
     diffuse_bounces: int | None = None
     transmission_bounces: int | None = None
@@ -107,10 +108,15 @@ class PathTraceSettings:
         """The per-pixel sample plan these settings stand for (rule in the class docstring)."""
         if self.samples is None:
             threshold = DEFAULT_NOISE_THRESHOLD if self.noise_threshold is None else self.noise_threshold
-            return SamplingPlan(DEFAULT_MAX_SAMPLES, min(self.min_samples, DEFAULT_MAX_SAMPLES), threshold)
+            return SamplingPlan(DEFAULT_MAX_SAMPLES, min(self._min_samples(threshold), DEFAULT_MAX_SAMPLES),
+                                threshold)
         threshold = self.noise_threshold or 0.0
-        return SamplingPlan(self.samples, min(self.min_samples, self.samples) if threshold else self.samples,
-                            threshold)
+        return SamplingPlan(self.samples, min(self._min_samples(threshold), self.samples) if threshold
+                            else self.samples, threshold)
+
+    def _min_samples(self, threshold: float) -> int:
+        """``min_samples``, or Cycles' automatic minimum for ``threshold`` (> 0) when it is 0."""
+        return self.min_samples if self.min_samples != 0 else automatic_min_samples(threshold)
 
     def integrator(self) -> dict[str, Any]:
         """Mitsuba's built-in ``path`` integrator with these bounces (no clamping)."""

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
-from hybridgen.render.adaptive_sampling import SamplingPlan, pixel_error
+from hybridgen.render.adaptive_sampling import SamplingPlan, automatic_min_samples, pixel_error
 from hybridgen.render.mitsuba_variant import choose_variant, is_jit
 from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
 from hybridgen.render.render_color import ColorProducer
@@ -90,7 +90,13 @@ def test_explicit_samples_are_a_plain_fixed_count_and_defaults_are_adaptive(vari
     assert not PathTraceSettings(samples=8).plan().adaptive
     default = PathTraceSettings().plan()
     assert default.adaptive and default.max_samples == 1024 and default.noise_threshold == 0.01
-    assert PathTraceSettings(samples=64, noise_threshold=0.05).plan() == SamplingPlan(64, 16, 0.05)
+    assert PathTraceSettings(samples=64, noise_threshold=0.05, min_samples=16).plan() == SamplingPlan(64, 16, 0.05)
+    # min_samples 0 (the default) is Cycles' automatic minimum: ceil(16 / threshold^0.3), at least 4, even
+    assert default.min_samples == 64
+    assert PathTraceSettings(samples=64, noise_threshold=0.05).plan() == SamplingPlan(64, 40, 0.05)
+    assert [automatic_min_samples(t) for t in (0.1, 0.01, 0.001)] == [32, 64, 128]  # Cycles' comment's values
+    assert automatic_min_samples(10.0) == 10 and automatic_min_samples(1e6) == 4  # 9 rounded up to even; floor 4
+    assert PathTraceSettings(samples=32, noise_threshold=0.001).plan().min_samples == 32  # never above samples
     scene = _half_lit_scene()
     image, counts = PathTraceView(scene, PathTraceSettings(samples=8), variant=variant).render_with_counts(
         scene.camera.keypoints[0], seed=1)
