@@ -107,7 +107,8 @@ def render_labels(scene: Scene, sinks: Iterable[FrameSink], request: LabelReques
     if render_threads > 1:
         from .threaded_labels import ThreadedLabelProducer
 
-        producer = ThreadedLabelProducer(scene, request, render_threads, default_category_id=default_category_id)
+        producer = ThreadedLabelProducer(scene, request, render_threads, producer_class=LabelProducer,
+                                         default_category_id=default_category_id)
     else:
         producer = LabelProducer(scene, request, default_category_id=default_category_id, view=view)
     return run_keypoints(scene, sinks, [producer], progress=progress, what="labels", indices=indices)

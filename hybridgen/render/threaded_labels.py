@@ -17,7 +17,7 @@ from __future__ import annotations
 import queue
 import threading
 from concurrent.futures import Future
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
@@ -27,7 +27,9 @@ from ..scene.scene import Scene
 from .gl_context import create_context
 from .label_request import LabelRequest
 from .raster import RasterView
-from .render_labels import LabelProducer
+
+if TYPE_CHECKING:  # render_labels builds this class (imported lazily there): no import cycle
+    from .render_labels import LabelProducer
 
 DEFAULT_TIMEOUT_S = 600.0
 """Longest wait for one keypoint (or for a worker's context and upload) before giving up, seconds."""
@@ -36,13 +38,13 @@ DEFAULT_TIMEOUT_S = 600.0
 class _Worker:
     """One thread owning a GL context, a raster view of the scene and a :class:`LabelProducer` on it."""
 
-    def __init__(self, build: Callable[[Any], LabelProducer], name: str) -> None:
-        self.jobs: queue.Queue[tuple[Callable[[LabelProducer], Any], Future] | None] = queue.Queue()
+    def __init__(self, build: Callable[[Any], "LabelProducer"], name: str) -> None:
+        self.jobs: queue.Queue[tuple[Callable[["LabelProducer"], Any], Future] | None] = queue.Queue()
         self.ready: Future = Future()
         self.thread = threading.Thread(target=self._run, args=(build,), name=name, daemon=True)
         self.thread.start()
 
-    def _run(self, build: Callable[[Any], LabelProducer]) -> None:
+    def _run(self, build: Callable[[Any], "LabelProducer"]) -> None:
         ctx = producer = None
         try:
             ctx = create_context()
@@ -69,28 +71,29 @@ class _Worker:
             if ctx is not None:
                 ctx.release()
 
-    def submit(self, work: Callable[[LabelProducer], Any]) -> Future:
+    def submit(self, work: Callable[["LabelProducer"], Any]) -> Future:
         result: Future = Future()
         self.jobs.put((work, result))
         return result
 
 
 class ThreadedLabelProducer:
-    """The producer of :class:`LabelProducer` (same passes, same values, same order) on ``threads`` raster
-    threads, each with its own context and upload of ``scene``. ``view_options``: keyword arguments of every
-    worker's :class:`RasterView`."""
+    """The producer ``producer_class`` (:class:`~hybridgen.render.render_labels.LabelProducer`: same passes,
+    same values, same order) on ``threads`` raster threads, each with its own context and upload of ``scene``.
+    ``view_options``: keyword arguments of every worker's :class:`RasterView`."""
 
-    def __init__(self, scene: Scene, request: LabelRequest, threads: int, *, default_category_id: int | None = None,
+    def __init__(self, scene: Scene, request: LabelRequest, threads: int, *,
+                 producer_class: type["LabelProducer"], default_category_id: int | None = None,
                  timeout: float = DEFAULT_TIMEOUT_S, **view_options: Any) -> None:
         if threads < 1:
             raise InputError(f"render_threads must be >= 1, got {threads}")
         self.timeout = float(timeout)
 
-        def build(ctx: Any) -> LabelProducer:
+        def build(ctx: Any) -> "LabelProducer":
             view = RasterView(scene, normals_space=request.normals_space, depth_background=request.depth_background,
                               ctx=ctx, **view_options)
             try:
-                return LabelProducer(scene, request, default_category_id=default_category_id, view=view)
+                return producer_class(scene, request, default_category_id=default_category_id, view=view)
             except BaseException:
                 view.release()
                 raise

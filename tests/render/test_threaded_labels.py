@@ -61,7 +61,7 @@ def test_worker_error_surfaces_unchanged_and_does_not_hang(gl_context):
             single.produce(0, np.zeros((3, 3)))  # not a 4x4 pose: fails inside the view's submit
     finally:
         single.close()
-    producer = ThreadedLabelProducer(scene, request, 2, timeout=60)
+    producer = ThreadedLabelProducer(scene, request, 2, producer_class=LabelProducer, timeout=60)
     try:
         with pytest.raises(IndexError) as raised:
             producer.produce(0, np.zeros((3, 3)))  # the same, on a worker thread
@@ -80,11 +80,12 @@ def test_construction_error_surfaces_as_the_same_one_line_error(gl_context):
         render_labels(hg.Scene(), [MemorySink()], hg.LabelRequest(depth=True), render_threads=2)
     assert str(single.value) == str(threaded.value)
     with pytest.raises(InputError, match="render_threads"):
-        ThreadedLabelProducer(_scene(), hg.LabelRequest(depth=True), 0)
+        ThreadedLabelProducer(_scene(), hg.LabelRequest(depth=True), 0, producer_class=LabelProducer)
 
 
 def test_a_worker_that_never_answers_raises_instead_of_hanging(gl_context):
-    producer = ThreadedLabelProducer(_scene(), hg.LabelRequest(depth=True), 1, timeout=0.5)
+    producer = ThreadedLabelProducer(_scene(), hg.LabelRequest(depth=True), 1, producer_class=LabelProducer,
+                                     timeout=0.5)
     try:
         blocker = producer.workers[0].submit(lambda _: __import__("time").sleep(3))
         with pytest.raises(hg.errors.SystemSetupError, match="no answer for keypoint 0"):
