@@ -19,6 +19,8 @@ from typing import Any
 
 import numpy as np
 
+from . import pinhole_sensor
+
 PLUGIN_NAME = "hybridgen_thinlens"
 
 
@@ -40,11 +42,9 @@ def register(variant: str) -> None:
         x, y = aperture.x + shift_x, aperture.y + shift_y
         return mi.Point2f(x - dr.floor(x), y - dr.floor(y))
 
-    class ThinLensSensor(mi.Sensor):  # type: ignore[misc, name-defined]
+    class ThinLensSensor(pinhole_sensor.sensor_base(variant)):  # type: ignore[misc]
         def __init__(self, props: Any) -> None:
             super().__init__(props)
-            self.fx, self.fy, self.cx, self.cy = (float(props.get(k)) for k in ("fx", "fy", "cx", "cy"))
-            self.near, self.far = float(props.get("near_clip")), float(props.get("far_clip"))
             self.radius = float(props.get("aperture_radius"))
             self.fixed_focus = float(props.get("focus_distance"))
             self.focus_point = (np.array([float(props.get(f"focus_{axis}")) for axis in "xyz"])
@@ -57,29 +57,15 @@ def register(variant: str) -> None:
             focus = self.fixed_focus
             if self.focus_point is not None:  # Blender's focus object: its depth along the view axis
                 focus = max(abs(float(pose[:3, 2] @ (pose[:3, 3] - self.focus_point))), 1e-6)
-            self.rotation = mi.Matrix3f(pose[:3, :3].tolist())
-            self.origin = mi.Point3f(*pose[:3, 3].tolist())
             self.focus = mi.Float(focus)
-            dr.make_opaque(self.rotation, self.origin, self.focus)
+            self.set_pose_opaque(pose, self.focus)
 
         def sample_ray(self, time: Any, sample1: Any, sample2: Any, sample3: Any, active: Any = True) -> Any:
-            size = self.film().size()
-            x = sample2.x * size.x - 0.5
-            y = sample2.y * size.y - 0.5
-            focus = mi.Vector3f((x - self.cx) / self.fx, (y - self.cy) / self.fy, 1.0) * self.focus
+            focus = self.camera_direction(sample2) * self.focus
             lens = mi.warp.square_to_uniform_disk_concentric(_decorrelated(sample3, sample2)) * self.radius
             local = dr.normalize(focus - mi.Vector3f(lens.x, lens.y, 0.0))
-            inv_z = dr.rcp(local.z)
-            direction = self.rotation @ local
             start = self.origin + self.rotation @ mi.Vector3f(lens.x, lens.y, 0.0)
-            ray = mi.Ray3f(start + direction * (self.near * inv_z), direction, (self.far - self.near) * inv_z,
-                           time, [])
-            return ray, mi.Color3f(1.0)
-
-        def sample_ray_differential(self, time: Any, sample1: Any, sample2: Any, sample3: Any,
-                                    active: Any = True) -> Any:
-            ray, weight = self.sample_ray(time, sample1, sample2, sample3, active)
-            return mi.RayDifferential3f(ray), weight
+            return self.clipped_ray(start, local, time), mi.Color3f(1.0)
 
         def to_string(self) -> str:
             return f"HybridgenThinLens[fx={self.fx}, fy={self.fy}, aperture_radius={self.radius}]"
