@@ -223,11 +223,14 @@ class PixelTracer:
 
 def pattern_size(spp: int, sampler: str) -> int:
     """The sample count to give ``sampler`` for a launch of ``spp`` samples per pixel: the low-discrepancy
-    sampler's patterns have 4^k points (it warns and rounds up otherwise); a launch of 2^(2k+1) samples takes
-    half of a 4^(k+1)-point pattern (a random half: the sampler shuffles the sample order per dimension;
-    measured on the tabletop scene, as clean as splitting it into two full 4^k patterns)."""
+    sampler's patterns have 4^k points, k >= 1 (it warns and rounds up otherwise, 1 to 4); a launch of
+    2^(2k+1) samples takes half of a 4^(k+1)-point pattern (a random half: the sampler shuffles the sample
+    order per dimension; measured on the tabletop scene, as clean as splitting it into two full 4^k
+    patterns), a launch of 1 sample a quarter of a 4-point pattern."""
     if sampler != "LowDiscrepancySampler" or spp & (spp - 1):
         return spp
+    if spp == 1:
+        return 4
     return spp if spp.bit_length() % 2 == 1 else spp * 2
 
 

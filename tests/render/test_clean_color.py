@@ -316,7 +316,15 @@ def test_stratified_sampler_launches_power_of_two_patterns(variant):
     assert launch_counts(100, "LowDiscrepancySampler") == [64, 32, 4]
     assert launch_counts(7, "LowDiscrepancySampler") == [4, 2, 1]
     assert launch_counts(100, "IndependentSampler") == [100]
-    assert [pattern_size(n, "LowDiscrepancySampler") for n in (1, 2, 16, 32, 512, 1024)] == [1, 4, 16, 64, 1024, 1024]
+    assert [pattern_size(n, "LowDiscrepancySampler") for n in (1, 2, 16, 32, 512, 1024)] == [4, 4, 16, 64, 1024, 1024]
+    import mitsuba as mi
+
+    from hybridgen.render.mitsuba_variant import activate
+
+    activate(variant)
+    for n in (1, 2, 4, 8, 16, 32):  # Mitsuba takes each pattern size as it is (no rounding, no warning)
+        size = pattern_size(n, "LowDiscrepancySampler")
+        assert mi.load_dict({"type": "ldsampler", "sample_count": size}).sample_count() == size
     if not is_jit(variant):
         pytest.skip("pixel launches are the JIT variants' tracer")
     scene = _half_lit_scene()
