@@ -301,6 +301,7 @@ def dataset_standins(text: str, work: Path) -> dict[int, str]:
         out.update({i: str(room) for i in _args_of(text, "file_path")})
         out.update({i: str(textures) for i in _args_of(text, "texture_folder")})
     out.update(room_dataset_standins(text, work))
+    out.update(amass_standin(text, work))
     return out
 
 
@@ -363,6 +364,52 @@ def room_dataset_standins(text: str, work: Path) -> dict[int, str]:
         scene_mesh.export(work / "replica" / name / "mesh.ply")
         out.update({i: str(work / "replica") for i in _args_of(text, "data_path")})
     return out
+
+
+def amass_standin(text: str, work: Path) -> dict[int, str]:
+    """An AMASS folder for loader.AMASSLoader: taxonomy.json, <sub-dataset>/<sub-dataset>/<subject>/
+    <subject>_<sequence>_poses.npz (zero poses, enough frames for the config's frame_id) and SMPL-H/DMPL models
+    of the three genders: a stick body of SMPL-H's 52 joints, a 4 cm box per joint fully weighted to it.
+    Returns {argument index: path}."""
+    import json
+
+    import numpy as np
+
+    if "loader.AMASSLoader" not in text:
+        return {}
+    root = work / "AMASS"
+    sub = (re.findall(r'"sub_dataset_id"\s*:\s*"(\w+)"', text) or ["CMU"])[0]
+    subject = int((re.findall(r'"subject_id"\s*:\s*"?(\d+)', text) or ["1"])[0])
+    sequence = int((re.findall(r'"sequence_id"\s*:\s*"?(\d+)', text) or ["1"])[0])
+    frames = int((re.findall(r'"frame_id"\s*:\s*"?(\d+)', text) or ["0"])[0]) + 1
+    folder = root / sub / sub / f"{subject:02d}"
+    folder.mkdir(parents=True, exist_ok=True)
+    (root / "taxonomy.json").write_text(json.dumps([{"sub_data_id": sub, "path": f"{sub}/{sub}"}]))
+    np.savez(folder / f"{subject:02d}_{sequence:02d}_poses.npz", poses=np.zeros((frames, 156), np.float32),
+             betas=np.zeros(16), trans=np.zeros((frames, 3)))
+    parents = [0, 0, 0, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 9, 9, 12, 13, 14, 16, 17, 18, 19]
+    parents += [wrist if k % 3 == 0 else first + k - 1 for wrist, first in ((20, 22), (21, 37)) for k in range(15)]
+    steps = {1: (0.1, -0.1), 2: (-0.1, -0.1), 4: (0.0, -0.4), 5: (0.0, -0.4), 7: (0.0, -0.4), 8: (0.0, -0.4),
+             16: (0.2, 0.0), 17: (-0.2, 0.0), 18: (0.25, 0.0), 19: (-0.25, 0.0), 20: (0.25, 0.0),
+             21: (-0.25, 0.0)}  # (x, y) from the parent, metres, SMPL's y up; others 0.12 up or along the hand
+    joints = np.zeros((52, 3))
+    for j in range(1, 52):
+        step = steps.get(j, (0.0, 0.12) if j < 22 else (0.03 if parents[j] == 20 or j < 37 else -0.03, 0.0))
+        joints[j] = joints[parents[j]] + [step[0], step[1], 0.0]
+    joints[:, 1] -= joints[:, 1].min()
+    box = np.array([[x, y, z] for x in (-0.02, 0.02) for y in (-0.02, 0.02) for z in (-0.02, 0.02)])
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    box_faces = np.array([t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))])
+    count = 52 * 8
+    model = {"v_template": (joints[:, None] + box[None]).reshape(-1, 3),
+             "f": np.concatenate([box_faces + 8 * j for j in range(52)]), "shapedirs": np.zeros((count, 3, 16)),
+             "posedirs": np.zeros((count, 3, 459)), "weights": np.repeat(np.eye(52), 8, axis=0),
+             "J_regressor": np.repeat(np.eye(52), 8, axis=1) / 8, "kintree_table": np.array([parents, range(52)])}
+    for gender in ("male", "female", "neutral"):
+        for kind, arrays in (("smplh", model), ("dmpls", {"eigvec": np.zeros((count, 3, 8))})):
+            (root / "body_models" / kind / gender).mkdir(parents=True, exist_ok=True)
+            np.savez(root / "body_models" / kind / gender / "model.npz", **arrays)
+    return {i: str(root) for i in _args_of(text, "data_path")}
 
 
 BOP_NAME = "lm"

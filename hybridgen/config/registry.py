@@ -98,6 +98,7 @@ _BUILTIN_NAMES = {
     "object.CalibrationboardSampler": "hybridgen.modules.calibration_board",
     "loader.TextureLoader": "hybridgen.modules.texture_loader",
     "object.Shading": "hybridgen.modules.shading",
+    "loader.AMASSLoader": "hybridgen.modules.amass_loader",
 }
 """Built-in module name -> the file registering it: :func:`get_module` imports that file alone (importing all
 of them costs ~0.2 s of every run's start); a name missing here, or a plugin's, loads every module first."""

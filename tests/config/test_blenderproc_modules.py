@@ -52,13 +52,13 @@ def test_a_registered_module_wins_over_its_unavailable_entry(monkeypatch):
     """A loader added since (or a plugin) under a name listed as unavailable is the module that runs."""
     from hybridgen.config import registry
 
-    name = "loader.AMASSLoader"  # (loader.Pix3DLoader was the example until it was added)
+    name = "writer.StereoGlobalMatchingWriter"  # (loader.Pix3DLoader, then loader.AMASSLoader were the example)
     assert name in UNAVAILABLE
     all_modules()
     if name not in registry.MODULES:
         with pytest.raises(ConfigError, match="not available in hybridgen"):
             get_module(name)
-    stand_in = type("AmassStandIn", (), {})
+    stand_in = type("SgmStandIn", (), {})
     monkeypatch.setitem(registry.MODULES, name, stand_in)
     assert unavailable_reason(name) is None and get_module(name) is stand_in
 

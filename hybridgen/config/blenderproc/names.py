@@ -28,8 +28,6 @@ UNAVAILABLE = {
                               "with a selector for the lamp objects",
     "camera.SuncgCameraSampler": "samples cameras inside SUNCG rooms (a withdrawn dataset); use "
                                  "camera.CameraSampler with proximity_checks",
-    "loader.AMASSLoader": "posing SMPL bodies needs the AMASS data and the SMPL body model (licensed, not "
-                          "distributable); export posed bodies to OBJ and load them with loader.ObjLoader",
     "loader.RockEssentialsRockLoader": "reads Blender .blend rock packs; " + _EXPORT,
     "constructor.RockEssentialsGroundConstructor": "builds Blender node-displaced ground; use "
                                                    "loader.PrimitiveLoader (plane) with a texture",
