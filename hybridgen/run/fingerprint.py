@@ -5,8 +5,10 @@ writes. Its keys are
 
 - ``hybridgen_version``;
 - ``config:<module>#<index>.<key path>`` for every leaf of the resolved config (after ``<args:N>`` and
-  environment substitution). Keys named ``output_dir`` are left out: where a run writes does not change
-  what it writes, so a moved output folder still resumes;
+  environment substitution). Keys in :data:`IGNORED_KEYS` are left out: ``output_dir`` (where a run writes
+  does not change what it writes, so a moved output folder still resumes) and ``render_threads`` (how many
+  raster threads compute the labels; the values are the same, ``tests/render/test_threaded_labels.py``), so
+  a run resumes with another thread count;
 - ``input:<path>`` -> SHA-256 of each file the config names: a string value that is an existing file, a
   glob that matches files, or the files directly in a named folder (relative to the working directory,
   else to the config's folder, as modules read them), plus the MTL files an OBJ names and the texture
@@ -32,7 +34,8 @@ from ..io.mesh_references import referenced_files
 from .input_hashes import InputHashes
 
 FINGERPRINT_ATTR = "fingerprint"
-IGNORED_KEYS = ("output_dir",)
+IGNORED_KEYS = ("output_dir", "render_threads")
+"""Config keys that change where or how a run computes, not what it writes (left out of the fingerprint)."""
 MAX_FOLDER_FILES = 10_000  # files hashed per named folder
 _LONG_VALUE = 200  # leaf values longer than this (in JSON) are stored as their SHA-256
 

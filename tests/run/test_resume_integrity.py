@@ -181,6 +181,21 @@ def test_single_file_run_resumes_verifies_and_refuses(gl_context, tmp_path, writ
     assert (out / "data.hdf5").read_bytes() == first
 
 
+def test_a_run_resumes_with_another_raster_thread_count(gl_context, tmp_path, write_config, run_cli):
+    """render_threads changes how labels are computed, not their values: not part of the fingerprint."""
+    config = write_config(SINGLE.replace("SEED", "1"))
+    out = tmp_path / "out"
+    assert run_cli("run", "-q", str(config), str(out))[0] == 0
+    first = (out / "data.hdf5").read_bytes()
+    threaded = write_config(SINGLE.replace("SEED", "1").replace("{render_normals: false}",
+                                                                 "{render_normals: false, render_threads: 2}"),
+                            "threaded.yaml")
+    assert "render_threads: 2" in threaded.read_text()
+    code, out_text, err = run_cli("run", str(threaded), str(out))
+    assert code == 0 and "nothing to do" in err and "0 keypoint(s)" in out_text
+    assert (out / "data.hdf5").read_bytes() == first
+
+
 def test_changed_input_file_is_named(gl_context, tmp_path, write_config, run_cli):
     """Editing the MTL an OBJ names (not named by the config itself) is caught and named."""
     mesh, mtl = tmp_path / "thing.obj", tmp_path / "thing.mtl"
