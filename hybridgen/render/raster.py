@@ -291,10 +291,11 @@ class RasterView:
                  for draw in self._object_uniforms(cam2world, world2cam, near_reach, hidden)]
         frame_uniforms = {"u_projection": projection.tobytes(),
                           "u_cam_to_output": to_output.T.astype(np.float32).tobytes()}
-        members = {id(draw[0]): set(draw[0]) for draw in draws}
-        for program in {id(draw[0]): draw[0] for draw in draws}.values():
+        programs = {id(draw[0]): draw[0] for draw in draws}  # the few distinct programs of this keypoint
+        members = {key: set(program) for key, program in programs.items()}  # their uniform names, once each
+        for key, program in programs.items():
             for name, value in frame_uniforms.items():
-                if name in members[id(program)]:  # a packed variant without normals has no normal uniforms
+                if name in members[key]:  # a packed variant without normals has no normal uniforms
                     program[name].write(value)
         for prog, vao, gpu, modelview, normal_to_cam, cull, front_face, placement in draws:
             commands = None
@@ -341,8 +342,7 @@ class RasterView:
         intr, targets, queued = self._submitted.pop(slot)
         width, height = intr.width, intr.height
         key = (slot, width, height, targets)
-        dtypes = {"f4": np.float32, "u1": np.uint8, "u2": np.uint16, "u4": np.uint32}
-        arrays = {name: np.empty((height, width, components) if components > 1 else (height, width), dtypes[kind])
+        arrays = {name: np.empty((height, width, components) if components > 1 else (height, width), np.dtype(kind))
                   for name, components, kind in _attachments(targets)}
         for attachment, (name, components, kind) in enumerate(_attachments(targets)):
             if queued:
