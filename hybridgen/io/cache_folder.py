@@ -3,7 +3,7 @@
 ``$HYBRIDGEN_CACHE_DIR``, else ``$XDG_CACHE_HOME/hybridgen``, else ``~/.cache/hybridgen``. Parsed meshes
 (:mod:`hybridgen.io.mesh_cache`), input-file hashes (:mod:`hybridgen.run.input_hashes`) and convex
 decompositions (:mod:`hybridgen.physics.shapes`) live in it. ``HYBRIDGEN_CACHE_DIR=off`` (or ``0``, ``none``)
-turns the mesh and input-hash caches off. Nothing here imports more than the standard library, so every
+turns all three off. Nothing here imports more than the standard library, so every
 layer (io, run, physics) can use it.
 """
 from __future__ import annotations

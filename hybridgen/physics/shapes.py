@@ -3,7 +3,7 @@ disk) and the mass properties of the resulting solid.
 
 A decomposition is computed once per mesh and parameter set and cached under
 ``$HYBRIDGEN_CACHE_DIR`` (default ``$XDG_CACHE_HOME/hybridgen`` or ``~/.cache/hybridgen``), in
-``coacd/<sha256>.npz``; the key hashes the mesh's vertex and face bytes (object frame, before any scale),
+``coacd/<sha256>.npz`` (nothing is cached with ``HYBRIDGEN_CACHE_DIR=off``); the key hashes the mesh's vertex and face bytes (object frame, before any scale),
 the CoACD parameters and CoACD's version. Scale and shear of an object's pose are applied to the parts
 afterwards (a linear map keeps a convex part convex), so the cache serves every scale of a mesh.
 """
@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError, SystemSetupError
-from ..io.cache_folder import cache_root
+from ..io.cache_folder import cache_path, cache_root
 
 SHAPES = ("convex_hull", "convex_decomposition", "auto", "mesh")
 """Collision shape kinds: ``mesh`` (the exact triangles) is only possible for passive (static) objects."""
@@ -163,8 +163,9 @@ def convex_decomposition(vertices: np.ndarray, faces: np.ndarray, settings: Deco
     settings = settings or DecompositionSettings()
     vertices = np.ascontiguousarray(vertices, dtype=np.float64)
     faces = np.ascontiguousarray(faces, dtype=np.int64)
-    path = cache_dir() / "coacd" / f"{decomposition_key(vertices, faces, settings)}.npz"
-    if use_cache and path.is_file():
+    folder = cache_path("coacd") if use_cache else None  # None: HYBRIDGEN_CACHE_DIR=off or use_cache=False
+    path = folder / f"{decomposition_key(vertices, faces, settings)}.npz" if folder is not None else None
+    if path is not None and path.is_file():
         try:
             with np.load(path) as data:
                 v_counts, f_counts = data["vertex_counts"], data["face_counts"]
@@ -187,7 +188,7 @@ def convex_decomposition(vertices: np.ndarray, faces: np.ndarray, settings: Deco
     parts = [(np.asarray(v, dtype=np.float64), np.asarray(f, dtype=np.int64)) for v, f in result if len(f)]
     if not parts:
         raise InputError("convex decomposition (CoACD) returned no parts")
-    if use_cache:
+    if path is not None:
         path.parent.mkdir(parents=True, exist_ok=True)
         temporary = path.with_name(f".{path.stem}.{os.getpid()}.tmp.npz")
         np.savez(temporary, vertices=np.concatenate([v for v, _ in parts]),

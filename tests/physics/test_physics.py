@@ -184,6 +184,15 @@ def test_convex_decomposition_lets_an_object_into_a_cavity_and_is_cached(tmp_pat
         assert part.convex_hull.volume == pytest.approx(part.volume, rel=1e-6)
 
 
+def test_convex_decomposition_caches_nothing_when_the_cache_is_off(tmp_path, monkeypatch):
+    monkeypatch.setenv("HYBRIDGEN_CACHE_DIR", "off")
+    monkeypatch.chdir(tmp_path)  # "off" once named a folder in the working directory
+    cup_mesh = u_shape()
+    parts = convex_decomposition(cup_mesh.vertices, cup_mesh.faces, FAST_DECOMPOSITION)
+    assert 2 <= len(parts) <= 8
+    assert list(tmp_path.rglob("*")) == []
+
+
 def test_physics_errors_name_the_module(write_config, run_cli):
     base = """
 modules:
