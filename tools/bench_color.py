@@ -1,7 +1,8 @@
 """Color rendering: hybridgen vs a bare Mitsuba script on the same scene, and vs Blender Cycles (one run).
 
 Run: .venv/bin/python tools/bench_color.py [--res 640x480] [--spp 64] [--bounces 6] [--no-cycles] [--quick]
-     .venv/bin/python tools/bench_color.py --quality [--res 320x240] [--reference-spp 4096] (see color_quality.py)
+     .venv/bin/python tools/bench_color.py --quality [--res 320x240] [--reference-spp 4096] [--scenes a,b]
+         (defaults vs Cycles at BlenderProc's defaults, the issue's settings; see color_quality.py)
 
 Scene: a closed 6 x 6 x 3 m room (floor, four walls, emissive ceiling), 20 primitives and a 100,000-triangle
 torus knot; 8 camera poses inside the room (everything seeded).
@@ -449,7 +450,13 @@ def main() -> None:
                         "BlenderProc's glossy_bounces 0 / transmission_bounces 0, the light paths Cycles renders")
     parser.add_argument("--scenes", default="", help="quality mode: comma-separated scene names (default all)")
     parser.add_argument("--out", default=str(REPO / "output" / "bench_color_quality"),
-                        help="quality mode: folder for side-by-side PNGs")
+                        help="quality mode: folder for side-by-side PNGs and the rows (JSON)")
+    parser.add_argument("--warm-runs", type=int, default=1, help="quality mode: timed (warm-cache) hybridgen "
+                        "processes per scene, median (after one cold run)")
+    parser.add_argument("--reference-cache", default=None, help="quality mode: folder of the reference cache "
+                        "(default $HYBRIDGEN_BENCH_CACHE or ~/.cache/hybridgen/bench_color; 'off': none)")
+    parser.add_argument("--precompute", choices=("cycles", "hybridgen", "all"), default=None,
+                        help="quality mode: only render the missing references of these engines into the cache")
     args = parser.parse_args()
     if args.quality:
         import color_quality

@@ -1,8 +1,6 @@
 """Quality mode of tools/bench_color.py: hybridgen's default color vs Blender Cycles at BlenderProc 2.8's
 defaults, each scored against its own converged reference.
 
-Run: .venv/bin/python tools/bench_color.py --quality [--res 320x240] [--reference-spp 4096] [--scenes a,b]
-
 Scenes (built here from pybullet_data meshes, primitives and generated textures; one keypoint each):
 - ``tabletop``: textured duck, bunny, football and a glossy (roughness 0.2) mug-like cylinder on a floor, one
   point light (the issue's scene);
@@ -11,31 +9,51 @@ Scenes (built here from pybullet_data meshes, primitives and generated textures;
   a sky (world color) through the window only;
 - ``hdri_tabletop``: objects on a floor under a generated HDRI (sky gradient with a small, bright sun).
 
+Run: .venv/bin/python tools/bench_color.py --quality   (the issue's settings: 320x240, 4096-spp references)
+     .venv/bin/python tools/bench_color.py --quality [--res 160x120] [--reference-spp 2048] [--scenes a,b]
+     nice -n 10 .venv/bin/python tools/bench_color.py --quality --precompute cycles   (only fill the cache)
+
 For each scene: hybridgen's defaults (``PathTraceSettings()`` + denoising, as ``renderer.RgbRenderer``
 with no color options: stratified samples, Blackman-Harris 1.5 px pixel filter, adaptive 64..1024 spp at
 noise threshold 0.01 in Cycles' meaning, indirect clamp 10, filter glossy 1.0, principled lobes sampled by
 albedo, a constant world left to BSDF sampling, Cycles' roulette, 3 bounces for every lobe, OIDN; with
-``--blenderproc-lobes`` glossy and transmission bounces 0 as Cycles renders at BlenderProc's defaults)
-timed from scene load to the finished sRGB frame (scene translation, kernel compilation with a warm cache,
-raster guides, render, denoise) in this process; its reference is the same estimator at a fixed
+``--blenderproc-lobes`` glossy and transmission bounces 0 as Cycles renders at BlenderProc's defaults),
+timed as the issue asks: the WHOLE process (tools/default_color_process.py: Python's start, ``import
+hybridgen``, the scene built from its mesh files, Mitsuba, kernels, raster guides, render, denoise, the PNG
+written), wall clock from spawn to exit and CPU from the child's rusage. The first run of each scene gets
+fresh Dr.Jit kernel and hybridgen mesh caches (a new user: reported as "cold"); the timed runs
+(``--warm-runs``, median) reuse them, as a user's runs after the first. The in-process time of
+``render_color`` is reported beside it. hybridgen's reference is the same estimator at a fixed
 ``--reference-spp`` without denoising (and once more without the clamp, to measure the clamp's bias).
-Cycles (pip ``bpy`` in ``.venv-bpy``) renders with BlenderProc's defaults (``mode: blenderproc`` in
-tools/cycles_render.py; its render time only, scene sync excluded) and its reference at the same spp
-with ``mode: reference``. PSNR is computed on the 8-bit sRGB images (the ``colors`` users get).
-Side-by-side PNGs (hybridgen | its reference | Cycles | its reference) go to ``--out``.
+Cycles (pip ``bpy`` in ``.venv-bpy``, 2 threads on this 2-core machine: the machine's core count) renders
+with BlenderProc's defaults (``mode: blenderproc`` in tools/cycles_render.py), timed as its render only
+(``bpy.ops.render.render``: Cycles' scene sync, BVH, render and denoise; building the Blender scene from the
+export is not counted), and its reference at the same spp with ``mode: reference``. PSNR is computed on the
+8-bit sRGB images (the ``colors`` users get). References come from the on-disk cache of
+tools/reference_cache.py when their key matches (``--reference-cache PATH|off``). Side-by-side PNGs (hybridgen
+| its reference | Cycles | its reference) and the rows as JSON go to ``--out``.
 
-The machine is shared: times are wall-clock under whatever load there is; hybridgen and Cycles alternate
-scene by scene.
+The machine is shared: times are wall-clock under whatever load there is (the load average is printed at
+start and end; CPU seconds are steadier); hybridgen and Cycles alternate scene by scene (ABBA).
 """
 from __future__ import annotations
 
 import json
 import math
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from default_color_process import LOBES
+from reference_cache import ReferenceCache, cache_root, code_digest, estimator_digest, scene_digest
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -211,45 +229,11 @@ def build(name: str, width: int, height: int, workdir: Path) -> Any:
         return hdri_tabletop(width, height, workdir)
     return {"tabletop": tabletop, "materials": materials, "window_room": window_room}[name](width, height)
 
-
 # ------------------------------------------------------------------------------------------ scoring
 def psnr(image: np.ndarray, reference: np.ndarray) -> float:
     """PSNR (dB) of two 8-bit sRGB images."""
     mse = float(np.mean((image.astype(np.float64) - reference.astype(np.float64)) ** 2))
     return float("inf") if mse == 0 else 10 * math.log10(255.0 ** 2 / mse)
-
-
-BLENDERPROC_LOBES = {"glossy_bounces": 0, "transmission_bounces": 0}
-"""``--blenderproc-lobes``: BlenderProc's per-lobe limits (hybridgen's default is max_bounces for every lobe),
-so that hybridgen estimates the same light paths as Cycles at BlenderProc's defaults."""
-LOBES: dict[str, int] = {}
-
-
-def hybridgen_default(scene: Any, seed: int,
-                      threshold: float | None = None) -> tuple[np.ndarray, float, float, float]:
-    """sRGB frame with hybridgen's defaults (``threshold`` overrides the noise threshold, for tuning), seconds
-    from scene load to the frame (wall clock, and CPU time of this process's threads), mean samples per
-    pixel."""
-    from hybridgen.render.path_trace import PathTraceSettings
-    from hybridgen.render.render_color import ColorProducer
-
-    start, cpu = time.perf_counter(), time.process_time()
-    producer = ColorProducer(scene, PathTraceSettings(noise_threshold=threshold, **LOBES), seed=seed, denoise=True,
-                             sample_counts=True)
-    frame = producer.produce(0, scene.camera.keypoints[0])
-    seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
-    producer.close()
-    return frame["colors"], seconds, float(frame["sample_counts"].mean()), cpu
-
-
-def hybridgen_reference(scene: Any, spp: int, clamp: float) -> tuple[np.ndarray, float]:
-    from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
-    from hybridgen.render.tonemap import to_srgb8
-
-    start = time.perf_counter()
-    view = PathTraceView(scene, PathTraceSettings(samples=spp, clamp_indirect=clamp, **LOBES))
-    image = view.render(scene.camera.keypoints[0], seed=12345)
-    return to_srgb8(image), time.perf_counter() - start
 
 
 def _read_png(path: Path) -> np.ndarray:
@@ -258,64 +242,304 @@ def _read_png(path: Path) -> np.ndarray:
     return np.asarray(Image.open(path).convert("RGB"))
 
 
-def run_quality(args: Any, bpy_python: Path | None) -> list[dict[str, Any]]:
+# -------------------------------------------------------------------------------------- references
+REFERENCE_SEED = 12345
+"""Seed of both engines' references (the measured renders use seed 1)."""
+CLAMP = 10.0
+"""hybridgen's default indirect clamp, the value its reference is rendered with (and 0 for the clamp bias)."""
+
+
+def hybridgen_reference(scene: Any, spp: int, clamp: float, lobes: dict[str, int]) -> tuple[np.ndarray, float]:
+    """hybridgen's own estimator at a fixed ``spp`` (no adaptivity, no denoising) with indirect clamp ``clamp``
+    (0: off): the sRGB frame and its wall seconds, in this process."""
+    from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+    from hybridgen.render.tonemap import to_srgb8
+
+    start = time.perf_counter()
+    view = PathTraceView(scene, PathTraceSettings(samples=spp, clamp_indirect=clamp, **lobes))
+    image = view.render(scene.camera.keypoints[0], seed=REFERENCE_SEED)
+    return to_srgb8(image), time.perf_counter() - start
+
+
+def bpy_version(python: Path) -> str:
+    """The ``bpy`` package version of the bpy venv's ``python`` (without importing Blender)."""
+    done = subprocess.run([str(python), "-c", "import importlib.metadata as m; print(m.version('bpy'))"],
+                          capture_output=True, text=True, check=True)
+    return done.stdout.strip()
+
+
+class CyclesSession:
+    """tools/cycles_render.py on one exported scene, started on first use (cached references need none)."""
+
+    def __init__(self, python: Path, npz: Path) -> None:
+        self.python, self.npz = python, npz
+        self.worker: Any = None
+
+    def render(self, seed: int, png: Path, **request: Any) -> dict[str, Any]:
+        """Keypoint 0 rendered into ``png``; ``request``: ``mode``, ``spp`` (tools/cycles_render.py)."""
+        from bench_color import CyclesWorker
+
+        if self.worker is None:
+            self.worker = CyclesWorker(self.python, self.npz)
+        return self.worker.render(0, False, seed, png, **request)
+
+    def close(self) -> None:
+        if self.worker is not None:
+            self.worker.close()
+
+
+class References:
+    """Both engines' ``spp`` references of the scenes at ``resolution`` from the :class:`ReferenceCache`, or
+    rendered and stored (keys: tools/reference_cache.py)."""
+
+    def __init__(self, cache: ReferenceCache, spp: int, resolution: str, lobes: str, bpy_python: Path | None,
+                 workdir: Path) -> None:
+        from importlib.metadata import version
+
+        self.cache, self.spp, self.resolution, self.lobes, self.workdir = cache, spp, resolution, lobes, workdir
+        self.hybridgen_code = {"estimator": estimator_digest(), "mitsuba": version("mitsuba"),
+                               "drjit": version("drjit")}
+        self.cycles_code = {"bpy": bpy_version(bpy_python) if bpy_python else None,
+                            "cycles_render": code_digest(REPO / "tools" / "cycles_render.py")}
+
+    def _key(self, name: str, content: str) -> dict[str, Any]:
+        return {"scene": name, "resolution": self.resolution, "spp": self.spp, "seed": REFERENCE_SEED,
+                "content": content}
+
+    def hybridgen(self, name: str, scene: Any, content: str, clamp: float) -> tuple[np.ndarray, dict[str, Any]]:
+        """hybridgen's reference with indirect clamp ``clamp`` (and the record: seconds, cached)."""
+        key = {**self._key(name, content), "clamp_indirect": clamp, "lobes": self.lobes, **self.hybridgen_code}
+
+        def render() -> tuple[np.ndarray, dict[str, Any]]:
+            image, seconds = hybridgen_reference(scene, self.spp, clamp, LOBES[self.lobes])
+            return image, {"seconds": seconds}
+
+        return self.cache.fetch("hybridgen", key, render)
+
+    def cycles(self, name: str, content: str, session: CyclesSession) -> tuple[np.ndarray, dict[str, Any]]:
+        """Cycles' reference (BlenderProc's estimator at a fixed spp, ``mode: reference``) and its record."""
+        key = {**self._key(name, content), "mode": "reference", "light_tree": False, **self.cycles_code}
+
+        def render() -> tuple[np.ndarray, dict[str, Any]]:
+            png = self.workdir / f"{name}_cycles_ref.png"
+            answer = session.render(REFERENCE_SEED, png, mode="reference", spp=self.spp)
+            return _read_png(png), {"seconds": answer["seconds"], "cpu_s": answer["cpu_s"],
+                                    "blender": session.worker.hello["blender"]}
+
+        return self.cache.fetch("cycles", key, render)
+
+
+# ------------------------------------------------------------------------------ whole-process timing
+@dataclass(frozen=True)
+class Finished:
+    """A finished child process: its last JSON line, wall seconds from spawn to reaping, and CPU seconds
+    (user + system, from its rusage: every thread, and its own children once it waited for them)."""
+
+    report: dict[str, Any]
+    wall: float
+    cpu: float
+
+
+def run_timed(command: list[str], env: dict[str, str]) -> Finished:
+    """Runs ``command`` to its end; raises RuntimeError with its output's tail if it fails."""
+    with tempfile.TemporaryFile() as output:
+        start = time.perf_counter()
+        child = subprocess.Popen(command, stdout=output, stderr=subprocess.STDOUT, env=env)
+        _, status, usage = os.wait4(child.pid, 0)  # this child's own rusage (RUSAGE_CHILDREN mixes in others)
+        wall = time.perf_counter() - start
+        child.returncode = os.waitstatus_to_exitcode(status)
+        output.seek(0)
+        lines = output.read().decode(errors="replace").strip().splitlines()
+    if child.returncode != 0:
+        raise RuntimeError(f"`{' '.join(command)}` failed (exit {child.returncode}):\n  " + "\n  ".join(lines[-8:]))
+    report = next(json.loads(line) for line in reversed(lines) if line.startswith("{"))
+    return Finished(report, wall, usage.ru_utime + usage.ru_stime)
+
+
+class DefaultRuns:
+    """hybridgen's default render of one scene as whole processes (tools/default_color_process.py) that share
+    fresh caches (Dr.Jit's kernels, hybridgen's parsed meshes): the first run is a new user's (cold), the
+    next ones a returning user's (warm). Byte-compiled sources are used and written as by an installed
+    package (``PYTHONDONTWRITEBYTECODE`` is dropped)."""
+
+    def __init__(self, name: str, resolution: str, workdir: Path, lobes: str) -> None:
+        self.name, self.resolution, self.workdir, self.lobes = name, resolution, workdir, lobes
+        self.caches = Path(tempfile.mkdtemp(prefix=f"{name}-caches-", dir=workdir))
+        self.env = {**os.environ, "DRJIT_CACHE_DIR": str(self.caches / "drjit"),
+                    "HYBRIDGEN_CACHE_DIR": str(self.caches / "hybridgen")}
+        self.env.pop("PYTHONDONTWRITEBYTECODE", None)
+
+    def run(self, png: Path, threshold: float | None = None) -> dict[str, Any]:
+        """One process: wall and CPU seconds, mean spp, and its phases (s): ``startup`` (spawn to the script's
+        first line), ``import`` (hybridgen), ``build`` (the scene), ``render`` (render_color: scene translation,
+        kernels, raster guides, render, denoise - the in-process time), ``write`` (the PNG), ``exit``."""
+        command = [sys.executable, str(REPO / "tools" / "default_color_process.py"), self.name, self.resolution,
+                   str(png), str(self.workdir), "--lobes", self.lobes]
+        command += ["--threshold", str(threshold)] if threshold is not None else []
+        spawned = time.time()
+        finished = run_timed(command, self.env)
+        r = finished.report
+        return {"wall": finished.wall, "cpu": finished.cpu, "mean_spp": r["mean_spp"],
+                "startup": r["started"] - spawned, "import": r["imported"] - r["started"],
+                "build": r["built"] - r["imported"], "render": r["rendered"] - r["built"],
+                "write": r["written"] - r["rendered"], "exit": finished.wall - (r["written"] - spawned)}
+
+    def close(self) -> None:
+        shutil.rmtree(self.caches, ignore_errors=True)
+
+
+# ----------------------------------------------------------------------------------------- scoring
+def time_hybridgen(name: str, resolution: str, workdir: Path, args: Any, reference: np.ndarray,
+                   row: dict[str, Any]) -> np.ndarray:
+    """Fills ``row`` with hybridgen's whole-process numbers (one cold run, ``args.warm_runs`` warm ones:
+    medians) and PSNR; returns its frame."""
+    runs = DefaultRuns(name, resolution, workdir, LOBES_NAME[args.blenderproc_lobes])
+    try:
+        cold_png, png = workdir / f"{name}_hybridgen_cold.png", workdir / f"{name}_hybridgen.png"
+        cold = runs.run(cold_png, args.hg_threshold)
+        warm = [runs.run(png, args.hg_threshold) for _ in range(max(1, args.warm_runs))]
+        for threshold in args.try_thresholds:  # tuning: other thresholds, same reference, warm
+            other_png = workdir / f"{name}_hybridgen_{threshold}.png"
+            other = runs.run(other_png, threshold)
+            row[f"hg_{threshold}"] = {"psnr": psnr(_read_png(other_png), reference), "s": other["wall"],
+                                      "spp": other["mean_spp"], "cpu_s": other["cpu"]}
+    finally:
+        runs.close()
+    image = _read_png(png)
+    typical = sorted(warm, key=lambda run: run["wall"])[(len(warm) - 1) // 2]
+    row.update(hg_psnr=psnr(image, reference), hg_mean_spp=typical["mean_spp"],
+               hg_s=statistics.median(run["wall"] for run in warm),
+               hg_cpu_s=statistics.median(run["cpu"] for run in warm), hg_cold_s=cold["wall"],
+               hg_cold_cpu_s=cold["cpu"], hg_inprocess_s=typical["render"],
+               hg_phases={key: round(typical[key], 3) for key in PHASES},
+               hg_cold_phases={key: round(cold[key], 3) for key in PHASES},
+               hg_same_bytes_cold_warm=bool(np.array_equal(_read_png(cold_png), image)))
+    return image
+
+
+PHASES = ("startup", "import", "build", "render", "write", "exit")
+LOBES_NAME = {False: "default", True: "blenderproc"}
+
+
+def time_cycles(name: str, session: CyclesSession, workdir: Path, row: dict[str, Any]) -> np.ndarray:
+    """Fills ``row`` with Cycles' render time at BlenderProc's defaults (``bpy.ops.render.render`` alone);
+    returns its frame."""
+    png = workdir / f"{name}_cycles.png"
+    answer = session.render(1, png, mode="blenderproc")
+    row["cycles_s"], row["cycles_cpu_s"] = answer["seconds"], answer["cpu_s"]
+    return _read_png(png)
+
+
+def quality_row(name: str, scene: Any, content: str, refs: References, session: CyclesSession | None,
+                args: Any, workdir: Path, out: Path, hybridgen_first: bool) -> dict[str, Any]:
+    """One scene's row: both engines' defaults timed (in the order ``hybridgen_first`` says) and scored
+    against their references; the side-by-side PNG (hybridgen | its reference | Cycles | its reference)."""
     from PIL import Image
 
-    from bench_color import CyclesWorker, export_for_cycles
+    resolution = refs.resolution
+    row: dict[str, Any] = {"scene": name, "resolution": resolution, "reference_spp": refs.spp}
+    ref, record = refs.hybridgen(name, scene, content, CLAMP)
+    ref_unclamped, _ = refs.hybridgen(name, scene, content, 0.0)
+    row["hg_ref_s"], row["hg_ref_cached"] = record["seconds"], record["cached"]
+    parts = [lambda: time_hybridgen(name, resolution, workdir, args, ref, row)]
+    if session is not None:
+        parts.append(lambda: time_cycles(name, session, workdir, row))
+    images = [part() for part in (parts if hybridgen_first else parts[::-1])]
+    image = images[0 if hybridgen_first else -1]
+    row["hg_psnr_vs_unclamped_ref"] = psnr(image, ref_unclamped)
+    row["clamp_bias_psnr"] = psnr(ref, ref_unclamped)
+    row["clamp_bias_mean"] = float(ref.astype(float).mean() - ref_unclamped.astype(float).mean())
+    panels = [image, ref]
+    if session is not None:
+        cycles = images[1 if hybridgen_first else 0]
+        cycles_ref, record = refs.cycles(name, content, session)
+        row["cycles_psnr"] = psnr(cycles, cycles_ref)
+        row["cycles_ref_s"], row["cycles_ref_cached"] = record["seconds"], record["cached"]
+        panels += [cycles, cycles_ref]
+    Image.fromarray(np.concatenate(panels, axis=1)).save(out / f"{name}_side_by_side.png")
+    return row
 
-    width, height = (int(v) for v in args.res.split("x"))
-    LOBES.clear()
-    LOBES.update(BLENDERPROC_LOBES if args.blenderproc_lobes else {})
+
+def precompute(name: str, scene: Any, content: str, refs: References, session: CyclesSession | None,
+               engines: str) -> None:
+    """Renders (or finds) the references of ``engines`` ("cycles", "hybridgen" or "all") and says which."""
+    found: list[tuple[str, dict[str, Any]]] = []
+    if engines in ("hybridgen", "all"):
+        found += [(f"hybridgen clamp {clamp:g}", refs.hybridgen(name, scene, content, clamp)[1])
+                  for clamp in (CLAMP, 0.0)]
+    if engines in ("cycles", "all") and session is not None:
+        found.append(("Cycles", refs.cycles(name, content, session)[1]))
+    for what, record in found:
+        state = "cached" if record["cached"] else f"rendered in {record['seconds']:.1f} s"
+        print(f"{name} {refs.resolution} {refs.spp} spp, {what}: {state}", flush=True)
+
+
+def run_quality(args: Any, bpy_python: Path | None) -> list[dict[str, Any]]:
+    """The quality benchmark (or, with ``args.precompute``, only its references): one row per scene."""
+    from bench_color import export_for_cycles
+
+    width, height = (int(v) for v in args.res.lower().split("x"))
+    resolution = f"{width}x{height}"
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    workdir = Path(tempfile.mkdtemp(prefix="bench_color_quality_"))  # private: concurrent runs share --out
+    cache = ReferenceCache(cache_root(args.reference_cache))
+    refs = References(cache, args.reference_spp, resolution, LOBES_NAME[args.blenderproc_lobes], bpy_python,
+                      workdir)
+    load = os.getloadavg()
+    print(f"{resolution}, references {args.reference_spp} spp, reference cache "
+          f"{cache.root if cache.root else 'off'}; {os.cpu_count()} cores, load average {load[0]:.2f} "
+          f"{load[1]:.2f} {load[2]:.2f} at start", flush=True)
     rows = []
-    names = args.scenes.split(",") if args.scenes else list(SCENES)
-    for name in names:
-        scene = build(name, width, height, out)
-        row: dict[str, Any] = {"scene": name}
-        ref, row["hg_ref_s"] = hybridgen_reference(scene, args.reference_spp, 10.0)
-        ref_unclamped, _ = hybridgen_reference(scene, args.reference_spp, 0.0)
-        image, row["hg_s"], row["hg_mean_spp"], row["hg_cpu_s"] = hybridgen_default(scene, seed=1,
-                                                                                    threshold=args.hg_threshold)
-        row["hg_psnr"] = psnr(image, ref)
-        for threshold in args.try_thresholds:  # tuning: other thresholds, same reference
-            other, seconds, spp, cpu = hybridgen_default(scene, seed=1, threshold=threshold)
-            row[f"hg_{threshold}"] = {"psnr": psnr(other, ref), "s": seconds, "spp": spp, "cpu_s": cpu}
-        row["hg_psnr_vs_unclamped_ref"] = psnr(image, ref_unclamped)
-        row["clamp_bias_psnr"] = psnr(ref, ref_unclamped)
-        row["clamp_bias_mean"] = float(ref.astype(float).mean() - ref_unclamped.astype(float).mean())
-        panels = [image, ref]
-        if bpy_python is not None:
-            npz = out / f"{name}.npz"
+    try:
+        for index, name in enumerate(args.scenes.split(",") if args.scenes else SCENES):
+            scene = build(name, width, height, workdir)
+            npz = workdir / f"{name}.npz"
             export_for_cycles(scene, npz, 1024, 3, 0)
-            worker = CyclesWorker(bpy_python, npz)
+            content = scene_digest(npz)
+            session = CyclesSession(bpy_python, npz) if bpy_python is not None else None
             try:
-                cycles_png, cycles_ref_png = out / f"{name}_cycles.png", out / f"{name}_cycles_ref.png"
-                answer = worker.render(0, False, 1, cycles_png, mode="blenderproc")
-                row["cycles_s"], row["cycles_cpu_s"] = answer["seconds"], answer["cpu_s"]
-                answer = worker.render(0, False, 12345, cycles_ref_png, mode="reference", spp=args.reference_spp)
-                row["cycles_ref_s"] = answer["seconds"]
+                if args.precompute:
+                    precompute(name, scene, content, refs, session, args.precompute)
+                    continue
+                row = quality_row(name, scene, content, refs, session, args, workdir, out, index % 2 == 0)
             finally:
-                worker.close()
-            cycles, cycles_ref = _read_png(cycles_png), _read_png(cycles_ref_png)
-            row["cycles_psnr"] = psnr(cycles, cycles_ref)
-            panels += [cycles, cycles_ref]
-        Image.fromarray(np.concatenate(panels, axis=1)).save(out / f"{name}_side_by_side.png")
-        rows.append(row)
-        print(json.dumps(row), flush=True)
+                if session is not None:
+                    session.close()
+            rows.append(row)
+            print(json.dumps(row), flush=True)
+    finally:
+        shutil.rmtree(workdir, ignore_errors=True)
+    load = os.getloadavg()
+    print(f"load average {load[0]:.2f} {load[1]:.2f} {load[2]:.2f} at the end", flush=True)
+    if rows:
+        (out / f"quality_{resolution}_{args.reference_spp}spp.json").write_text(json.dumps(rows, indent=1))
     return rows
 
 
 def print_table(rows: list[dict[str, Any]], reference_spp: int) -> None:
-    print(f"\nPSNR (dB, 8-bit sRGB) against each engine's own {reference_spp}-spp reference; time in s (wall; "
-          "CPU = CPU time of the engine's threads, steadier on a loaded machine)")
-    print(f"{'scene':15} {'hybridgen':>10} {'time':>7} {'CPU':>6} {'spp':>6} {'Cycles BP':>10} {'time':>7} {'CPU':>6} "
-          f"{'wall ratio':>10} {'CPU ratio':>9} {'clamp bias':>10}")
+    """The rows as a Markdown table (goal: hybridgen's PSNR >= Cycles' and time ratio <= 0.5)."""
+    if not rows:
+        return
     nan = float("nan")
+    print(f"\nPSNR (dB, 8-bit sRGB) against each engine's own {reference_spp}-spp reference at "
+          f"{rows[0]['resolution']}. hybridgen: the whole process (median of warm runs; cold = fresh Dr.Jit kernel "
+          "and mesh caches; in-proc = render_color alone); Cycles: its render only, at BlenderProc's defaults. "
+          "CPU = user + system s of every thread. Ratio = hybridgen / Cycles.\n")
+    print("| scene | hybridgen dB (mean spp) | hg wall s | hg CPU s | hg cold wall s | hg in-proc s | Cycles dB | "
+          "Cycles wall s | Cycles CPU s | wall ratio | CPU ratio | goal (wall / CPU) | clamp bias dB |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
-        ratio = r["hg_s"] / r["cycles_s"] if r.get("cycles_s") else nan
+        wall_ratio = r["hg_s"] / r["cycles_s"] if r.get("cycles_s") else nan
         cpu_ratio = r["hg_cpu_s"] / r["cycles_cpu_s"] if r.get("cycles_cpu_s") else nan
-        print(f"{r['scene']:15} {r['hg_psnr']:10.1f} {r['hg_s']:7.2f} {r['hg_cpu_s']:6.2f} {r['hg_mean_spp']:6.0f} "
-              f"{r.get('cycles_psnr', nan):10.1f} {r.get('cycles_s', nan):7.2f} {r.get('cycles_cpu_s', nan):6.2f} "
-              f"{ratio:10.2f} {cpu_ratio:9.2f} {r['clamp_bias_psnr']:10.1f}")
-    print("clamp bias: PSNR of hybridgen's clamped reference against its unclamped one (higher = less bias)")
+        clean = r["hg_psnr"] >= r.get("cycles_psnr", nan)
+        goal = " / ".join("yes" if clean and ratio <= 0.5 else "no" for ratio in (wall_ratio, cpu_ratio))
+        print(f"| {r['scene']} | {r['hg_psnr']:.1f} ({r['hg_mean_spp']:.0f}) | {r['hg_s']:.2f} | {r['hg_cpu_s']:.2f} | "
+              f"{r['hg_cold_s']:.2f} | {r['hg_inprocess_s']:.2f} | {r.get('cycles_psnr', nan):.1f} | "
+              f"{r.get('cycles_s', nan):.2f} | {r.get('cycles_cpu_s', nan):.2f} | {wall_ratio:.2f} | {cpu_ratio:.2f} | "
+              f"{goal} | {r['clamp_bias_psnr']:.1f} |")
+    print("\nclamp bias: PSNR of hybridgen's clamped reference against its unclamped one (higher = less bias; inf = "
+          "none). Warm-run phases (s) per scene, startup / import / build / render / write / exit:")
+    for r in rows:
+        print(f"  {r['scene']}: " + " / ".join(f"{r['hg_phases'][k]:.2f}" for k in PHASES)
+              + " (cold: " + " / ".join(f"{r['hg_cold_phases'][k]:.2f}" for k in PHASES) + ")")
