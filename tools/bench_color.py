@@ -257,10 +257,11 @@ def ensure_bpy_venv(venv: Path) -> Path | None:
     return python
 
 
-def export_for_cycles(scene: Any, path: Path, spp: int, bounces: int, min_bounces: int) -> None:
+def export_for_cycles(scene: Any, path: Path, spp: int, bounces: int, min_bounces: int,
+                      threads: int | None = None) -> None:
     """Meshes in world coordinates (with the world-space vertex normals hybridgen gives Mitsuba), materials
     (base-color textures and UVs included), lights, world (color or HDRI), camera and poses, for
-    tools/cycles_render.py."""
+    tools/cycles_render.py, which renders with ``threads`` CPU threads (default: every core)."""
     from hybridgen.render.mitsuba_scene import emitted_radiance
 
     arrays: dict[str, np.ndarray] = {}
@@ -295,7 +296,7 @@ def export_for_cycles(scene: Any, path: Path, spp: int, bounces: int, min_bounce
             "hdri": {"path": str(world.hdri_path), "strength": float(world.strength),
                      "rotation": float(world.hdri_rotation)} if world.hdri_path else None,
             "resolution": [intr.width, intr.height], "K": intr.K.tolist(), "clip": [intr.clip_start, intr.clip_end],
-            "spp": spp, "max_bounces": bounces, "min_bounces": min_bounces, "threads": os.cpu_count() or 2}
+            "spp": spp, "max_bounces": bounces, "min_bounces": min_bounces, "threads": threads or os.cpu_count() or 2}
     np.savez(path, meta=np.array(json.dumps(meta)), poses=np.stack(scene.camera.keypoints), **arrays)
 
 
@@ -451,6 +452,8 @@ def main() -> None:
     parser.add_argument("--scenes", default="", help="quality mode: comma-separated scene names (default all)")
     parser.add_argument("--out", default=str(REPO / "output" / "bench_color_quality"),
                         help="quality mode: folder for side-by-side PNGs and the rows (JSON)")
+    parser.add_argument("--threads", type=int, default=2, help="quality mode: CPU threads of both engines "
+                        "(hybridgen: $HYBRIDGEN_THREADS; default 2, the issue's)")
     parser.add_argument("--warm-runs", type=int, default=1, help="quality mode: timed (warm-cache) hybridgen "
                         "processes per scene, median (after one cold run)")
     parser.add_argument("--reference-cache", default=None, help="quality mode: folder of the reference cache "

@@ -25,7 +25,7 @@ fresh Dr.Jit kernel and hybridgen mesh caches (a new user: reported as "cold"); 
 (``--warm-runs``, median) reuse them, as a user's runs after the first. The in-process time of
 ``render_color`` is reported beside it. hybridgen's reference is the same estimator at a fixed
 ``--reference-spp`` without denoising (and once more without the clamp, to measure the clamp's bias).
-Cycles (pip ``bpy`` in ``.venv-bpy``, 2 threads on this 2-core machine: the machine's core count) renders
+Both engines use ``--threads`` CPU threads (2, the issue's). Cycles (pip ``bpy`` in ``.venv-bpy``) renders
 with BlenderProc's defaults (``mode: blenderproc`` in tools/cycles_render.py), timed as its render only
 (``bpy.ops.render.render``: Cycles' scene sync, BVH, render and denoise; building the Blender scene from the
 export is not counted), and its reference at the same spp with ``mode: reference``. PSNR is computed on the
@@ -359,14 +359,14 @@ def run_timed(command: list[str], env: dict[str, str]) -> Finished:
 class DefaultRuns:
     """hybridgen's default render of one scene as whole processes (tools/default_color_process.py) that share
     fresh caches (Dr.Jit's kernels, hybridgen's parsed meshes): the first run is a new user's (cold), the
-    next ones a returning user's (warm). Byte-compiled sources are used and written as by an installed
-    package (``PYTHONDONTWRITEBYTECODE`` is dropped)."""
+    next ones a returning user's (warm). Dr.Jit runs ``threads`` threads (``$HYBRIDGEN_THREADS``). Byte-compiled
+    sources are used and written as by an installed package (``PYTHONDONTWRITEBYTECODE`` is dropped)."""
 
-    def __init__(self, name: str, resolution: str, workdir: Path, lobes: str) -> None:
+    def __init__(self, name: str, resolution: str, workdir: Path, lobes: str, threads: int) -> None:
         self.name, self.resolution, self.workdir, self.lobes = name, resolution, workdir, lobes
         self.caches = Path(tempfile.mkdtemp(prefix=f"{name}-caches-", dir=workdir))
         self.env = {**os.environ, "DRJIT_CACHE_DIR": str(self.caches / "drjit"),
-                    "HYBRIDGEN_CACHE_DIR": str(self.caches / "hybridgen")}
+                    "HYBRIDGEN_CACHE_DIR": str(self.caches / "hybridgen"), "HYBRIDGEN_THREADS": str(threads)}
         self.env.pop("PYTHONDONTWRITEBYTECODE", None)
 
     def run(self, png: Path, threshold: float | None = None) -> dict[str, Any]:
@@ -393,7 +393,7 @@ def time_hybridgen(name: str, resolution: str, workdir: Path, args: Any, referen
                    row: dict[str, Any]) -> np.ndarray:
     """Fills ``row`` with hybridgen's whole-process numbers (one cold run, ``args.warm_runs`` warm ones:
     medians) and PSNR; returns its frame."""
-    runs = DefaultRuns(name, resolution, workdir, LOBES_NAME[args.blenderproc_lobes])
+    runs = DefaultRuns(name, resolution, workdir, LOBES_NAME[args.blenderproc_lobes], args.threads)
     try:
         cold_png, png = workdir / f"{name}_hybridgen_cold.png", workdir / f"{name}_hybridgen.png"
         cold = runs.run(cold_png, args.hg_threshold)
@@ -487,7 +487,7 @@ def run_quality(args: Any, bpy_python: Path | None) -> list[dict[str, Any]]:
     refs = References(cache, args.reference_spp, resolution, LOBES_NAME[args.blenderproc_lobes], bpy_python,
                       workdir)
     load = os.getloadavg()
-    print(f"{resolution}, references {args.reference_spp} spp, reference cache "
+    print(f"{resolution}, references {args.reference_spp} spp, {args.threads} threads per engine, reference cache "
           f"{cache.root if cache.root else 'off'}; {os.cpu_count()} cores, load average {load[0]:.2f} "
           f"{load[1]:.2f} {load[2]:.2f} at start", flush=True)
     rows = []
@@ -495,7 +495,7 @@ def run_quality(args: Any, bpy_python: Path | None) -> list[dict[str, Any]]:
         for index, name in enumerate(args.scenes.split(",") if args.scenes else SCENES):
             scene = build(name, width, height, workdir)
             npz = workdir / f"{name}.npz"
-            export_for_cycles(scene, npz, 1024, 3, 0)
+            export_for_cycles(scene, npz, 1024, 3, 0, threads=args.threads)
             content = scene_digest(npz)
             session = CyclesSession(bpy_python, npz) if bpy_python is not None else None
             try:

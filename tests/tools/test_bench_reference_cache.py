@@ -38,7 +38,8 @@ def test_module_closure_follows_relative_lazy_and_parent_imports(tmp_path: Path)
     files = {
         "__init__.py": "",
         "a.py": "import os\nfrom . import b\n\ndef f():\n    from .sub.c import value\n    return value\n",
-        "b.py": "from typing import TYPE_CHECKING\nfrom pkg.sub import d\nif TYPE_CHECKING:\n    from . import unused\n",
+        "b.py": ("from typing import TYPE_CHECKING\nfrom pkg.sub import d\n"
+                 "if TYPE_CHECKING:\n    from . import unused\n"),
         "unused.py": "from . import a\n",
         "sub/__init__.py": "",
         "sub/c.py": "from ..b import something\nvalue = 1\n",
