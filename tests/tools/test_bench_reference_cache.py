@@ -132,3 +132,28 @@ def test_whole_process_timing_counts_the_child_and_its_children() -> None:
     result = json.loads(done.stdout.strip().splitlines()[-1])
     assert result["report"] == {"done": 1}
     assert 0.3 <= result["cpu"] <= result["wall"] * 2 + 0.1
+
+
+def test_default_color_process_renders_what_render_color_renders(tmp_path: Path) -> None:
+    """tools/default_color_process.py (the process the quality benchmark times) writes the same bytes as an
+    in-process ``render_color`` with no color options (denoised), and reports its phases in order."""
+    from PIL import Image
+
+    import hybridgen as hg
+
+    png = tmp_path / "materials.png"
+    done = subprocess.run([sys.executable, str(REPO / "tools" / "default_color_process.py"), "materials", "40x30",
+                           str(png), str(tmp_path)], cwd=REPO, capture_output=True, text=True, check=True)
+    report = json.loads(done.stdout.strip().splitlines()[-1])
+    marks = [report[key] for key in ("started", "imported", "built", "rendered", "written")]
+    assert marks == sorted(marks) and report["mean_spp"] >= 1
+    sys.path.insert(0, str(REPO / "tools"))
+    try:
+        import color_quality
+    finally:
+        sys.path.remove(str(REPO / "tools"))
+    sink = hg.MemorySink()
+    hg.render_color(color_quality.build("materials", 40, 30, tmp_path), [sink], hg.PathTraceSettings(), seed=1,
+                    denoise=True, sample_counts=True)
+    assert np.array_equal(np.asarray(Image.open(png).convert("RGB")), sink.frames[0]["colors"])
+    assert report["mean_spp"] == pytest.approx(float(sink.frames[0]["sample_counts"].mean()))
