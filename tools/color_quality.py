@@ -225,9 +225,11 @@ SCENES = ("tabletop", "materials", "window_room", "hdri_tabletop")
 
 
 def build(name: str, width: int, height: int, workdir: Path) -> Any:
+    """Scene ``name`` (one of :data:`SCENES`) at ``width`` x ``height`` px; generated inputs go to ``workdir``."""
     if name == "hdri_tabletop":
         return hdri_tabletop(width, height, workdir)
     return {"tabletop": tabletop, "materials": materials, "window_room": window_room}[name](width, height)
+
 
 # ------------------------------------------------------------------------------------------ scoring
 def psnr(image: np.ndarray, reference: np.ndarray) -> float:
