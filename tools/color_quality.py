@@ -251,14 +251,16 @@ CLAMP = 10.0
 """hybridgen's default indirect clamp, the value its reference is rendered with (and 0 for the clamp bias)."""
 
 
-def hybridgen_reference(scene: Any, spp: int, clamp: float, lobes: dict[str, int]) -> tuple[np.ndarray, float]:
+def hybridgen_reference(scene: Any, spp: int, clamp: float,
+                        lobes: dict[str, int] | None = None) -> tuple[np.ndarray, float]:
     """hybridgen's own estimator at a fixed ``spp`` (no adaptivity, no denoising) with indirect clamp ``clamp``
-    (0: off): the sRGB frame and its wall seconds, in this process."""
+    (0: off) and per-lobe bounces ``lobes`` (default: hybridgen's): the sRGB frame and its wall seconds, in
+    this process."""
     from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
     from hybridgen.render.tonemap import to_srgb8
 
     start = time.perf_counter()
-    view = PathTraceView(scene, PathTraceSettings(samples=spp, clamp_indirect=clamp, **lobes))
+    view = PathTraceView(scene, PathTraceSettings(samples=spp, clamp_indirect=clamp, **(lobes or {})))
     image = view.render(scene.camera.keypoints[0], seed=REFERENCE_SEED)
     return to_srgb8(image), time.perf_counter() - start
 
