@@ -5,15 +5,25 @@ A JIT variant is only chosen after a probe **in a child process** rendered a tin
 unsuitable LLVM (e.g. 15 or 16) Dr.Jit aborts the whole process at the first kernel, which no ``try`` can
 catch. The choice can be forced with the ``HYBRIDGEN_MITSUBA_VARIANT`` environment variable or the
 renderer's ``variant`` option.
+
+The probe's answer is kept in hybridgen's cache folder (``mitsuba_variants.json``,
+:mod:`hybridgen.io.cache_folder`; ``HYBRIDGEN_CACHE_DIR=off`` probes every time), keyed by the Python
+executable, the Mitsuba and Dr.Jit versions and the version of the LLVM / CUDA library Dr.Jit loaded in
+this process (loading it runs no kernel, so that much is safe in-process). A backend Dr.Jit cannot load at
+all is answered in-process, without a child. The child probe costs about 0.6 s (wall) per process, a
+quarter of a small frame's whole run.
 """
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
+import tempfile
 from functools import lru_cache
 
 from ..errors import SystemSetupError
+from ..io.cache_folder import cache_path
 
 AUTO_ORDER = ("cuda_ad_rgb", "llvm_ad_rgb", "scalar_rgb")
 ENV_VARIABLE = "HYBRIDGEN_MITSUBA_VARIANT"
@@ -32,15 +42,71 @@ print("ok" if value == value else "nan")
 """
 
 
+PROBE_CACHE = "mitsuba_variants.json"
+"""File in hybridgen's cache folder with the probes' answers, by :func:`probe_key`."""
+
+
 @lru_cache(maxsize=None)
 def variant_works(variant: str, timeout: float = 180.0) -> bool:
-    """True if a child process can render with ``variant`` (cached per process)."""
+    """True if a child process can render with ``variant`` (cached per process, and on disk by
+    :func:`probe_key`)."""
+    key = probe_key(variant)
+    if key is None:  # Dr.Jit cannot load the backend's library at all
+        return False
+    cached = _read_probe_cache().get(key)
+    if isinstance(cached, bool):
+        return cached
     try:
         done = subprocess.run([sys.executable, "-c", _PROBE, variant], capture_output=True, text=True,
                               timeout=timeout)
     except (subprocess.TimeoutExpired, OSError):
-        return False
-    return done.returncode == 0 and done.stdout.strip().endswith("ok")
+        return False  # not kept: a timeout may be the machine's load
+    works = done.returncode == 0 and done.stdout.strip().endswith("ok")
+    _write_probe_cache(key, works)
+    return works
+
+
+def probe_key(variant: str) -> str | None:
+    """What a probe's answer depends on: ``variant``, the Python executable, the Mitsuba and Dr.Jit versions
+    and the version of the backend library (libLLVM / the CUDA driver) Dr.Jit loads in this process; None
+    when Dr.Jit cannot load it (no kernel is run to find out)."""
+    import drjit as dr
+    import mitsuba as mi
+
+    if variant.startswith("cuda_"):
+        backend, version = dr.JitBackend.CUDA, dr.detail.cuda_version
+    elif variant.startswith("llvm_"):
+        backend, version = dr.JitBackend.LLVM, dr.detail.llvm_version
+    else:
+        return f"{variant}"
+    if not dr.has_backend(backend):
+        return None
+    library = ".".join(str(part) for part in version())
+    return f"{variant}|{sys.executable}|mitsuba {mi.__version__}|drjit {dr.__version__}|{library}"
+
+
+def _read_probe_cache() -> dict[str, object]:
+    path = cache_path(PROBE_CACHE)
+    try:
+        answers = json.loads(path.read_text()) if path is not None else {}
+    except (OSError, ValueError):
+        return {}
+    return answers if isinstance(answers, dict) else {}
+
+
+def _write_probe_cache(key: str, works: bool) -> None:
+    """Adds one answer (written to a temporary file, then renamed: readers never see half a file)."""
+    path = cache_path(PROBE_CACHE)
+    if path is None:
+        return
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        answers = {**_read_probe_cache(), key: works}
+        with tempfile.NamedTemporaryFile("w", dir=path.parent, suffix=".tmp", delete=False) as handle:
+            json.dump(answers, handle, indent=1, sort_keys=True)
+        os.replace(handle.name, path)
+    except OSError:
+        pass  # a read-only cache folder costs the probe next time, nothing else
 
 
 def available_variants() -> list[str]:
