@@ -3,6 +3,9 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
+import sys
+import threading
 
 import h5py
 import numpy as np
@@ -10,6 +13,7 @@ import pytest
 import yaml
 
 import hybridgen as hg
+from hybridgen.io.hdf5_single import WORKER_NICENESS
 from hybridgen.io.label_encoding import OCTAHEDRAL_MAX_ERROR_RAD, decode_dataset
 from tests.conftest import REPO
 
@@ -133,3 +137,72 @@ def test_incomplete_file_never_has_the_final_name(tmp_path):
     assert len(list(tmp_path.iterdir())) == 1  # the hidden temporary file
     writer.abort()
     assert list(tmp_path.iterdir()) == []
+
+
+def _small_writer(path, **options):
+    from hybridgen.io.frame_sink import PassLayout
+
+    writer = hg.Hdf5SingleFileWriter(path, **options)
+    writer.begin(4, [PassLayout("depth", "float32", (16, 16)), PassLayout("records", "json", ())], {}, {})
+    return writer
+
+
+def _depth(index):
+    return np.random.default_rng(index).random((16, 16), dtype=np.float32)
+
+
+def test_keypoints_are_stored_in_order_whatever_finishes_first(tmp_path, monkeypatch):
+    """Keypoint 0's chunk is made last (its job waits until the others are compressed): the file still holds the
+    chunks in keypoint order, byte for byte the file one thread writes."""
+    files = {}
+    for threads in (1, 3):
+        writer = _small_writer(tmp_path / f"{threads}.hdf5", threads=threads)
+        if threads == 3:
+            made, chunk = threading.Event(), writer._chunk
+
+            def late_first(key, index, value):
+                if index == 0:
+                    assert made.wait(10)  # keypoints 1 and 2 are compressed before keypoint 0
+                elif index == 2:
+                    made.set()
+                return chunk(key, index, value)
+            monkeypatch.setattr(writer, "_chunk", late_first)
+        for i in range(4):
+            writer.write(i, {"depth": _depth(i), "records": [{"keypoint": i}]})
+        writer.finalize()
+        files[threads] = (tmp_path / f"{threads}.hdf5").read_bytes()
+    assert files[1] == files[3]
+    with h5py.File(tmp_path / "3.hdf5") as f:
+        for i in range(4):
+            np.testing.assert_array_equal(f["depth"][i], _depth(i))
+            assert json.loads(f["records"][i]) == [{"keypoint": i}]
+
+
+def test_writes_block_while_the_writer_is_behind(tmp_path, monkeypatch):
+    """At most queue_size + threads keypoints are in flight: the producer waits instead of piling up arrays."""
+    writer = _small_writer(tmp_path / "x.hdf5", threads=1, queue_size=1)
+    release, chunk = threading.Event(), writer._chunk
+    monkeypatch.setattr(writer, "_chunk", lambda *args: (release.wait(10), chunk(*args))[1])
+    returned = []
+    producer = threading.Thread(target=lambda: [returned.append(writer.write(i, {"depth": _depth(i), "records": []}))
+                                                for i in range(4)])
+    producer.start()
+    producer.join(0.5)
+    assert len(returned) == 2  # the third write waits for the first keypoint to be stored
+    release.set()
+    producer.join(10)
+    assert len(returned) == 4
+    writer.finalize()
+    with h5py.File(tmp_path / "x.hdf5") as f:
+        np.testing.assert_array_equal(f["depth"][3], _depth(3))
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="per-thread nice values are Linux's")
+def test_writer_threads_yield_to_the_render_threads(tmp_path):
+    writer = _small_writer(tmp_path / "x.hdf5", threads=2)
+    own = os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
+    seen = {writer._pool.submit(lambda: os.getpriority(os.PRIO_PROCESS, threading.get_native_id())).result()
+            for _ in range(4)}
+    assert seen == {min(19, own + WORKER_NICENESS)} and WORKER_NICENESS > 0
+    assert os.getpriority(os.PRIO_PROCESS, threading.get_native_id()) == own  # the caller's own is unchanged
+    writer.abort()
