@@ -8,14 +8,21 @@ tools/color_quality.py (160x120, 64 spp, against a 1024-spp reference) 40.4 dB w
 ``factor`` times the resolution (K scaled so that sub-pixel centres tile the pixel, see
 :meth:`hybridgen.scene.camera.Intrinsics.resized`) and averages ``factor x factor`` blocks. Averaged normals
 are not renormalised: at a silhouette the shorter mixed vector is what the pixel sees.
+
+Given the color's path-trace view, sub-pixels that see sharp glass, mirrors or smooth metal get the features
+of what is seen *through* them, as Cycles' denoising passes do (:mod:`hybridgen.render.specular_guides`),
+before the same filter; all other sub-pixels keep the raster values.
 """
 from __future__ import annotations
+
+from typing import Any
 
 import numpy as np
 
 from ..scene.scene import Scene
 from .pixel_filter import DEFAULT_WIDTH, filter_supersampled
 from .scene_raster import SceneRaster
+from .specular_guides import SpecularGuideTracer, can_be_specular_like
 
 DEFAULT_FACTOR = 3
 
@@ -32,6 +39,8 @@ class DenoiseGuides:
         self.fine = intr.resized(intr.width * self.factor, intr.height * self.factor)
         self._own = raster is None
         self.raster = raster or SceneRaster(scene)
+        self._tracer: tuple[Any, SpecularGuideTracer] | None = None  # (the Mitsuba scene it traces, tracer)
+        self.traced_subpixels = 0  # of the last render (sub-pixels whose features come from behind glass/mirrors)
 
     def _box(self, image: np.ndarray) -> np.ndarray:
         f = self.factor
@@ -41,13 +50,37 @@ class DenoiseGuides:
         blocks = image.reshape(self.height, f, self.width, f, -1)
         return np.ascontiguousarray(blocks.mean(axis=(1, 3), dtype=np.float32))
 
-    def render(self, cam2world: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(albedo, normals) of one keypoint (OpenCV-axes ``cam2world``)."""
+    def render(self, cam2world: np.ndarray, path_view: Any = None) -> tuple[np.ndarray, np.ndarray]:
+        """(albedo, normals) of one keypoint (OpenCV-axes ``cam2world``); with ``path_view`` (the color's
+        :class:`~hybridgen.render.path_trace.PathTraceView`, JIT variants) they follow sharp specular surfaces
+        (:mod:`hybridgen.render.specular_guides`)."""
+        tracer = self._tracer_for(path_view)
         albedo = self.raster.albedo.render(cam2world, intrinsics=self.fine)
-        normals = self.raster.view.render(cam2world, ["normals"], intrinsics=self.fine,
-                                          normals_space="camera")["normals"]
+        passes = self.raster.view.render(cam2world, ["normals"] + (["instance_segmaps"] if tracer else []),
+                                         intrinsics=self.fine, normals_space="camera")
+        normals = passes["normals"]
+        self.traced_subpixels = 0
+        if tracer is not None:
+            normals = np.array(normals, dtype=np.float32)
+            self.traced_subpixels = tracer.apply(cam2world, self.fine, np.asarray(passes["instance_segmaps"]),
+                                                 albedo, normals)
         return self._box(albedo), self._box(normals)
 
+    def _tracer_for(self, path_view: Any) -> SpecularGuideTracer | None:
+        """The tracer of ``path_view``'s Mitsuba scene (rebuilt with it), or None where nothing is traced."""
+        if path_view is None or not any(can_be_specular_like(o.material) for o in self.raster.scene.objects):
+            return None
+        from .mitsuba_variant import is_jit
+
+        if not is_jit(path_view.variant):
+            return None
+        if self._tracer is None or self._tracer[0] is not path_view.mi_scene:
+            s = path_view.settings
+            self._tracer = (path_view.mi_scene, SpecularGuideTracer(
+                self.raster.scene, path_view.mi_scene, s.max_bounces, s.glossy_bounces, s.transmission_bounces))
+        return self._tracer[1]
+
     def release(self) -> None:
+        self._tracer = None
         if self._own:
             self.raster.release()

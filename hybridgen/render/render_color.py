@@ -76,7 +76,7 @@ class ColorProducer:
         if self.sample_counts:
             values["sample_counts"] = counts
         if self._guides is not None:
-            linear = oidn_denoise(linear, *self._guides.render(cam2world))
+            linear = oidn_denoise(linear, *self._guides.render(cam2world, self.view))
         values["colors"] = to_srgb8(linear)
         if self.hdr:
             values["colors_hdr"] = linear.astype(np.float16)

@@ -113,8 +113,8 @@ def test_labels_and_denoising_guides_share_one_raster_view(gl_context, monkeypat
         built.append(self)
         original_init(self, *args, **kwargs)
 
-    def keeping_render(self, cam2world):
-        guides.append(original_render(self, cam2world))
+    def keeping_render(self, cam2world, path_view=None):
+        guides.append(original_render(self, cam2world, path_view))
         return guides[-1]
 
     monkeypatch.setattr(raster.RasterView, "__init__", counting_init)
