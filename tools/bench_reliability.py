@@ -40,7 +40,7 @@ from bench_workers import CONFIG, KINDS  # noqa: E402  (one scene template for t
 VARIANTS = ("bare", "direct", "staged")
 _PATCHES = {
     "bare": ("import hybridgen.io.integrity as integrity, hybridgen.run.fingerprint as fingerprint, "
-             "hybridgen.run.staged_output as staged; integrity.content_digest = lambda h5: 'unsealed'; "
+             "hybridgen.run.staged_output as staged; integrity.content_digest = lambda h5, streams=None: 'unsealed'; "
              "fingerprint.input_files = lambda config: []; staged.part_keypoints = lambda requested, traces: 0"),
     "direct": "import hybridgen.run.staged_output as staged; staged.part_keypoints = lambda requested, traces: 0",
     "staged": "pass",

@@ -33,7 +33,7 @@ from ..config.options import checked_options, option
 from ..errors import InputError
 from .atomic import commit, prepare_output_dir, temporary_path
 from .frame_sink import PassLayout
-from .integrity import seal
+from .integrity import ChunkStream, seal
 from .label_encoding import NARROWED, OCTAHEDRAL, EncodedArray, StoredPass, plan_storage, storage_tag
 
 COMPRESSIONS = ("gzip", "lzf", "none")
@@ -75,6 +75,19 @@ def _tag(stored: StoredPass, layout: PassLayout) -> str | None:
     if stored.encode is None or encoding not in (OCTAHEDRAL, NARROWED):
         return None
     return storage_tag(encoding, stored.dtype, np.dtype(layout.dtype))
+
+
+class _UnknownStream(ChunkStream):
+    """A dataset whose stored chunks the writer did not see (filtered by HDF5): the seal reads them."""
+
+    def add(self, offset: tuple[int, ...], mask: int, data: Any) -> None:
+        pass
+
+    def hexdigest(self) -> str | None:
+        return None
+
+
+_UNKNOWN = _UnknownStream()
 
 
 def default_threads() -> int:
@@ -151,6 +164,7 @@ class Hdf5SingleFileWriter:
         self._layouts: dict[str, PassLayout] = {}
         self._stored: dict[str, StoredPass] = {}
         self._datasets: dict[str, h5py.Dataset] = {}  # looked up once: h5[key] costs ~70 us per call
+        self._streams: dict[str, ChunkStream] = {}  # chunked datasets' chunks, hashed as stored (the seal's)
         self._pool: ThreadPoolExecutor | None = None
         self._in_flight = threading.BoundedSemaphore(queue_size + self.threads)  # keypoints queued or being written
         self._stored_before: threading.Event | None = None  # set once the last queued keypoint is stored
@@ -222,7 +236,7 @@ class Hdf5SingleFileWriter:
             h5.create_dataset(key, data=json.dumps(value), dtype=h5py.string_dtype(), track_times=False)
         for key, value in (attributes or {}).items():
             h5.attrs[key] = value
-        seal(h5)  # content_sha256: resume and readers verify the file with it
+        seal(h5, self._streams)  # content_sha256: resume and readers verify the file with it
         h5.close()
         self._file = None
         self._shutdown_pool()
@@ -280,6 +294,7 @@ class Hdf5SingleFileWriter:
         for name, value in stored.attrs.items():
             dset.attrs[name] = value
         self._datasets[layout.key] = dset
+        self._streams[layout.key] = ChunkStream()
 
     def _chunk(self, key: str, index: int, value: Any) -> np.ndarray | bytes | None:
         """Keypoint ``index``'s stored chunk of ``key`` (on the pool): the encoded array, or for gzip
@@ -335,11 +350,15 @@ class Hdf5SingleFileWriter:
                 continue
             if chunk is None:
                 continue
+            stream = self._streams[key]
             if isinstance(chunk, bytes) or self.compression == "none":
                 # gzip: deflated bytes; none: the array's bytes are the chunk as HDF5 stores it
-                dset.id.write_direct_chunk((index,) + (0,) * len(self._stored[key].shape), chunk)
-            else:
+                offset = (index,) + (0,) * len(self._stored[key].shape)
+                dset.id.write_direct_chunk(offset, chunk)
+                stream.add(offset, 0, chunk)
+            else:  # HDF5 filters it (lzf): the stored bytes are read back by the seal
                 dset[index] = chunk
+                self._streams[key] = _UNKNOWN
         self.frames_written += 1
 
     def _drain(self) -> None:

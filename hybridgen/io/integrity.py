@@ -7,6 +7,14 @@ decompressed, so checking costs one read of the file), the values for contiguous
 attributes (they say how a pass is encoded) and every file attribute except the digest itself. A flipped
 bit in any chunk, a truncated file or a changed attribute fails the check; a damaged file header fails to open. Virtual datasets are skipped (an index checks its
 sources with :func:`hybridgen.run.shard_index.check_index_sources`).
+
+Two schemes, named by the file attribute ``content_sha256_scheme`` (absent: the first):
+
+- the chunks of every chunked dataset are hashed inline, in chunk order;
+- ``chunk-streams``: each chunked dataset contributes the SHA-256 of its chunk stream (the same bytes the
+  first scheme hashes inline) instead. A writer that stores chunks in order hashes them as it writes them
+  (:class:`ChunkStream`), so sealing a finished file reads no chunk back (the single-file HDF5 writer: a
+  full read of the file at the end of every run before). Checking costs the same under both.
 """
 from __future__ import annotations
 
@@ -18,6 +26,30 @@ import h5py
 import numpy as np
 
 DIGEST_ATTR = "content_sha256"
+SCHEME_ATTR = "content_sha256_scheme"
+CHUNK_STREAMS = "chunk-streams"
+
+
+class ChunkStream:
+    """The SHA-256 of one dataset's chunk stream, fed while the chunks are written: ``add`` each chunk as it
+    lies on disk (offset tuple, filter mask, stored bytes) in increasing offset order. ``hexdigest`` is None
+    when the chunks did not arrive in that order (then the seal reads them back)."""
+
+    def __init__(self) -> None:
+        self._hash = hashlib.sha256()
+        self._last: tuple[int, ...] | None = None
+        self._in_order = True
+
+    def add(self, offset: tuple[int, ...], mask: int, data: Any) -> None:
+        view = memoryview(data).cast("B")
+        if self._last is not None and offset <= self._last:
+            self._in_order = False
+        self._last = offset
+        self._hash.update(f"{offset}:{mask}:{view.nbytes}".encode())
+        self._hash.update(view)
+
+    def hexdigest(self) -> str | None:
+        return self._hash.hexdigest() if self._in_order else None
 
 
 def _update_value(digest: "hashlib._Hash", value: Any) -> None:
@@ -37,12 +69,8 @@ def _update_attributes(digest: "hashlib._Hash", attrs: h5py.AttributeManager, pr
             _update_value(digest, attrs[key])
 
 
-def _update_dataset(digest: "hashlib._Hash", name: str, dset: h5py.Dataset) -> None:
-    digest.update(f"\0{name}\0{dset.dtype}\0{dset.shape}\0".encode())
-    _update_attributes(digest, dset.attrs, name)
-    if dset.chunks is None:
-        _update_value(digest, dset[()])
-        return
+def _update_chunks(digest: "hashlib._Hash", dset: h5py.Dataset) -> None:
+    """Every stored chunk of ``dset`` in offset order: ``offset:mask:length`` and its bytes."""
     dsid = dset.id
     infos: list[Any] = []
     if hasattr(dsid, "chunk_iter"):  # HDF5 >= 1.12.3: one pass over the chunk index (20x faster)
@@ -55,26 +83,53 @@ def _update_dataset(digest: "hashlib._Hash", name: str, dset: h5py.Dataset) -> N
         digest.update(data)
 
 
-def content_digest(h5: h5py.File) -> str:
-    """The hex SHA-256 of ``h5``'s datasets (stored bytes) and attributes, ``content_sha256`` excluded.
+def _update_dataset(digest: "hashlib._Hash", name: str, dset: h5py.Dataset, streams: bool,
+                    known: dict[str, str]) -> None:
+    digest.update(f"\0{name}\0{dset.dtype}\0{dset.shape}\0".encode())
+    _update_attributes(digest, dset.attrs, name)
+    if dset.chunks is None:
+        _update_value(digest, dset[()])
+    elif not streams:
+        _update_chunks(digest, dset)
+    else:
+        stream = known.get(name)
+        if stream is None:
+            chunks = hashlib.sha256()
+            _update_chunks(chunks, dset)
+            stream = chunks.hexdigest()
+        digest.update(stream.encode())
+
+
+def content_digest(h5: h5py.File, streams: dict[str, ChunkStream] | None = None) -> str:
+    """The hex SHA-256 of ``h5``'s datasets (stored bytes) and attributes, ``content_sha256`` excluded, under
+    the file's scheme (``content_sha256_scheme``). ``streams``: chunk streams hashed while writing, by dataset
+    name (used by the ``chunk-streams`` scheme; a dataset without one, or fed out of order, is read).
     Datasets are opened one at a time: an open virtual dataset holds its whole source mapping (~5 KB per
     source file in HDF5), so holding all of an index's datasets at once grew with the number of shards."""
+    scheme = h5.attrs.get(SCHEME_ATTR)
+    by_streams = (scheme.decode() if isinstance(scheme, bytes) else scheme) == CHUNK_STREAMS
+    known = {name: value for name, stream in (streams or {}).items()
+             if (value := stream.hexdigest()) is not None}
     digest = hashlib.sha256()
     names: list[str] = []
     h5.visititems(lambda name, obj: names.append(name) if isinstance(obj, h5py.Dataset) else None)
     for name in sorted(names):
         dset = h5[name]
         if not dset.is_virtual:
-            _update_dataset(digest, name, dset)
+            _update_dataset(digest, name, dset, by_streams, known)
         del dset
     _update_attributes(digest, h5.attrs, "")
     return digest.hexdigest()
 
 
-def seal(h5: h5py.File) -> str:
-    """Store the digest of ``h5`` (open for writing, complete) as its ``content_sha256`` attribute."""
+def seal(h5: h5py.File, streams: dict[str, ChunkStream] | None = None) -> str:
+    """Store the digest of ``h5`` (open for writing, complete) as its ``content_sha256`` attribute. With
+    ``streams`` (the chunk streams of its chunked datasets, hashed while writing; see :class:`ChunkStream`)
+    the file is sealed under the ``chunk-streams`` scheme, reading back only what no stream covers."""
+    if streams is not None:
+        h5.attrs[SCHEME_ATTR] = CHUNK_STREAMS
     h5.flush()
-    value = content_digest(h5)
+    value = content_digest(h5, streams)
     h5.attrs[DIGEST_ATTR] = value
     return value
 

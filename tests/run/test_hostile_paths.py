@@ -68,7 +68,7 @@ def test_disk_full_is_one_line_and_leaves_nothing(gl_context, tmp_path, write_co
 
     import hybridgen.io.hdf5_single as single
 
-    def full(h5):
+    def full(h5, streams=None):
         raise OSError(errno.ENOSPC, "No space left on device")
 
     monkeypatch.setattr(single, "seal", full)
