@@ -21,6 +21,7 @@ from ..errors import InputError
 from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
 from .alpha_cutout import Cutout, set_cutout_uniforms, upload_cutout
+from .framebuffer_ring import FramebufferRing, Shape
 from .gl_calls import gl_calls
 from .gl_context import shared_context
 from .label_targets import LabelTargets
@@ -93,7 +94,6 @@ class RasterView:
         self.readback = readback or ("direct" if software else "pbo")
         if self.readback not in READBACKS:
             raise InputError(f"readback must be one of {READBACKS}, got {readback!r}")
-        self._pbos: dict[Any, list[Any]] = {}  # framebuffer key -> a pixel-pack buffer per attachment
         self._gl = gl_calls() if gil_free else None  # draws and reads that release the GIL (gl_calls.py)
         self.program = self._label_program(cutout=False)
         self._cutout_program: Any = None  # built with the first object that cuts out (render/alpha_cutout.py)
@@ -103,8 +103,10 @@ class RasterView:
             self._class_lut = self.category_lut()
         except InputError:
             self._class_lut = np.zeros(len(scene.objects) + 1, dtype=np.int32)
-        self._fbos: dict[Any, Any] = {}  # (slot, width, height) -> framebuffer
-        self._submitted: dict[Any, Intrinsics] = {}
+        # slot -> framebuffer (and its pixel-pack buffers): a ring per image shape (render/framebuffer_ring.py)
+        self._framebuffers = FramebufferRing(self._create_framebuffer, self._destroy_framebuffer)
+        self._submitted: dict[Any, tuple[Intrinsics, LabelTargets | None, bool]] = {}
+        self._fences: dict[Any, int] = {}  # slot -> fence after its draws (direct GIL-free readback)
         self._ray_lengths: np.ndarray | None = None
         self._ray_key: Any = None
         self._cached_pose_key: bytes | None = None
@@ -192,21 +194,23 @@ class RasterView:
                          vertex_order, obj.is_closed and cutout is None, obj.bounds_local, cutout,
                          clusters=clusters if indirect is not None else None, indirect=indirect)
 
-    def _framebuffer(self, slot: Any, width: int, height: int, targets: LabelTargets | None = None) -> Any:
-        key = (slot, width, height, targets)
-        if key not in self._fbos:
-            for old in [k for k in self._fbos if k[0] == slot]:
-                self._release_fbo(self._fbos.pop(old))
-                for pbo in self._pbos.pop(old, []):
-                    pbo.release()
-            ctx = self.ctx
-            formats = [(c, d) for _, c, d in _attachments(targets)]
-            self._fbos[key] = ctx.framebuffer(
-                color_attachments=[ctx.renderbuffer((width, height), c, dtype=d) for c, d in formats],
-                depth_attachment=ctx.depth_renderbuffer((width, height)))
-            if self.readback == "pbo":
-                self._pbos[key] = [ctx.buffer(reserve=width * height * c * int(d[1])) for c, d in formats]
-        return self._fbos[key]
+    def _create_framebuffer(self, shape: Shape) -> tuple[Any, list[Any]]:
+        """A framebuffer of ``shape`` (width, height, targets) and, for PBO readback, a pixel-pack buffer per
+        attachment."""
+        width, height, targets = shape
+        ctx = self.ctx
+        formats = [(c, d) for _, c, d in _attachments(targets)]
+        fbo = ctx.framebuffer(color_attachments=[ctx.renderbuffer((width, height), c, dtype=d) for c, d in formats],
+                              depth_attachment=ctx.depth_renderbuffer((width, height)))
+        pbos = ([ctx.buffer(reserve=width * height * c * int(d[1])) for c, d in formats]
+                if self.readback == "pbo" else [])
+        return fbo, pbos
+
+    def _destroy_framebuffer(self, resources: tuple[Any, list[Any]]) -> None:
+        fbo, pbos = resources
+        self._release_fbo(fbo)
+        for pbo in pbos:
+            pbo.release()
 
     def _clear(self, fbo: Any, targets: LabelTargets | None) -> None:
         """Clear ``fbo``: everything to 0 (depth buffer to 1); packed targets' depth to ``depth_background``
@@ -220,6 +224,12 @@ class RasterView:
         fbo.color_mask = [(True,) * 4] + [(False,) * 4] * (count - 1)
         fbo.clear(self.depth_background, 0.0, 0.0, 0.0)
         fbo.color_mask = [(True,) * 4] * count
+
+    def _drop_fence(self, slot: Any) -> None:
+        """Forget the fence of ``slot``'s previous draws (never collected)."""
+        fence = self._fences.pop(slot, None)
+        if fence is not None and self._gl is not None:
+            self._gl.discard(fence)
 
     @staticmethod
     def _release_fbo(fbo: Any) -> None:
@@ -275,7 +285,8 @@ class RasterView:
         """
         intr = intrinsics or self.scene.camera.intrinsics
         width, height = intr.width, intr.height
-        fbo = self._framebuffer(slot, width, height, targets)
+        self._drop_fence(slot)
+        fbo, pbos = self._framebuffers.resources(self._framebuffers.bind(slot, (width, height, targets)))
         fbo.scissor = region
         fbo.use()
         self._clear(fbo, targets)
@@ -331,26 +342,39 @@ class RasterView:
                 self._gl.draw_indirect(prog, vao, gpu.indirect, len(commands))
         queued = self.readback == "pbo" and region is None
         if queued:  # the copies run on the GPU after the draws; collect() maps them
-            for attachment, ((_, components, kind), pbo) in enumerate(
-                    zip(_attachments(targets), self._pbos[(slot, width, height, targets)])):
+            for attachment, ((_, components, kind), pbo) in enumerate(zip(_attachments(targets), pbos)):
                 fbo.read_into(pbo, attachment=attachment, components=components, dtype=kind)
+        elif self._gl is not None and region is None:  # flushes: the rasterizer starts on this keypoint now
+            self._fences[slot] = self._gl.fence()
         self._submitted[slot] = (intr, targets, queued)
 
     def collect(self, slot: Any = 0) -> RasterOutput:
         """Read back what :meth:`submit` drew into ``slot`` (waits for it to finish); every target is read
-        straight into its own fresh contiguous array."""
+        straight into its own fresh contiguous array.
+
+        With direct GIL-free readback, while another slot is in flight: wait for this slot's fence alone, then
+        begin the scene of the next keypoint of this size by clearing its framebuffer, so that the read waits
+        for nothing else (llvmpipe; see render/framebuffer_ring.py)."""
         intr, targets, queued = self._submitted.pop(slot)
         width, height = intr.width, intr.height
-        key = (slot, width, height, targets)
+        fence = self._fences.pop(slot, None)
+        if fence is not None and self._gl is not None:
+            self._gl.wait(fence)
+            if self._submitted:
+                upcoming, _ = self._framebuffers.resources(self._framebuffers.upcoming((width, height, targets)))
+                upcoming.scissor = None
+                upcoming.use()
+                self._clear(upcoming, targets)
+        fbo, pbos = self._framebuffers.resources(self._framebuffers.unbind(slot))
         arrays = {name: np.empty((height, width, components) if components > 1 else (height, width), np.dtype(kind))
                   for name, components, kind in _attachments(targets)}
         for attachment, (name, components, kind) in enumerate(_attachments(targets)):
             if queued:
-                self._pbos[key][attachment].read_into(arrays[name])
+                pbos[attachment].read_into(arrays[name])
             elif self._gl is not None:  # waits for the rasterizer without holding the GIL
-                self._gl.read_into(arrays[name], self._fbos[key], attachment, components, kind)
+                self._gl.read_into(arrays[name], fbo, attachment, components, kind)
             else:
-                self._fbos[key].read_into(arrays[name], attachment=attachment, components=components, dtype=kind)
+                fbo.read_into(arrays[name], attachment=attachment, components=components, dtype=kind)
         if targets is not None:
             return RasterOutput(None, arrays["instance"], self._rays(intr), self._class_lut, self.depth_background,
                                 depth_image=arrays["depth"], normal_codes=arrays.get("normal_codes"),
@@ -367,7 +391,8 @@ class RasterView:
         slot = ("now", intr.width, intr.height)
         self.submit(cam2world, intr, hidden, slot=slot, region=region)
         self._submitted.pop(slot)
-        fbo = self._fbos[(slot, intr.width, intr.height, None)]
+        self._drop_fence(slot)
+        fbo, _ = self._framebuffers.resources(self._framebuffers.unbind(slot))
         x, y, w, h = region if region is not None else (0, 0, intr.width, intr.height)
         part = np.empty((h, w), dtype=np.uint32)
         fbo.read_into(part, viewport=(x, y, w, h), attachment=1, components=1, dtype="u4")
@@ -438,13 +463,10 @@ class RasterView:
             for buf in gpu.buffers:
                 buf.release()
         self.gpu_objects = []
-        for fbo in self._fbos.values():
-            self._release_fbo(fbo)
-        self._fbos.clear()
-        for pbos in self._pbos.values():
-            for pbo in pbos:
-                pbo.release()
-        self._pbos.clear()
+        for slot in list(self._fences):
+            self._drop_fence(slot)
+        self._submitted.clear()
+        self._framebuffers.release()
         for program in self._programs():  # compiled programs per view: leaked ~1.7 MB per scene before
             program.release()
         self.program = self._cutout_program = None
