@@ -10,15 +10,13 @@ Writing never blocks the render thread: each keypoint is one job on a small thre
 byte-shuffles (float passes) and deflates its passes (numpy and ISA-L / zlib release the GIL) and then, in
 keypoint order, stores the chunks with ``write_direct_chunk`` - bit-identical to what HDF5's shuffle + gzip
 filters make, so any HDF5 reader opens the file, and the file's bytes do not depend on thread timing. The
-pool's threads run at a lower scheduling priority than the render threads (Linux; :data:`WORKER_NICENESS`),
-so that they fill the cores the raster pass leaves idle instead of delaying it. The file is written under a
-temporary name and renamed only when complete.
+chunks are hashed as they are stored, so sealing the file (``content_sha256``) reads nothing back. The file is
+written under a temporary name and renamed only when complete.
 """
 from __future__ import annotations
 
 import json
 import os
-import sys
 import threading
 import zlib
 from concurrent.futures import Future, ThreadPoolExecutor
@@ -38,12 +36,6 @@ from .label_encoding import NARROWED, OCTAHEDRAL, EncodedArray, StoredPass, plan
 
 COMPRESSIONS = ("gzip", "lzf", "none")
 ENCODINGS = ("compact", "plain")
-WORKER_NICENESS = 10
-"""How much lower the writer threads' scheduling priority is than the render threads' (Linux ``nice``
-increment of each pool thread; other systems: unchanged). Measured on 2 cores (50 objects, 640x480): a
-background job of 2.5 ms CPU per keypoint lengthened the raster pass by 2.0 ms at the same priority and by
-1.3 ms at +10. It only orders the process's own threads against each other where the scheduler groups
-processes (Linux autogroups, cgroups): an idle core still runs the writer at full speed."""
 
 
 def deflate(data: Any, level: int) -> bytes:
@@ -93,17 +85,6 @@ _UNKNOWN = _UnknownStream()
 def default_threads() -> int:
     """Writer threads: the cores left over by the render thread (at least one)."""
     return max(1, (os.cpu_count() or 2) - 1)
-
-
-def _lower_priority() -> None:
-    """Pool thread initializer: this thread's nice value raised by :data:`WORKER_NICENESS` (Linux only: there
-    ``setpriority`` with a thread id sets that thread's own value; elsewhere it would renice the process)."""
-    if sys.platform.startswith("linux") and WORKER_NICENESS > 0:
-        try:
-            tid = threading.get_native_id()
-            os.setpriority(os.PRIO_PROCESS, tid, os.getpriority(os.PRIO_PROCESS, tid) + WORKER_NICENESS)
-        except OSError:  # not permitted here (seccomp, ...): run at the same priority
-            pass
 
 
 def shuffled(array: np.ndarray) -> np.ndarray:
@@ -193,8 +174,7 @@ class Hdf5SingleFileWriter:
         for key, value in attributes.items():
             h5.attrs[key] = value
         if self._pool is None:
-            self._pool = ThreadPoolExecutor(self.threads, thread_name_prefix="hdf5-writer",
-                                            initializer=_lower_priority)
+            self._pool = ThreadPoolExecutor(self.threads, thread_name_prefix="hdf5-writer")
 
     def write(self, index: int, values: dict[str, Any]) -> None:
         """Queue keypoint ``index``'s values (arrays or JSON-ready objects): one pool job makes their chunks

@@ -3,8 +3,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
-import sys
 import threading
 
 import h5py
@@ -13,7 +11,6 @@ import pytest
 import yaml
 
 import hybridgen as hg
-from hybridgen.io.hdf5_single import WORKER_NICENESS
 from hybridgen.io.label_encoding import OCTAHEDRAL_MAX_ERROR_RAD, decode_dataset
 from tests.conftest import REPO
 
@@ -195,14 +192,3 @@ def test_writes_block_while_the_writer_is_behind(tmp_path, monkeypatch):
     writer.finalize()
     with h5py.File(tmp_path / "x.hdf5") as f:
         np.testing.assert_array_equal(f["depth"][3], _depth(3))
-
-
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="per-thread nice values are Linux's")
-def test_writer_threads_yield_to_the_render_threads(tmp_path):
-    writer = _small_writer(tmp_path / "x.hdf5", threads=2)
-    own = os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
-    seen = {writer._pool.submit(lambda: os.getpriority(os.PRIO_PROCESS, threading.get_native_id())).result()
-            for _ in range(4)}
-    assert seen == {min(19, own + WORKER_NICENESS)} and WORKER_NICENESS > 0
-    assert os.getpriority(os.PRIO_PROCESS, threading.get_native_id()) == own  # the caller's own is unchanged
-    writer.abort()
