@@ -1,6 +1,7 @@
 """Label throughput: hybridgen's raster pass vs pyrender, and end to end with HDF5 writing.
 
 Run: .venv/bin/python tools/bench_labels.py [--frames 8] [--rounds 5] [--quick] [--breakdown]
+     .venv/bin/python tools/bench_labels.py --e2e-only [--e2e-keypoints 120] [--baseline OTHER_CHECKOUT]
 Needs the ``bench`` extras (pyrender, pybullet for the real meshes, embreex for ``--check``).
 
 Each engine lives in its own process (two OpenGL contexts in one process would fight over which is
@@ -30,9 +31,12 @@ from typing import Any
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 CHECK_RESOLUTION = "640x480"
+E2E_KEYPOINTS = 16
 
 
-def _ours_worker(conn: Any) -> None:
+def _ours_worker(conn: Any, checkout: str | None = None) -> None:
+    if checkout is not None:  # --baseline: that checkout's hybridgen (this one's bench_scenes)
+        sys.path.insert(0, checkout)
     import bench_scenes as bs
     import numpy as np
 
@@ -379,9 +383,9 @@ def run_timed(command: list[str], env: dict[str, str], cpu: list[float] | None =
 
 
 def whole_process_table(names: list[str], resolutions: list[str], count: int, rounds: int,
-                        ask: Any, cache_dir: Path, render_threads: int = 1) -> None:
+                        ask: Any, cache_dir: Path, render_threads: int = 1, e2e_keypoints: int = E2E_KEYPOINTS) -> None:
     """The issue's table: whole ``hybridgen run`` vs the pyrender script, alternating, plus raw / in-process
-    end-to-end label fps (alternating, 16 keypoints, medians of ``rounds``) and their ratio, bytes per keypoint
+    end-to-end label fps (alternating, ``e2e_keypoints`` keypoints, medians of ``rounds``) and their ratio, bytes per keypoint
     and time to first keypoint (1-keypoint runs)."""
     hybridgen = [sys.executable, "-m", "hybridgen"]  # the package on sys.path (PYTHONPATH: another checkout)
     env = dict(os.environ, HYBRIDGEN_CACHE_DIR=str(cache_dir))
@@ -441,9 +445,9 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
                 for r in range(rounds):
                     for kind in (("raw", "hdf5") if r % 2 == 0 else ("hdf5", "raw")):
                         if kind == "raw":
-                            raws.append(ask("ours", "raw", name, resolution, 16))
+                            raws.append(ask("ours", "raw", name, resolution, e2e_keypoints))
                         else:
-                            e2es.append(ask("ours", "hdf5", name, resolution, 16, "default")[0])
+                            e2es.append(ask("ours", "hdf5", name, resolution, e2e_keypoints, "default")[0])
                 raw, e2e = statistics.median(raws), statistics.median(e2es)
                 print(f"{name:<20} {resolution:<10} {raw:>8.1f} {e2e:>8.1f} {e2e / raw:>7.2f} "
                       f"{count / med['ours']:>8.1f} "
@@ -454,6 +458,36 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
                     print(f"{'':<20} {'':<10} render_threads {render_threads}: run fps {count / med['threads']:.1f}, "
                           f"ratio {med['theirs'] / med['threads']:.2f}, cpu ratio "
                           f"{statistics.median(cpu['theirs']) / statistics.median(cpu['threads']):.2f}", flush=True)
+
+
+def e2e_table(names: list[str], resolutions: list[str], count: int, rounds: int, ask: Any,
+              checkouts: list[str]) -> None:
+    """Raw vs end-to-end label fps in process (the e2e/raw goal) per scene and resolution: medians of ``rounds``
+    rounds; in each round every checkout's raw pass and default-writer run, in an order that alternates."""
+    print(f"\nin process, {count} keypoints per measurement, {rounds} alternating rounds, medians; raw = the label "
+          "pass making the stored forms, no writer; e2e = the same with the default HDF5 writer (created, every "
+          "keypoint written, finalized); ratio = median over rounds of e2e / raw of the same round; load average "
+          f"{os.getloadavg()[0]:.1f} at the start")
+    print(f"{'scene':<20} {'resolution':<10} {'checkout':<9} {'raw fps':>8} {'e2e fps':>8} {'e2e/raw':>7} {'MB/kp':>6}")
+    for name in names:
+        for resolution in resolutions:
+            fps: dict[tuple[str, str], list[float]] = {}
+            size: dict[str, float] = {}
+            for r in range(rounds):
+                runs = [(checkout, kind) for checkout in checkouts for kind in ("raw", "hdf5")]
+                for checkout, kind in (runs if r % 2 == 0 else runs[::-1]):
+                    if kind == "raw":
+                        fps.setdefault((checkout, kind), []).append(ask(checkout, "raw", name, resolution, count))
+                    else:
+                        value, size[checkout] = ask(checkout, "hdf5", name, resolution, count, "default")
+                        fps.setdefault((checkout, kind), []).append(value)
+            for checkout in checkouts:
+                raw, e2e = fps[checkout, "raw"], fps[checkout, "hdf5"]
+                ratio = statistics.median(b / a for a, b in zip(raw, e2e))
+                print(f"{name:<20} {resolution:<10} {'this' if checkout == 'ours' else checkout:<9} "
+                      f"{statistics.median(raw):>8.1f} {statistics.median(e2e):>8.1f} {ratio:>7.2f} "
+                      f"{size[checkout] / 1e6:>6.2f}", flush=True)
+    print(f"load average at the end: {os.getloadavg()[0]:.1f}")
 
 
 def main() -> None:
@@ -475,6 +509,12 @@ def main() -> None:
     parser.add_argument("--whole-rounds", type=int, default=3, help="alternating rounds of the whole-process runs")
     parser.add_argument("--inner", action="store_true", help="also the in-process sections: raster pass vs "
                         "pyrender, --breakdown, --check, end to end per compression")
+    parser.add_argument("--e2e-only", action="store_true", help="only raw vs end to end in process (the e2e/raw "
+                        "goal), --rounds alternating rounds per scene and resolution")
+    parser.add_argument("--e2e-keypoints", type=int, default=E2E_KEYPOINTS, help="keypoints of each in-process raw "
+                        "and end-to-end measurement (writer created, every keypoint written, file finalized)")
+    parser.add_argument("--baseline", type=Path, help="with --e2e-only: also time another checkout's hybridgen "
+                        "(e.g. git archive <commit> | tar -x -C /tmp/base) in the same rounds")
     parser.add_argument("--cache-dir", type=Path, help="HYBRIDGEN_CACHE_DIR of the whole-process runs "
                         "(default: a fresh temporary folder, warmed by an untimed run)")
     args = parser.parse_args()
@@ -493,11 +533,18 @@ def main() -> None:
 
     spawn = mp.get_context("spawn")
     workers = {}
-    for engine, target in (("ours", _ours_worker), ("pyrender", _pyrender_worker)):
-        if engine == "pyrender" and args.skip_pyrender:
-            continue
+    engines: list[tuple[str, Any, tuple[Any, ...]]] = [("ours", _ours_worker, ())]
+    if not (args.skip_pyrender or args.e2e_only):
+        engines.append(("pyrender", _pyrender_worker, ()))
+    if args.baseline is not None:
+        if not args.e2e_only:
+            parser.error("--baseline needs --e2e-only")
+        if not (args.baseline / "hybridgen" / "__init__.py").is_file():
+            parser.error(f"--baseline {args.baseline}: no hybridgen package there")
+        engines.append(("baseline", _ours_worker, (str(args.baseline.resolve()),)))
+    for engine, target, extra in engines:
         parent, child = spawn.Pipe()
-        process = spawn.Process(target=target, args=(child,), daemon=True)
+        process = spawn.Process(target=target, args=(child, *extra), daemon=True)
         process.start()
         workers[engine] = (parent, process)
 
@@ -509,10 +556,16 @@ def main() -> None:
     triangles = {name: bs.ALL_SCENES[name]().triangle_count for name in names}
     print(f"{frames} keypoints per round, {rounds} rounds, median frames/s; ours = depth + normals + instance + class; "
           f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f} (other processes skew absolute numbers)")
+    if args.e2e_only:
+        e2e_table(names, resolutions, args.e2e_keypoints, args.rounds, ask, ["ours", *workers.keys() & {"baseline"}])
+        for conn, process in workers.values():
+            conn.send(None)
+            process.join(timeout=10)
+        return
     with tempfile.TemporaryDirectory() as cache:
         whole_process_table(names, resolutions, 20 if args.quick else args.keypoints,
                             2 if args.quick else args.whole_rounds, ask, args.cache_dir or Path(cache),
-                            args.render_threads)
+                            args.render_threads, args.e2e_keypoints)
     if not args.inner:
         for conn, process in workers.values():
             conn.send(None)
