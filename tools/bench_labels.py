@@ -383,10 +383,11 @@ def run_timed(command: list[str], env: dict[str, str], cpu: list[float] | None =
 
 
 def whole_process_table(names: list[str], resolutions: list[str], count: int, rounds: int,
-                        ask: Any, cache_dir: Path, render_threads: int = 1, e2e_keypoints: int = E2E_KEYPOINTS) -> None:
+                        ask: Any, cache_dir: Path, render_threads: int = 1,
+                        e2e_keypoints: int = E2E_KEYPOINTS) -> None:
     """The issue's table: whole ``hybridgen run`` vs the pyrender script, alternating, plus raw / in-process
-    end-to-end label fps (alternating, ``e2e_keypoints`` keypoints, medians of ``rounds``) and their ratio, bytes per keypoint
-    and time to first keypoint (1-keypoint runs)."""
+    end-to-end label fps (alternating, ``e2e_keypoints`` keypoints, medians of ``rounds``) and their ratio, bytes
+    per keypoint and time to first keypoint (1-keypoint runs)."""
     hybridgen = [sys.executable, "-m", "hybridgen"]  # the package on sys.path (PYTHONPATH: another checkout)
     env = dict(os.environ, HYBRIDGEN_CACHE_DIR=str(cache_dir))
     print(f"\nwhole processes, {count} keypoints, {rounds} alternating rounds, medians; 1st kp = a whole run of one "
