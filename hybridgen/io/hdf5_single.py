@@ -32,7 +32,8 @@ from ..errors import InputError
 from .atomic import commit, prepare_output_dir, temporary_path
 from .frame_sink import PassLayout
 from .integrity import ChunkStream, seal
-from .label_encoding import NARROWED, OCTAHEDRAL, EncodedArray, StoredPass, plan_storage, storage_tag
+from .label_encoding import (DERIVED_DISTANCE, NARROWED, OCTAHEDRAL, EncodedArray, StoredPass, plan_storage,
+                             storage_tag)
 
 COMPRESSIONS = ("gzip", "lzf", "none")
 ENCODINGS = ("compact", "plain")
@@ -62,8 +63,11 @@ except ImportError:  # pragma: no cover - isal is a dependency; zlib is the fall
 
 
 def _tag(stored: StoredPass, layout: PassLayout) -> str | None:
-    """The storage tag of a pass stored encoded (octahedral normals, narrowed ids), None otherwise."""
+    """The storage tag of a pass stored encoded (octahedral normals, narrowed ids, ``derived_from_depth``: not
+    stored at all), None otherwise."""
     encoding = stored.attrs.get("encoding")
+    if stored.encode is None and encoding == DERIVED_DISTANCE:
+        return DERIVED_DISTANCE  # a renderer need not compute it
     if stored.encode is None or encoding not in (OCTAHEDRAL, NARROWED):
         return None
     return storage_tag(encoding, stored.dtype, np.dtype(layout.dtype))
@@ -283,6 +287,8 @@ class Hdf5SingleFileWriter:
         if isinstance(value, EncodedArray) and value.tag != _tag(stored, layout):
             value = value.decode()  # a form this file does not store
         if isinstance(value, EncodedArray):  # already the stored form (drawn so by the raster pass)
+            if stored.encode is None:
+                return None  # derived on read: the renderer made no values, none are stored
             if value.stored.shape != stored.shape or value.stored.dtype != stored.dtype:
                 raise InputError(f"'{key}' keypoint {index} holds {value.stored.dtype} {value.stored.shape}, "
                                  f"expected {stored.dtype} {stored.shape}")

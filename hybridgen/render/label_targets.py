@@ -73,8 +73,8 @@ def packed_targets(request: Any, tables: Any, scene: Any, accepted: dict[str, st
 
     ``tables``: the request's :class:`~hybridgen.render.keypoint_frame.LabelTables`; ``accepted``: output key ->
     the storage tag every sink receiving it stores (octahedral normals, narrowed ids): those passes are handed
-    on as drawn."""
-    from ..io.array_encoding import NARROWED, OCTAHEDRAL, storage_tag
+    on as drawn; distance, when every sink derives it from depth on read, is not computed."""
+    from ..io.array_encoding import DERIVED_DISTANCE, NARROWED, OCTAHEDRAL, storage_tag
 
     if request.normals and accepted.get("normals") != OCTAHEDRAL:
         return None
@@ -90,4 +90,6 @@ def packed_targets(request: Any, tables: Any, scene: Any, accepted: dict[str, st
         tag = storage_tag(NARROWED, dtype, np.dtype(np.int32)) if dtype is not None else None
         if tag is not None and accepted.get(key) == tag:
             encoded.append((key, tag))
+    if request.distance and accepted.get("distance") == DERIVED_DISTANCE:  # the sinks derive it from depth
+        encoded.append(("distance", DERIVED_DISTANCE))
     return LabelTargets(bool(request.normals), instance_dtype, category_dtype, tuple(encoded))

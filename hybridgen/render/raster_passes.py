@@ -12,7 +12,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..io.array_encoding import NARROWED, OCTAHEDRAL, EncodedArray, decode_octahedral, storage_tag
+from ..io.array_encoding import (DERIVED_DISTANCE, NARROWED, OCTAHEDRAL, EncodedArray, decode_octahedral,
+                                 storage_tag)
 from .readback import RasterOutput
 
 
@@ -25,8 +26,12 @@ def depth(out: RasterOutput) -> np.ndarray:
     return values
 
 
-def distance(out: RasterOutput) -> np.ndarray:
-    """Euclidean distance from the camera centre (m), ``depth_background`` where nothing was hit."""
+def distance(out: RasterOutput) -> Any:
+    """Euclidean distance from the camera centre (m), ``depth_background`` where nothing was hit; an empty
+    ``derived_from_depth`` :class:`~hybridgen.io.label_encoding.EncodedArray` where every sink derives it from
+    depth on read (``encoded``)."""
+    if out.encoded.get("distance") == DERIVED_DISTANCE:
+        return EncodedArray(np.empty(0, np.float32), DERIVED_DISTANCE)
     dist = out.z * out.ray_lengths
     dist[~out.hit] = out.depth_background
     return dist.astype(np.float32, copy=False)

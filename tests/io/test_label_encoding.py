@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
+from hybridgen.io.array_encoding import DERIVED_DISTANCE, EncodedArray
 from hybridgen.io.frame_sink import PassLayout
 from hybridgen.io.label_encoding import (OCTAHEDRAL_MAX_ERROR_RAD, decode_dataset, decode_octahedral,
                                          encode_octahedral, narrowest_integer_dtype)
@@ -158,3 +159,46 @@ def test_stereo_passes_decode(gl_context, tmp_path):
             np.testing.assert_array_equal(decode_dataset(f["distance"], i)[1], right["distance"])
             np.testing.assert_array_equal(decode_dataset(f["instance_segmaps"], i)[1], right["instance_segmaps"])
         assert decode_dataset(f["distance"]).shape == (4, 2, 48, 64)
+
+
+class _SpySink:
+    """Takes what the HDF5 file next to it takes (its accepted encodings) and keeps the values it is handed."""
+
+    def __init__(self, writer):
+        self.writer, self.values = writer, []
+
+    def begin(self, n, layouts, records, attributes):
+        pass
+
+    def accepted_encodings(self):
+        return self.writer.accepted_encodings()
+
+    def write(self, index, values):
+        self.values.append(values)
+
+    def end(self):
+        pass
+
+
+def test_distance_derived_on_read_is_not_computed(gl_context, tmp_path):
+    """The file derives distance from depth: the renderer hands over an empty marker instead of computing it,
+    and the file reads back the distance the renderer computes for a sink that stores it."""
+    scene = _scene()
+    request = hg.LabelRequest(distance=True, map_by=["instance"])
+    writer = hg.Hdf5SingleFileWriter(tmp_path / "x.hdf5")
+    spy = _SpySink(writer)
+    hg.render_labels(scene, [writer, spy], request)
+    writer.finalize()
+    assert all(isinstance(v["distance"], EncodedArray) and v["distance"].tag == DERIVED_DISTANCE
+               and v["distance"].stored.size == 0 for v in spy.values)
+    memory = hg.MemorySink()  # stores distance itself: it is computed for both sinks
+    other = hg.Hdf5SingleFileWriter(tmp_path / "y.hdf5")
+    hg.render_labels(scene, [other, memory], request)
+    other.finalize()
+    with h5py.File(tmp_path / "x.hdf5") as f, h5py.File(tmp_path / "y.hdf5") as g:
+        assert f["distance"].id.get_storage_size() == 0
+        for i in range(len(scene.camera)):
+            expected = memory.frames[i]["distance"]
+            assert isinstance(expected, np.ndarray) and expected.dtype == np.float32
+            np.testing.assert_array_equal(decode_dataset(f["distance"], i), expected)
+            np.testing.assert_array_equal(decode_dataset(g["distance"], i), expected)
