@@ -36,7 +36,7 @@ estimate is conservative (it sees more noise than the full estimate has) and pix
 than the threshold strictly needs. Against Mitsuba's default ``independent`` random numbers it lowers the
 noise of the tabletop scene of tools/color_quality.py at 16 / 64 / 256 spp from 28.5 / 34.3 / 40.1 dB to
 35.3 / 40.7 / 45.5 dB (PSNR against a 4096-spp reference): as clean as 8-16x the samples, for ~15 % more
-CPU time per sample. Sample counts are traced in power-of-two launches
+CPU time per sample. Sample counts are traced as whole 4^k-point patterns
 (:func:`hybridgen.render.adaptive_sampling.launch_counts`)."""
 
 DEFAULT_MAX_SAMPLES = 1024

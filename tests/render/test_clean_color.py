@@ -308,13 +308,16 @@ def test_scalar_variant_samples_adaptively_through_whole_frames():
     assert image.mean() == pytest.approx(reference.mean(), rel=0.03)
 
 
-def test_stratified_sampler_launches_power_of_two_patterns(variant):
-    """The low-discrepancy sampler takes 4^k-point patterns: a count is traced as power-of-two launches (each
-    the first half or all of such a pattern), so any fixed spp works, deterministically and unbiased."""
+def test_stratified_sampler_launches_whole_patterns(variant):
+    """The low-discrepancy sampler takes 4^k-point patterns: a count is traced as whole patterns of up to 1024
+    points (a rest of 2 or 3 as half of a 4-point pattern), so any fixed spp works, deterministically and
+    unbiased."""
     from hybridgen.render.adaptive_sampling import launch_counts, pattern_size
 
-    assert launch_counts(100, "LowDiscrepancySampler") == [64, 32, 4]
+    assert launch_counts(100, "LowDiscrepancySampler") == [64, 16, 16, 4]
     assert launch_counts(7, "LowDiscrepancySampler") == [4, 2, 1]
+    assert launch_counts(128, "LowDiscrepancySampler") == [64, 64]  # adaptive rounds run 64- and 256-point kernels
+    assert launch_counts(4096, "LowDiscrepancySampler") == [1024] * 4
     assert launch_counts(100, "IndependentSampler") == [100]
     assert [pattern_size(n, "LowDiscrepancySampler") for n in (1, 2, 16, 32, 512, 1024)] == [4, 4, 16, 64, 1024, 1024]
     import mitsuba as mi
