@@ -191,11 +191,14 @@ class SpecularGuideTracer:
         self.candidates = np.array(sorted(obj.instance_id for obj, ok in zip(objects, self.lobes.specular_like) if ok),
                                    dtype=np.int64)
         row_of_key = {f"object_{obj.instance_id}": row for row, obj in enumerate(objects)}
-        self._shape_rows: dict[int, int] = {}
+        shape_rows: dict[int, int] = {}  # Dr.Jit registry id of a plain mesh shape -> its object's row
         for shape in mi_scene.shapes():
             key = shape.id().removesuffix("_back")
             if key in row_of_key and isinstance(shape, mi.Mesh):
-                self._shape_rows[int(dr.reinterpret_array(mi.UInt32, mi.ShapePtr(shape))[0])] = row_of_key[key]
+                shape_rows[int(dr.reinterpret_array(mi.UInt32, mi.ShapePtr(shape))[0])] = row_of_key[key]
+        self._shape_lut = np.full(max(shape_rows, default=0) + 1, -1, dtype=np.int64)
+        for shape_id, row in shape_rows.items():
+            self._shape_lut[shape_id] = row
         self._row_lut = np.full(max((o.instance_id for o in objects), default=0) + 1, -1, dtype=np.int64)
         for row, obj in enumerate(objects):
             self._row_lut[obj.instance_id] = row
@@ -316,7 +319,8 @@ class SpecularGuideTracer:
         dr.eval(base, valid, shapes, si.p, si.n, si.sh_frame.n)  # one kernel (each read would launch its own)
         valid = np.array(valid, dtype=bool)
         shape_ids = np.array(shapes, dtype=np.int64)
-        row = np.array([self._shape_rows.get(int(s), -1) for s in shape_ids], dtype=np.int64)
+        known = shape_ids < len(self._shape_lut)  # else an instanced shape's mesh (-1); a miss is id 0 (-1)
+        row = np.where(known, self._shape_lut[np.where(known, shape_ids, 0)], -1)
         as_rows = lambda value: np.array(value, dtype=np.float64).T.reshape(-1, 3)[:count]  # noqa: E731
         normal, geometric = as_rows(si.sh_frame.n), as_rows(si.n)
         return _Hits(valid[:count], as_rows(si.p), normal, geometric, np.clip(as_rows(base), 0.0, None), row[:count])
