@@ -393,6 +393,12 @@ class DefaultRuns:
 
 
 # ----------------------------------------------------------------------------------------- scoring
+PHASES = ("startup", "import", "build", "render", "write", "exit")
+"""The phases of a timed hybridgen process (:meth:`DefaultRuns.run`)."""
+LOBES_NAME = {False: "default", True: "blenderproc"}
+"""``--blenderproc-lobes`` -> the name of default_color_process.LOBES' entry."""
+
+
 def time_hybridgen(name: str, resolution: str, workdir: Path, args: Any, reference: np.ndarray,
                    row: dict[str, Any]) -> np.ndarray:
     """Fills ``row`` with hybridgen's whole-process numbers (one cold run, ``args.warm_runs`` warm ones:
@@ -419,10 +425,6 @@ def time_hybridgen(name: str, resolution: str, workdir: Path, args: Any, referen
                hg_cold_phases={key: round(cold[key], 3) for key in PHASES},
                hg_same_bytes_cold_warm=bool(np.array_equal(_read_png(cold_png), image)))
     return image
-
-
-PHASES = ("startup", "import", "build", "render", "write", "exit")
-LOBES_NAME = {False: "default", True: "blenderproc"}
 
 
 def time_cycles(name: str, session: CyclesSession, workdir: Path, row: dict[str, Any]) -> np.ndarray:
