@@ -31,8 +31,15 @@ Fresnel of the specular layer, F0 = 0.08 x specular, ``F_g`` the glass Fresnel o
 with F0 = base color): diffuse ``(1-m)(1-t)(1-F_s) base``, specular layer ``(1-m)(1-t) F_s``, metal
 ``m F_m``, glass ``(1-m) t (F_g + (1-F_g) base)``; the last three are specular-like when roughness^2 <= 0.075.
 
-Limits: objects with a roughness or metallic *texture* are treated as rough (their raster guides stay), and a
-secondary hit on instanced geometry (Mitsuba shape groups) writes its features there. JIT variants only.
+Limits: objects with a roughness or metallic *texture* are treated as rough (their raster guides stay);
+instanced geometry (Mitsuba shape groups, :mod:`hybridgen.render.mitsuba_instances`) is not looked through (its
+hit shape is the group's mesh, not one object), and a branch that hits it writes its features there. JIT
+variants only (``scalar_rgb`` keeps the raster guides).
+
+Cost (materials scene of tools/color_quality.py, 160x120, guides 3 x 3 supersampled, ~16k of 173k sub-pixels
+deferred, 4 ray launches): guide CPU 0.017 -> 0.09 s per frame on the loaded 2-core machine, against ~3.5 s
+for the whole default color process; scenes without smooth specular materials run no ray. Dr.Jit compiles
+each launch size once per process (its kernel cache on disk keeps them across processes).
 """
 from __future__ import annotations
 
