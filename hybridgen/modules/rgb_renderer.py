@@ -39,12 +39,13 @@ class RgbRenderer(Module):
               "default); N: a plain N-spp estimate in every pixel, or at most N when noise_threshold is given "
               "(Cycles' meaning)", check=_optional_positive),
         Param("noise_threshold", "float|null", None, doc="adaptive sampling: a pixel gets no more samples once "
-              "its noise estimate (Cycles') is below this; null: 0.01 when samples is null, else off; 0: off",
+              "its noise estimate (Cycles') is below this (Cycles' meaning: 0.01 is BlenderProc's default); null: "
+              "0.005 when samples is null (samples here cost a third of Cycles'), else off; 0: off",
               check=_optional_non_negative),
         Param("use_adaptive_sampling", "float|null", None, doc="BlenderProc 1.x's name of noise_threshold",
               check=_optional_non_negative),
         Param("min_samples", "int", 0, "spp", "samples every pixel gets before adaptive sampling judges it "
-              "(Cycles' Min Samples); 0: Cycles' automatic value, 64 at noise threshold 0.01",
+              "(Cycles' Min Samples); 0: Cycles' automatic value, 80 at noise threshold 0.005, 64 at 0.01",
               check=_non_negative),
         Param("clamp_indirect", "float", 10.0, doc="firefly control, Cycles' sample_clamp_indirect: indirect "
               "light of one sample is scaled down to at most this linear radiance (direct light never); 0: off",

@@ -4,7 +4,8 @@ Knobs (Cycles' and BlenderProc's names and meaning):
 
 - ``noise_threshold``: a pixel stops receiving samples once its error estimate is below five times it
   (Cycles' "Noise Threshold" with Cycles' factor of 5, verified below; BlenderProc's ``set_noise_threshold``
-  / 1.x ``use_adaptive_sampling``; 0.01 is BlenderProc's default, smaller is cleaner and slower). 0 disables
+  / 1.x ``use_adaptive_sampling``; 0.01 is BlenderProc's default, hybridgen's is 0.005:
+  :data:`hybridgen.render.path_trace.DEFAULT_NOISE_THRESHOLD`; smaller is cleaner and slower). 0 disables
   adaptivity: every pixel gets ``max_samples``.
 - ``max_samples``: samples per pixel a pixel never exceeds (Cycles' ``samples`` when adaptive).
 - ``min_samples``: samples every pixel gets before the first error estimate (Cycles' "Min Samples"); 0, the
