@@ -348,10 +348,13 @@ class Hdf5SingleFileWriter:
         self.frames_written += 1
 
     def _drain(self) -> None:
-        """Wait until every queued keypoint is stored (or dropped after an error); raise the first error."""
-        pending, self._pending, self._stored_before = self._pending, [], None
-        for job in pending:
-            job.result()  # _keypoint never raises: its errors are kept in self._error
+        """Wait until every queued keypoint is stored (or dropped after an error); raise the first error. A job
+        leaves the list only once it is done, so an interrupted drain (SIGTERM's SystemExit) is finished by the
+        next one (``abort``) before the file is closed."""
+        while self._pending:
+            self._pending[0].result()  # _keypoint never raises: its errors are kept in self._error
+            self._pending.pop(0)
+        self._stored_before = None
         self._raise_worker_error()
 
     def _raise_worker_error(self) -> None:
