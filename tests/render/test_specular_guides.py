@@ -167,3 +167,18 @@ def test_guides_in_a_smooth_metal_mirror_are_the_wall_times_schlick_and_rough_pi
     far = ~near & (ids != mirror.instance_id)  # rough pixels away from the mirror: raster values bit for bit
     np.testing.assert_array_equal(albedo[far], raster_albedo[far])
     np.testing.assert_array_equal(normals[far], raster_normals[far])
+
+
+def test_color_producer_denoises_with_the_guides_of_its_own_path_trace_view(gl_context, jit_variant):
+    pytest.importorskip("pyoidn")
+    from hybridgen.render.render_color import ColorProducer
+
+    scene = _slab_scene(roughness=0.0)
+    scene.lights.append(hg.Light("sun", "SUN", energy=2.0, local2world=hg.object_pose([0, 0, 5], [0.3, 0.1, 0])))
+    producer = ColorProducer(scene, PathTraceSettings(samples=1), variant=jit_variant, denoise=True)
+    try:
+        producer.produce(0, scene.camera.keypoints[0])
+        intr = scene.camera.intrinsics
+        assert producer._guides is not None and producer._guides.traced_subpixels == intr.width * intr.height * 9
+    finally:
+        producer.close()
