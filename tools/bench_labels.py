@@ -307,9 +307,11 @@ def export_assets(name: str, folder: Path) -> list[dict[str, Any]]:
     return entries
 
 
-def write_configs(name: str, resolution: str, count: int, folder: Path, render_threads: int = 1) -> tuple[Path, Path]:
+def write_configs(name: str, resolution: str, count: int, folder: Path,
+                  render_threads: int | None = None) -> tuple[Path, Path]:
     """A labels-only hybridgen config (depth + normals + class + instance, default HDF5 writer, ``render_threads``
-    raster threads) and the pyrender script's spec: the same meshes, intrinsics and ``count`` poses."""
+    raster threads; None: SegMapRenderer's default, auto) and the pyrender script's spec: the same meshes,
+    intrinsics and ``count`` poses."""
     import json
 
     import bench_scenes as bs
@@ -333,10 +335,11 @@ def write_configs(name: str, resolution: str, count: int, folder: Path, render_t
         # source_frame as in BlenderProc: the OpenCV camera's axes in Blender camera axes
         lines.append(f"        - {{cam2world_matrix: {[float(v) for v in pose.ravel()]}, source_frame: [X, -Y, -Z]}}")
     lines.append("  - {name: renderer.SegMapRenderer, config: {render_depth: true, render_normals: true, "
-                 f"map_by: [class, instance], render_threads: {render_threads}}}}}")
+                 "map_by: [class, instance]" + ("" if render_threads is None else f", render_threads: {render_threads}")
+                 + "}}")
     lines.append("  - {name: writer.Hdf5Writer}")
     folder.mkdir(parents=True, exist_ok=True)
-    stem = f"{name.split()[0]}_{resolution}_{count}_{render_threads}t"
+    stem = f"{name.split()[0]}_{resolution}_{count}_{render_threads or 'default'}t"
     config = folder / f"{stem}.yaml"
     config.write_text("\n".join(lines) + "\n")
     spec = folder / f"{stem}.json"

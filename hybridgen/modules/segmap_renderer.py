@@ -9,9 +9,16 @@ from ..io.blenderproc_segmap import SegmapSink, apply_default_values, segmap_pla
 from ..io.renamed_sink import renamed_sinks
 from ..render.label_request import parse_map_by
 from ..render.render_labels import render_labels
+from ..render.threaded_labels import auto_render_threads
 from ..run.context import RunContext
 from .base import Module, Role
 from .label_params import label_params, label_request, stored_keys
+
+
+def _threads_check(value: Any) -> str | None:
+    if value == "auto" or (isinstance(value, int) and not isinstance(value, bool) and value >= 1):
+        return None
+    return f"must be 'auto' or an integer >= 1, got {value!r}"
 
 
 def _segmap_check(value: Any) -> str | None:
@@ -34,9 +41,10 @@ class SegMapRenderer(Module):
                     doc="also store BlenderProc's one segmap, {key, default_values}: a channel per numeric map_by "
                     "attribute in order (text attributes only in instance_attribute_maps); objects lacking an "
                     "attribute get its default value (set by BlenderProc configs)"),
-              Param("render_threads", "int", 1, check=lambda v: None if v >= 1 else f"must be >= 1, got {v}",
-                    doc="raster threads, each with its own GL context and copy of the geometry "
-                    "(docs/label_pipeline.md); same bytes as 1"))
+              Param("render_threads", "int|str", "auto", check=_threads_check,
+                    doc="raster threads, each with its own GL context and copy of the geometry; auto: 2 for "
+                    "scenes of 1M triangles or more on 2+ cores, else 1 (docs/label_pipeline.md); same bytes "
+                    "whatever the count"))
 
     def produces(self) -> frozenset[str] | None:
         segmap = self.config["blenderproc_segmap"]
@@ -50,8 +58,11 @@ class SegMapRenderer(Module):
             plan = segmap_plan(context.scene, parse_map_by(config["map_by"]))
             config = {**config, "map_by": plan.map_by or None}
             sinks = [SegmapSink(sink, plan.channels, segmap.get("key", "segmap")) for sink in sinks]
+        threads = config["render_threads"]
+        if threads == "auto":
+            threads = auto_render_threads(context.scene.triangle_count)
         context.frames_rendered += render_labels(context.scene, sinks, label_request(config),
                                                  default_category_id=context.default_category_id,
                                                  progress=context.progress,
                                                  indices=context.keypoint_indices(),
-                                                 render_threads=config["render_threads"])
+                                                 render_threads=threads)

@@ -156,3 +156,45 @@ def test_gil_free_calls_give_the_same_readback_as_moderngl(gl_context):
     finally:
         free.release()
         held.release()
+
+
+def test_auto_render_threads_rule(monkeypatch):
+    from hybridgen.render.threaded_labels import AUTO_THREADS_TRIANGLES, auto_render_threads, process_cores
+
+    assert auto_render_threads(AUTO_THREADS_TRIANGLES - 1, cores=16) == 1
+    assert auto_render_threads(AUTO_THREADS_TRIANGLES, cores=2) == 2
+    assert auto_render_threads(10 * AUTO_THREADS_TRIANGLES, cores=1) == 1
+    monkeypatch.setenv("LP_NUM_THREADS", "1")  # a pool worker's share of the cores
+    assert process_cores() == 1 and auto_render_threads(AUTO_THREADS_TRIANGLES) == 1
+    monkeypatch.setenv("LP_NUM_THREADS", "3")
+    assert process_cores() == 3 and auto_render_threads(AUTO_THREADS_TRIANGLES) == 2
+    monkeypatch.delenv("LP_NUM_THREADS")
+    assert process_cores() >= 1
+
+
+def test_segmap_renderer_render_threads_auto_follows_the_triangle_count(run_cli, tmp_path, monkeypatch):
+    import hybridgen.modules.segmap_renderer as module
+    import hybridgen.render.threaded_labels as threaded_labels
+    from tests.conftest import REPO
+
+    seen: list[int] = []
+    real = module.render_labels
+
+    def recording(*args, **kwargs):
+        seen.append(kwargs["render_threads"])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(module, "render_labels", recording)
+    monkeypatch.setenv("LP_NUM_THREADS", "2")
+    default = CONFIG.replace("{render_threads: %d}", "{}") % (REPO / "configs/assets/knot.obj")
+    for threshold, expected in ((10**9, 1), (1, 2)):  # the knot is far below / above the threshold
+        monkeypatch.setattr(threaded_labels, "AUTO_THREADS_TRIANGLES", threshold)
+        config = tmp_path / f"auto{expected}.yaml"
+        config.write_text(default)
+        code, _, err = run_cli("run", "--quiet", str(config), str(tmp_path / f"auto{expected}"))
+        assert code == 0, err
+        assert seen[-1] == expected
+    config = tmp_path / "bad.yaml"
+    config.write_text(CONFIG.replace("%d", "fast") % (REPO / "configs/assets/knot.obj"))
+    code, _, err = run_cli("run", "--quiet", str(config), str(tmp_path / "bad"))
+    assert code == 2 and "render_threads" in err and "auto" in err and len(err.strip().splitlines()) == 1, err
