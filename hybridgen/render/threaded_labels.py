@@ -14,9 +14,9 @@ raises :class:`~hybridgen.errors.SystemSetupError` instead of hanging.
 
 ``render_threads: auto`` (:func:`auto_render_threads`) takes 2 threads for scenes of
 :data:`AUTO_THREADS_TRIANGLES` triangles or more when the process has 2 cores or more, else 1 (measured
-2026-11-24, whole ``hybridgen run`` processes of 120 keypoints, docs/label_pipeline.md: the 1.4M-triangle mesh
-gains 8-13 %, the 125k-triangle monastery *loses* ~50 %, since one thread already overlaps its binning with
-llvmpipe's rasterizer threads).
+2026-11-24, whole ``hybridgen run`` processes of 120 keypoints, loaded machine, docs/label_pipeline.md: the
+1.4M-triangle mesh gains 14 % at 1280x720 and nothing at 640x480, the 125k-triangle monastery *loses* ~50 %,
+since one thread already overlaps its binning with llvmpipe's rasterizer threads).
 """
 from __future__ import annotations
 
