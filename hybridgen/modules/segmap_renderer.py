@@ -43,8 +43,8 @@ class SegMapRenderer(Module):
                     "attribute get its default value (set by BlenderProc configs)"),
               Param("render_threads", "int|str", "auto", check=_threads_check,
                     doc="raster threads, each with its own GL context and copy of the geometry; auto: 2 for "
-                    "scenes of 1M triangles or more on 2+ cores, else 1 (docs/label_pipeline.md); same bytes "
-                    "whatever the count"))
+                    "32+ keypoints of a scene of 1M+ triangles on 2+ cores, else 1 (docs/label_pipeline.md); "
+                    "same bytes whatever the count"))
 
     def produces(self) -> frozenset[str] | None:
         segmap = self.config["blenderproc_segmap"]
@@ -60,7 +60,7 @@ class SegMapRenderer(Module):
             sinks = [SegmapSink(sink, plan.channels, segmap.get("key", "segmap")) for sink in sinks]
         threads = config["render_threads"]
         if threads == "auto":
-            threads = auto_render_threads(context.scene.triangle_count)
+            threads = auto_render_threads(context.scene.triangle_count, len(context.keypoint_indices()))
         context.frames_rendered += render_labels(context.scene, sinks, label_request(config),
                                                  default_category_id=context.default_category_id,
                                                  progress=context.progress,

@@ -13,7 +13,8 @@ the constructor, for context creation and upload); a worker that does not answer
 raises :class:`~hybridgen.errors.SystemSetupError` instead of hanging.
 
 ``render_threads: auto`` (:func:`auto_render_threads`) takes 2 threads for scenes of
-:data:`AUTO_THREADS_TRIANGLES` triangles or more when the process has 2 cores or more, else 1 (measured
+:data:`AUTO_THREADS_TRIANGLES` triangles or more when the process has 2 cores or more and renders
+:data:`AUTO_THREADS_KEYPOINTS` keypoints or more (a second context and upload cost ~0.2-0.3 s), else 1 (measured
 2026-11-24, whole ``hybridgen run`` processes of 120 keypoints, loaded machine, docs/label_pipeline.md: the
 1.4M-triangle mesh gains 14 % at 1280x720 and nothing at 640x480, the 125k-triangle monastery *loses* ~50 %,
 since one thread already overlaps its binning with llvmpipe's rasterizer threads).
@@ -42,6 +43,8 @@ DEFAULT_TIMEOUT_S = 600.0
 """Longest wait for one keypoint (or for a worker's context and upload) before giving up, seconds."""
 AUTO_THREADS_TRIANGLES = 1_000_000
 """Scenes of at least this many triangles get 2 raster threads under ``render_threads: auto``."""
+AUTO_THREADS_KEYPOINTS = 32
+"""... when at least this many keypoints are rendered (below, the second upload costs more than it saves)."""
 
 
 def process_cores() -> int:
@@ -56,11 +59,13 @@ def process_cores() -> int:
         return os.cpu_count() or 1
 
 
-def auto_render_threads(triangles: int, cores: int | None = None) -> int:
-    """Raster threads for a scene of ``triangles`` triangles on ``cores`` cores (default: :func:`process_cores`):
-    2 for :data:`AUTO_THREADS_TRIANGLES` or more on 2 cores or more, else 1."""
+def auto_render_threads(triangles: int, keypoints: int, cores: int | None = None) -> int:
+    """Raster threads for ``keypoints`` keypoints of a scene of ``triangles`` triangles on ``cores`` cores
+    (default: :func:`process_cores`): 2 for :data:`AUTO_THREADS_TRIANGLES` triangles or more, 2 cores or more
+    and :data:`AUTO_THREADS_KEYPOINTS` keypoints or more, else 1."""
     cores = process_cores() if cores is None else cores
-    return 2 if triangles >= AUTO_THREADS_TRIANGLES and cores >= 2 else 1
+    big = triangles >= AUTO_THREADS_TRIANGLES and keypoints >= AUTO_THREADS_KEYPOINTS
+    return 2 if big and cores >= 2 else 1
 
 
 class _Worker:

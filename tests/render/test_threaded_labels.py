@@ -159,15 +159,18 @@ def test_gil_free_calls_give_the_same_readback_as_moderngl(gl_context):
 
 
 def test_auto_render_threads_rule(monkeypatch):
-    from hybridgen.render.threaded_labels import AUTO_THREADS_TRIANGLES, auto_render_threads, process_cores
+    from hybridgen.render.threaded_labels import (AUTO_THREADS_KEYPOINTS, AUTO_THREADS_TRIANGLES,
+                                                  auto_render_threads, process_cores)
 
-    assert auto_render_threads(AUTO_THREADS_TRIANGLES - 1, cores=16) == 1
-    assert auto_render_threads(AUTO_THREADS_TRIANGLES, cores=2) == 2
-    assert auto_render_threads(10 * AUTO_THREADS_TRIANGLES, cores=1) == 1
+    many, big = AUTO_THREADS_KEYPOINTS, AUTO_THREADS_TRIANGLES
+    assert auto_render_threads(big - 1, many, cores=16) == 1
+    assert auto_render_threads(big, many, cores=2) == 2
+    assert auto_render_threads(big, many - 1, cores=2) == 1  # too few keypoints to pay for a second upload
+    assert auto_render_threads(10 * big, 10 * many, cores=1) == 1
     monkeypatch.setenv("LP_NUM_THREADS", "1")  # a pool worker's share of the cores
-    assert process_cores() == 1 and auto_render_threads(AUTO_THREADS_TRIANGLES) == 1
+    assert process_cores() == 1 and auto_render_threads(big, many) == 1
     monkeypatch.setenv("LP_NUM_THREADS", "3")
-    assert process_cores() == 3 and auto_render_threads(AUTO_THREADS_TRIANGLES) == 2
+    assert process_cores() == 3 and auto_render_threads(big, many) == 2
     monkeypatch.delenv("LP_NUM_THREADS")
     assert process_cores() >= 1
 
@@ -186,6 +189,7 @@ def test_segmap_renderer_render_threads_auto_follows_the_triangle_count(run_cli,
 
     monkeypatch.setattr(module, "render_labels", recording)
     monkeypatch.setenv("LP_NUM_THREADS", "2")
+    monkeypatch.setattr(threaded_labels, "AUTO_THREADS_KEYPOINTS", 3)  # the config's keypoints
     default = CONFIG.replace("{render_threads: %d}", "{}") % (REPO / "configs/assets/knot.obj")
     for threshold, expected in ((10**9, 1), (1, 2)):  # the knot is far below / above the threshold
         monkeypatch.setattr(threaded_labels, "AUTO_THREADS_TRIANGLES", threshold)
