@@ -57,7 +57,7 @@ def main() -> None:
             reference = (references[0] + references[1]) / 2
             reference_noise = ((references[0] - references[1]) ** 2).sum(axis=2) / 4  # its share of the error
             ids = RasterView(scene).render(cam, ["instance_segmaps"])["instance_segmaps"]
-            guides = DenoiseGuides(scene, filter_width=view.filter_width)
+            guides = DenoiseGuides(scene, filter_width=view.filter_width, follow_specular=True)
             rows = {"raster": [], "traced": []}
             per_object: dict[str, dict[str, list[float]]] = {"raster": {}, "traced": {}}
             seconds = {"raster": 0.0, "traced": 0.0}

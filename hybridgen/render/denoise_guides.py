@@ -9,9 +9,9 @@ tools/color_quality.py (160x120, 64 spp, against a 1024-spp reference) 40.4 dB w
 :meth:`hybridgen.scene.camera.Intrinsics.resized`) and averages ``factor x factor`` blocks. Averaged normals
 are not renormalised: at a silhouette the shorter mixed vector is what the pixel sees.
 
-Given the color's path-trace view, sub-pixels that see sharp glass, mirrors or smooth metal get the features
-of what is seen *through* them, as Cycles' denoising passes do (:mod:`hybridgen.render.specular_guides`),
-before the same filter; all other sub-pixels keep the raster values.
+With ``follow_specular`` and the color's path-trace view, sub-pixels that see sharp glass, mirrors or smooth
+metal get the features of what is seen *through* them, as Cycles' denoising passes do
+(:mod:`hybridgen.render.specular_guides`), before the same filter; all other sub-pixels keep the raster values.
 """
 from __future__ import annotations
 
@@ -25,6 +25,14 @@ from .scene_raster import SceneRaster
 from .specular_guides import SpecularGuideTracer, can_be_specular_like
 
 DEFAULT_FACTOR = 3
+FOLLOW_SPECULAR = False
+"""Whether the guides follow sharp specular surfaces by default (:mod:`hybridgen.render.specular_guides`). Off,
+as measured with tools/bench_denoise_guides.py on the materials scene of tools/color_quality.py (160x120, the
+same noisy render denoised both ways, PSNR against two 2048-spp references without their own noise): +0.06 dB
+over 6 seeds (-0.12 .. +0.19), -0.05 dB (-0.94 .. +0.53) after later sampling changes, +0.21 dB with a
+checker floor seen through the glass; at BlenderProc's lobe limits (glossy and transmission bounces 0) +0.22,
++0.23 and -1.98 dB (a point light's highlights on the near-specular spheres lose the sphere's normal in the
+guide). Neutral on average, with outliers, for +0.07 s of guide CPU per frame."""
 
 
 class DenoiseGuides:
@@ -32,13 +40,14 @@ class DenoiseGuides:
     drawn with ``raster`` (the scene's shared raster view, left open) or a view built here."""
 
     def __init__(self, scene: Scene, factor: int = DEFAULT_FACTOR, raster: SceneRaster | None = None,
-                 filter_width: float = DEFAULT_WIDTH) -> None:
+                 filter_width: float = DEFAULT_WIDTH, follow_specular: bool | None = None) -> None:
         intr = scene.camera.intrinsics
         self.factor, self.width, self.height = int(factor), intr.width, intr.height
         self.filter_width = float(filter_width)  # the color's pixel filter (0: box), render/pixel_filter.py
         self.fine = intr.resized(intr.width * self.factor, intr.height * self.factor)
         self._own = raster is None
         self.raster = raster or SceneRaster(scene)
+        self.follow_specular = FOLLOW_SPECULAR if follow_specular is None else bool(follow_specular)
         self._tracer: tuple[Any, SpecularGuideTracer] | None = None  # (the Mitsuba scene it traces, tracer)
         self.traced_subpixels = 0  # of the last render (sub-pixels whose features come from behind glass/mirrors)
 
@@ -52,8 +61,8 @@ class DenoiseGuides:
 
     def render(self, cam2world: np.ndarray, path_view: Any = None) -> tuple[np.ndarray, np.ndarray]:
         """(albedo, normals) of one keypoint (OpenCV-axes ``cam2world``); with ``path_view`` (the color's
-        :class:`~hybridgen.render.path_trace.PathTraceView`, JIT variants) they follow sharp specular surfaces
-        (:mod:`hybridgen.render.specular_guides`)."""
+        :class:`~hybridgen.render.path_trace.PathTraceView`, JIT variants) and ``follow_specular`` they follow
+        sharp specular surfaces (:mod:`hybridgen.render.specular_guides`)."""
         tracer = self._tracer_for(path_view)
         albedo = self.raster.albedo.render(cam2world, intrinsics=self.fine)
         passes = self.raster.view.render(cam2world, ["normals"] + (["instance_segmaps"] if tracer else []),
@@ -68,7 +77,7 @@ class DenoiseGuides:
 
     def _tracer_for(self, path_view: Any) -> SpecularGuideTracer | None:
         """The tracer of ``path_view``'s Mitsuba scene (rebuilt with it), or None where nothing is traced."""
-        if path_view is None or not any(can_be_specular_like(o.material) for o in self.raster.scene.objects):
+        if path_view is None or not self.follow_specular or not any(can_be_specular_like(o.material) for o in self.raster.scene.objects):
             return None
         from .mitsuba_variant import is_jit
 

@@ -13,8 +13,9 @@ Apache-2.0, read for its behaviour):
   albedo times the throughput so far) and the path stops writing;
 - otherwise the feature throughput is multiplied by the specular closures' albedo and the features are taken
   at the next hit of the path (which Cycles samples: reflection or refraction in proportion to their weights),
-  up to the path's bounce limits; a path that ends first (or escapes; the background writes no normal) adds
-  no normal.
+  up to the path's bounce limits; a path that ends first writes no features, and a path that escapes, or that
+  went past a per-lobe limit (``glossy_bounces``/``transmission_bounces``) and then hits an emitter, adds that
+  emission to the albedo and no normal.
 
 Here the same rule runs deterministically on the supersampled guide sub-pixels whose raster object could be
 specular-like: the camera ray through the sub-pixel centre is traced in the color's own Mitsuba scene, and at
@@ -23,7 +24,8 @@ or Schlick's ``F`` of the base color (metal), refraction with ``(1 - F)`` times 
 while the normal is averaged with each branch's share of the sampling probability, as Cycles' sample mean
 converges to. Albedo at the surface where features are written is its base color as the raster albedo draws
 it (Mitsuba's ``eval_diffuse_reflectance``: base color, texture or vertex colors); escaping rays add the world
-color (the raster background). Every other sub-pixel keeps the raster value bit for bit, so scenes without
+color (the raster background), and branches past a per-lobe limit that hit an emitting object add its base color
+(the raster albedo of emitters). Every other sub-pixel keeps the raster value bit for bit, so scenes without
 smooth specular materials cost nothing.
 
 Principled closures and their sample weights (``m`` metallic, ``t`` transmission, ``F_s`` the dielectric
@@ -43,7 +45,7 @@ each launch size once per process (its kernel cache on disk keeps them across pr
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
@@ -51,6 +53,7 @@ import numpy as np
 from ..scene.camera import Intrinsics
 from ..scene.material import Material
 from ..scene.scene import Scene
+from .material_emission import emitted_radiance
 
 SPECULAR_ALPHA = 0.075
 """GGX alpha (roughness squared) at or below which Cycles counts a closure as specular-like for its denoising
@@ -157,8 +160,10 @@ def split_surface(lobes: SurfaceLobes, base: np.ndarray, cos_i: np.ndarray, insi
 
 @dataclass
 class _Branches:
-    """Feature paths in flight: the guide sub-pixel each belongs to, ray, throughput, sampling probability
-    and the bounces it has used (reflections, transmissions)."""
+    """Feature paths in flight: the guide sub-pixel each belongs to, ray, throughput, sampling probability,
+    the bounces it has used (reflections, transmissions) and whether it went past a per-lobe bounce limit
+    (``final``: the path tracer still adds what it hits next if that emits - the world or an emitter - and ends;
+    Cycles likewise adds that emission to its denoising albedo, and writes no features there)."""
 
     pixel: np.ndarray
     origin: np.ndarray
@@ -167,6 +172,7 @@ class _Branches:
     probability: np.ndarray
     reflections: np.ndarray
     transmissions: np.ndarray
+    final: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -210,6 +216,7 @@ class SpecularGuideTracer:
         for row, obj in enumerate(objects):
             self._row_lut[obj.instance_id] = row
         self.world_color = np.asarray(scene.world.color, dtype=np.float64)[:3]
+        self.emissive = np.array([bool(np.any(emitted_radiance(obj) > 0)) for obj in objects] + [False])  # [-1]: none
 
     @property
     def active(self) -> bool:
@@ -247,7 +254,7 @@ class SpecularGuideTracer:
         if n == 0:
             return 0
         paths = _Branches(np.arange(n), np.tile(centre, (n, 1)), direction, np.ones((n, 3)), np.ones(n),
-                          np.zeros(n, np.int64), np.zeros(n, np.int64))
+                          np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n, bool))
         # Traced again from the camera: a raster normal and depth are float32, and a refraction through a curved
         # surface magnifies their rounding into visible steps.
         hits = self._intersect(paths.origin, paths.direction)
@@ -267,6 +274,9 @@ class SpecularGuideTracer:
             escaped = ~hits.valid
             add_at(out_albedo, paths.pixel[escaped], paths.weight[escaped] * self.world_color)
             paths, hits = _take(paths, ~escaped), _take_hits(hits, ~escaped)
+            glowing = paths.final & self.emissive[hits.row]  # past a lobe limit: only an emitter still shows
+            add_at(out_albedo, paths.pixel[glowing], paths.weight[glowing] * hits.base[glowing])
+            paths, hits = _take(paths, ~paths.final), _take_hits(hits, ~paths.final)
             lobes = self.lobes.take(np.maximum(hits.row, 0))
             lobes = SurfaceLobes(lobes.metallic, lobes.transmission, lobes.specular_f0, lobes.ior,
                                  lobes.specular_like & (hits.row >= 0))
@@ -298,16 +308,15 @@ class SpecularGuideTracer:
             weight = paths.weight * factor
             reflections = paths.reflections + int(reflected)
             transmissions = paths.transmissions + int(not reflected)
-            ok = (weight.mean(1) > MIN_BRANCH_WEIGHT) & (bounces < self.max_bounces) & \
-                (reflections <= self.max_reflections) & (transmissions <= self.max_transmissions)
+            ok = (weight.mean(1) > MIN_BRANCH_WEIGHT) & (bounces < self.max_bounces)
+            final = (reflections > self.max_reflections) | (transmissions > self.max_transmissions)
             side = np.where(np.einsum("ij,ij->i", new_dir, hits.geometric) >= 0, 1.0, -1.0)
             scale = 1e-4 * (1.0 + np.abs(hits.point).max(axis=1))
             origin = hits.point + (side * scale)[:, None] * hits.geometric
             share = np.where(total > 0, factor.mean(1) / np.where(total > 0, total, 1.0), 0.0)
             parts.append(_Branches(paths.pixel[ok], origin[ok], new_dir[ok], weight[ok],
-                                   (paths.probability * share)[ok], reflections[ok], transmissions[ok]))
-        return _Branches(*(np.concatenate([getattr(p, f) for p in parts]) for f in
-                           ("pixel", "origin", "direction", "weight", "probability", "reflections", "transmissions")))
+                                   (paths.probability * share)[ok], reflections[ok], transmissions[ok], final[ok]))
+        return _Branches(**{f.name: np.concatenate([getattr(p, f.name) for p in parts]) for f in fields(_Branches)})
 
     def _intersect(self, origin: np.ndarray, direction: np.ndarray) -> _Hits:
         import drjit as dr
@@ -340,13 +349,12 @@ def add_at(target: np.ndarray, index: np.ndarray, values: np.ndarray) -> None:
 
 
 def _take(paths: _Branches, keep: np.ndarray) -> _Branches:
-    return _Branches(*(getattr(paths, f)[keep] for f in
-                       ("pixel", "origin", "direction", "weight", "probability", "reflections", "transmissions")))
+    return _Branches(**{f.name: getattr(paths, f.name)[keep] for f in fields(_Branches)})
 
 
 def _take_hits(hits: _Hits, keep: np.ndarray) -> _Hits:
-    return _Hits(*(getattr(hits, f)[keep] for f in ("valid", "point", "normal", "geometric", "base", "row")))
+    return _Hits(**{f.name: getattr(hits, f.name)[keep] for f in fields(_Hits)})
 
 
 def _take_split(split: SurfaceSplit, keep: np.ndarray) -> SurfaceSplit:
-    return SurfaceSplit(*(getattr(split, f)[keep] for f in ("features_here", "reflect", "refract", "cos_t", "eta")))
+    return SurfaceSplit(**{f.name: getattr(split, f.name)[keep] for f in fields(SurfaceSplit)})

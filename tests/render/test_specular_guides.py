@@ -68,10 +68,10 @@ def _filtered(scene: hg.Scene, value) -> np.ndarray:
     return filter_supersampled(value(rays.reshape(fine.height, fine.width, 3)), DEFAULT_FACTOR, DEFAULT_WIDTH)
 
 
-def _guides(scene: hg.Scene, variant: str) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray],
-                                                      int]:
-    view = PathTraceView(scene, PathTraceSettings(samples=1), variant=variant)
-    guides = DenoiseGuides(scene, filter_width=view.filter_width)
+def _guides(scene: hg.Scene, variant: str, **settings: int) -> tuple[tuple[np.ndarray, np.ndarray],
+                                                                     tuple[np.ndarray, np.ndarray], int]:
+    view = PathTraceView(scene, PathTraceSettings(samples=1, **settings), variant=variant)
+    guides = DenoiseGuides(scene, filter_width=view.filter_width, follow_specular=True)
     try:
         pose = scene.camera.keypoints[0]
         raster, traced = guides.render(pose), guides.render(pose, view)
@@ -169,16 +169,53 @@ def test_guides_in_a_smooth_metal_mirror_are_the_wall_times_schlick_and_rough_pi
     np.testing.assert_array_equal(normals[far], raster_normals[far])
 
 
-def test_color_producer_denoises_with_the_guides_of_its_own_path_trace_view(gl_context, jit_variant):
+@pytest.mark.parametrize("follow", [False, True])
+def test_color_producer_denoises_with_the_guides_of_its_own_path_trace_view(gl_context, jit_variant, monkeypatch,
+                                                                            follow):
+    """Off by default (denoise_guides.FOLLOW_SPECULAR: measured neutral); on, the producer's own view is traced."""
     pytest.importorskip("pyoidn")
+    from hybridgen.render import denoise_guides
     from hybridgen.render.render_color import ColorProducer
 
+    assert denoise_guides.FOLLOW_SPECULAR is False
+    monkeypatch.setattr(denoise_guides, "FOLLOW_SPECULAR", follow)
     scene = _slab_scene(roughness=0.0)
     scene.lights.append(hg.Light("sun", "SUN", energy=2.0, local2world=hg.object_pose([0, 0, 5], [0.3, 0.1, 0])))
     producer = ColorProducer(scene, PathTraceSettings(samples=1), variant=jit_variant, denoise=True)
     try:
         producer.produce(0, scene.camera.keypoints[0])
         intr = scene.camera.intrinsics
-        assert producer._guides is not None and producer._guides.traced_subpixels == intr.width * intr.height * 9
+        assert producer._guides is not None
+        assert producer._guides.traced_subpixels == (intr.width * intr.height * 9 if follow else 0)
     finally:
         producer.close()
+
+
+def test_past_the_glossy_bounce_limit_a_mirror_shows_only_what_emits(gl_context, jit_variant):
+    """glossy_bounces 0 (BlenderProc's): the path tracer ends after the mirror bounce but still adds the emission
+    it hits, as Cycles adds it to its denoising albedo (with no features): an emitting wall shows in the guide
+    albedo times Schlick's F, a plain one not at all; no normal either way."""
+    results = []
+    for emitting in (True, False):
+        scene = hg.Scene()
+        mirror = hg.make_primitive("plane", 40.0, name="mirror", category_id=1, color=(0.9, 0.6, 0.3))
+        mirror.material.metallic, mirror.material.roughness = 1.0, 0.0
+        scene.add(mirror)
+        wall = hg.make_primitive("plane", 40.0, name="wall", category_id=2, color=TARGET,
+                                 local2world=hg.object_pose([0.0, 6.0, 0.0], [math.pi / 2, 0.0, 0.0]))
+        wall.material.specular = 0.0
+        if emitting:
+            wall.material.emission, wall.material.emission_strength = (1.0, 1.0, 1.0), 2.0
+        scene.add(wall)
+        scene.world.color = (0.0, 0.0, 0.0)
+        scene.camera.intrinsics = hg.Intrinsics.from_fov(0.3, 32, 24, clip_start=0.01)
+        scene.camera.add_keypoint(hg.look_at([0.0, -3.0, 1.0], [0.0, 0.0, 0.2]))
+        results.append(_guides(scene, jit_variant, glossy_bounces=0)[1])
+    (albedo, normals), (dark_albedo, dark_normals) = results
+    inner = _interior(albedo.shape[:2])
+    expected = _filtered(scene, lambda rays: schlick(np.tile((0.9, 0.6, 0.3), (rays.size // 3, 1)), np.abs(
+        rays[..., 2].ravel())).reshape(rays.shape) * TARGET)
+    np.testing.assert_allclose(albedo[inner], expected[inner], rtol=1e-4)
+    np.testing.assert_array_equal(dark_albedo[inner], 0.0)
+    np.testing.assert_array_equal(normals[inner], 0.0)
+    np.testing.assert_array_equal(dark_normals[inner], 0.0)
