@@ -27,7 +27,7 @@ def is_closed_volume(vertices: np.ndarray, faces: np.ndarray) -> bool:
     faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
     if len(faces) == 0 or len(vertices) == 0:
         return False
-    merged, representative = _merged_vertices(vertices, faces)
+    merged, representative = merged_vertices(vertices, faces)
     if not _watertight_and_consistent(merged, len(representative)):
         return False
     return signed_volume(vertices[representative[merged]]) > 0
@@ -42,7 +42,7 @@ def signed_volume(triangles: np.ndarray) -> float:
     return float((cross_x * f1_x).sum() / 6.0)
 
 
-def _merged_vertices(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def merged_vertices(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(F, 3) faces over merged vertex ids, and per merged id the index of the vertex that represents it (the
     lowest-index referenced vertex of its group)."""
     referenced = np.zeros(len(vertices), dtype=bool)

@@ -6,27 +6,22 @@ from typing import Any, Callable
 import numpy as np
 
 from ..errors import InputError
+from . import primitive_meshes
 from .material import Material
 from .mesh_object import MeshObject
+from .primitive_meshes import Mesh
 
 
-def _trimesh() -> Any:
-    import trimesh
-
-    return trimesh
-
-
-PRIMITIVES: dict[str, Callable[[float], Any]] = {
-    "cube": lambda size: _trimesh().creation.box(extents=[size] * 3),
-    "sphere": lambda size: _trimesh().creation.icosphere(subdivisions=4, radius=size / 2),
-    "cylinder": lambda size: _trimesh().creation.cylinder(radius=size / 2, height=size, sections=64),
-    "cone": lambda size: _trimesh().creation.cone(radius=size / 2, height=size, sections=64),
-    "torus": lambda size: _trimesh().creation.torus(major_radius=size * 0.35, minor_radius=size * 0.15),
-    "plane": lambda size: _trimesh().Trimesh(
-        vertices=np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], dtype=np.float64) * size / 2,
-        faces=np.array([[0, 1, 2], [0, 2, 3]])),
+PRIMITIVES: dict[str, Callable[[float], Mesh]] = {
+    "cube": lambda size: primitive_meshes.box((size, size, size)),
+    "sphere": lambda size: primitive_meshes.icosphere(subdivisions=4, radius=size / 2),
+    "cylinder": lambda size: primitive_meshes.cylinder(radius=size / 2, height=size, sections=64),
+    "cone": lambda size: primitive_meshes.cone(radius=size / 2, height=size, sections=64),
+    "torus": lambda size: primitive_meshes.torus(major_radius=size * 0.35, minor_radius=size * 0.15),
+    "plane": primitive_meshes.plane,
 }
-"""Shape name -> builder taking the size (edge length or diameter, metres)."""
+"""Shape name -> builder taking the size (edge length or diameter, metres) and returning (vertices, faces)
+(NumPy only: building primitives never imports trimesh)."""
 
 SMOOTH = {"sphere", "torus"}
 """Shapes whose shading normals are the smooth vertex normals; the others are flat-shaded."""
@@ -35,22 +30,23 @@ SMOOTH = {"sphere", "torus"}
 def make_primitive(shape: str, size: float = 1.0, *, name: str | None = None, category_id: int | None = None,
                    local2world: np.ndarray | None = None, color: tuple[float, ...] | None = None,
                    attributes: dict[str, Any] | None = None) -> MeshObject:
-    """A primitive as a :class:`MeshObject`; the sphere's and torus' vertex normals are analytic."""
+    """A primitive as a :class:`MeshObject`; the sphere's vertex normals are analytic (unit position), the
+    torus' the angle-weighted face normals; the other shapes are flat-shaded."""
     if shape not in PRIMITIVES:
         raise InputError(f"unknown primitive {shape!r}; known: {sorted(PRIMITIVES)}")
     if not size > 0:
         raise InputError(f"primitive size must be > 0, got {size}")
-    mesh = PRIMITIVES[shape](float(size))
+    vertices, faces = PRIMITIVES[shape](float(size))
     material = Material(name=f"{shape}_material")
     if color is not None:
         rgba = tuple(float(c) for c in color) + (1.0,) * (4 - len(color))
         material.base_color = rgba[:4]  # type: ignore[assignment]
     return MeshObject(
         name=name or shape,
-        vertices=np.asarray(mesh.vertices),
-        faces=np.asarray(mesh.faces),
-        vertex_normals=_sphere_normals(mesh.vertices) if shape == "sphere" else
-        (np.asarray(mesh.vertex_normals) if shape in SMOOTH else None),
+        vertices=vertices,
+        faces=faces,
+        vertex_normals=_sphere_normals(vertices) if shape == "sphere" else
+        (primitive_meshes.angle_weighted_normals(vertices, faces) if shape in SMOOTH else None),
         material=material,
         category_id=category_id,
         attributes=dict(attributes or {}),
