@@ -29,6 +29,7 @@ from ..io.image_check import check_image_file
 from ..scene.light import Light
 from ..scene.mesh_object import MeshObject
 from ..scene.scene import Scene, World
+from ..scene.vertex_normals import angle_weighted_normals
 from . import light_selection
 from .material_emission import emitted_radiance, radiance_texture
 from .mitsuba_instances import instanced_entries
@@ -42,11 +43,8 @@ mapping (world +Z up, u = 1/2 - atan2(y, x) / 2 pi): image centre column = world
 
 
 def _world_normals(obj: MeshObject) -> np.ndarray:
-    """Unit vertex normals in world axes: the mesh's own, else area-weighted face normals."""
-    import trimesh
-
-    local = obj.vertex_normals if obj.vertex_normals is not None else \
-        trimesh.Trimesh(obj.vertices, obj.faces, process=False).vertex_normals
+    """Unit vertex normals in world axes: the mesh's own, else angle-weighted face normals."""
+    local = obj.vertex_normals if obj.vertex_normals is not None else angle_weighted_normals(obj.vertices, obj.faces)
     normals = local @ np.linalg.inv(obj.local2world[:3, :3])
     return normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
 

@@ -10,6 +10,7 @@ from . import primitive_meshes
 from .material import Material
 from .mesh_object import MeshObject
 from .primitive_meshes import Mesh
+from .vertex_normals import angle_weighted_normals
 
 
 PRIMITIVES: dict[str, Callable[[float], Mesh]] = {
@@ -46,7 +47,7 @@ def make_primitive(shape: str, size: float = 1.0, *, name: str | None = None, ca
         vertices=vertices,
         faces=faces,
         vertex_normals=_sphere_normals(vertices) if shape == "sphere" else
-        (primitive_meshes.angle_weighted_normals(vertices, faces) if shape in SMOOTH else None),
+        (angle_weighted_normals(vertices, faces) if shape in SMOOTH else None),
         material=material,
         category_id=category_id,
         attributes=dict(attributes or {}),

@@ -13,6 +13,7 @@ import trimesh
 from hybridgen.scene import primitive_meshes
 from hybridgen.scene.closed_volume import is_closed_volume, signed_volume
 from hybridgen.scene.primitives import PRIMITIVES, make_primitive
+from hybridgen.scene.vertex_normals import angle_weighted_normals
 
 SIZES = (1.0, 0.7, 2.0, 0.123, 0.03, 6.0, 37.5)
 
@@ -74,7 +75,7 @@ def test_angle_weighted_normals_ignore_degenerate_faces_as_trimesh_does() -> Non
     vertices, faces = primitive_meshes.box((1.0, 2.0, 0.5))
     faces = np.concatenate([faces, [[0, 0, 1], [2, 2, 2]]])  # two zero-area faces
     expected = trimesh.Trimesh(vertices, faces, process=False).vertex_normals
-    assert np.array_equal(primitive_meshes.angle_weighted_normals(vertices, faces), expected)
+    assert np.array_equal(angle_weighted_normals(vertices, faces), expected)
 
 
 @pytest.mark.parametrize("size", [1.0, 0.3])
