@@ -1,0 +1,84 @@
+"""Singular surfaces as in Cycles (render/clamped_path.py): principled lobes of roughness <= 0.00376 get no
+next-event estimation, and light they reflect is found by BSDF sampling at full weight."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import hybridgen as hg
+from hybridgen.render import clamped_path
+from hybridgen.render.mitsuba_variant import choose_variant, is_jit
+from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.scene.material import Material
+
+LOOK_DOWN = np.array([[1.0, 0, 0, 0], [0, -1, 0, 0], [0, 0, -1, 1.0], [0, 0, 0, 1]])  # at z = 1 looking down
+
+
+@pytest.fixture
+def variant():
+    chosen = choose_variant(None)
+    if not is_jit(chosen):
+        pytest.skip("singular surfaces live in hybridgen's path tracer (JIT variants)")
+    return chosen
+
+
+def test_threshold_is_cycles_roughness_sq_thresh():
+    # Cycles: alpha_x alpha_y <= 2e-10 with alpha = roughness^2
+    assert clamped_path.SINGULAR_ROUGHNESS ** 4 == pytest.approx(2e-10)
+    assert clamped_path.SINGULAR_ROUGHNESS == pytest.approx(0.0037606, abs=1e-6)
+
+
+def test_singular_lanes_of_hybridgen_bsdfs(variant):
+    """hybridgen's own BSDFs (twosided principled with the glossy filter's roughness wrapper, glass, diffuse):
+    metal and glass singular at roughness 0 and 0.0037, not at 0.004 or 0.2, never a diffuse one nor a principled
+    one with a diffuse lobe (sharp plastic, half metal: its diffuse light needs NEE); the glossy filter's floor
+    (si.time) lifts a sharp lobe out of it, as Cycles' blur_glossy sets SD_BSDF_HAS_EVAL again."""
+    import mitsuba as mi
+
+    mi.set_variant(variant)
+    from hybridgen.render.mitsuba_materials import bsdf_dict
+
+    materials = [Material(metallic=1.0, roughness=0.0), Material(metallic=1.0, roughness=0.0037),
+                 Material(metallic=1.0, roughness=0.004), Material(roughness=0.2, specular=0.5),
+                 Material(transmission=1.0, roughness=0.0, ior=1.5), Material(specular=0.0),
+                 Material(roughness=0.0, specular=0.5), Material(metallic=0.5, roughness=0.0)]
+    shapes = {f"s{i}": {"type": "sphere", "center": [3.0 * i, 0, 0], "radius": 1.0,
+                        "bsdf": bsdf_dict(m, f"s{i}")} for i, m in enumerate(materials)}
+    scene = mi.load_dict({"type": "scene", **shapes})
+    n = len(materials)
+    ray = mi.Ray3f(mi.Point3f([3.0 * i for i in range(n)], [0.0] * n, [-5.0] * n), mi.Vector3f(0, 0, 1))
+    si = scene.ray_intersect(ray)
+    assert np.all(np.array(si.is_valid()))
+    singular = np.array(clamped_path.is_singular(si.bsdf(ray), si))
+    np.testing.assert_array_equal(singular, [True, True, False, False, True, False, False, False])
+    si.time = mi.Float(0.01)  # a roughness floor after a rough bounce
+    np.testing.assert_array_equal(np.array(clamped_path.is_singular(si.bsdf(ray), si)), [False] * n)
+
+
+def _mirror_scene(*, panel: bool, roughness: float = 0.0) -> hg.Scene:
+    scene = hg.Scene()
+    scene.world.strength = 0.0
+    mirror = hg.make_primitive("plane", 4.0, name="mirror", category_id=1, color=(0.8, 0.8, 0.8))
+    mirror.material.metallic, mirror.material.roughness = 1.0, roughness
+    scene.add(mirror)
+    if panel:  # an emitting panel above the camera, facing down (Mitsuba area emitters emit along +normal)
+        light = hg.make_primitive("plane", 6.0, name="panel", category_id=2, color=(0.0, 0.0, 0.0),
+                                  local2world=hg.object_pose([0, 0, 2.0], [np.pi, 0, 0]))
+        light.material.specular, light.material.emission, light.material.emission_strength = 0.0, (1.0, 1.0, 1.0), 1.5
+        scene.add(light)
+    else:
+        scene.add_light(hg.Light("lamp", "POINT", energy=100.0, local2world=hg.object_pose([0.02, 0.01, 1.0])))
+    scene.camera.intrinsics = hg.Intrinsics.from_fov(0.3, 8, 6)
+    return scene
+
+
+def test_sharp_mirror_shows_no_point_light_and_the_full_reflected_panel(variant):
+    """A roughness-0 metal mirror (F0 = base 0.8) under a black world: a point light is not reflected at all
+    (Cycles: no NEE on a singular closure, and a point light cannot be hit), and an emitting panel of radiance
+    1.5 is reflected at full weight: F x 1.5 with Schlick's F at these near-normal angles (< 9 deg: F - F0 <
+    1e-6)."""
+    settings = PathTraceSettings(samples=64)
+    dark = PathTraceView(_mirror_scene(panel=False), settings, variant=variant).render(LOOK_DOWN, seed=3)
+    assert float(np.abs(dark).max()) == 0.0
+    panel = PathTraceView(_mirror_scene(panel=True), settings, variant=variant).render(LOOK_DOWN, seed=3)
+    np.testing.assert_allclose(panel.reshape(-1, 3), np.full((48, 3), 0.8 * 1.5), rtol=1e-3)
