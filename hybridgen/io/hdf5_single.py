@@ -6,17 +6,18 @@ smallest integer type, octahedral uint16 normals, distance derived from depth - 
 :mod:`hybridgen.io.label_encoding`, whose :func:`~hybridgen.io.label_encoding.decode_dataset` reads them
 back); ``encoding="plain"`` stores the documented dtypes as they are.
 
-Writing never blocks the render thread: each keypoint is one job on a small thread pool, which encodes,
-byte-shuffles (float passes) and deflates its passes (numpy and ISA-L / zlib release the GIL) and then, in
-keypoint order, stores the chunks with ``write_direct_chunk`` - bit-identical to what HDF5's shuffle + gzip
-filters make, so any HDF5 reader opens the file, and the file's bytes do not depend on thread timing. The
-chunks are hashed as they are stored, so sealing the file (``content_sha256``) reads nothing back. The file is
+Writing never blocks the render thread: each pass of a keypoint is encoded, byte-shuffled (float passes)
+and deflated on a thread pool (numpy and ISA-L / zlib release the GIL), while one writer thread stores the finished
+chunks in keypoint order with ``write_direct_chunk`` - bit-identical to what HDF5's shuffle + gzip filters
+make, so any HDF5 reader opens the file, and the file's bytes do not depend on thread timing. The writer thread
+hashes each chunk as it stores it, so sealing the file (``content_sha256``) reads nothing back. The file is
 written under a temporary name and renamed only when complete.
 """
 from __future__ import annotations
 
 import json
 import os
+import queue
 import threading
 import zlib
 from concurrent.futures import Future, ThreadPoolExecutor
@@ -37,6 +38,7 @@ from .label_encoding import (DERIVED_DISTANCE, NARROWED, OCTAHEDRAL, EncodedArra
 
 COMPRESSIONS = ("gzip", "lzf", "none")
 ENCODINGS = ("compact", "plain")
+_STOP = object()
 
 
 def deflate(data: Any, level: int) -> bytes:
@@ -87,7 +89,7 @@ _UNKNOWN = _UnknownStream()
 
 
 def default_threads() -> int:
-    """Writer threads: the cores left over by the render thread (at least one)."""
+    """Compressor threads: the cores left over by the render thread (at least one)."""
     return max(1, (os.cpu_count() or 2) - 1)
 
 
@@ -151,9 +153,8 @@ class Hdf5SingleFileWriter:
         self._datasets: dict[str, h5py.Dataset] = {}  # looked up once: h5[key] costs ~70 us per call
         self._streams: dict[str, ChunkStream] = {}  # chunked datasets' chunks, hashed as stored (the seal's)
         self._pool: ThreadPoolExecutor | None = None
-        self._in_flight = threading.BoundedSemaphore(queue_size + self.threads)  # keypoints queued or being written
-        self._stored_before: threading.Event | None = None  # set once the last queued keypoint is stored
-        self._pending: list[Future[None]] = []
+        self._queue: queue.Queue[Any] = queue.Queue(maxsize=queue_size)
+        self._thread: threading.Thread | None = None
         self._error: BaseException | None = None
         self.frames_written = 0
 
@@ -178,25 +179,22 @@ class Hdf5SingleFileWriter:
         for key, value in attributes.items():
             h5.attrs[key] = value
         if self._pool is None:
-            self._pool = ThreadPoolExecutor(self.threads, thread_name_prefix="hdf5-writer")
+            self._pool = ThreadPoolExecutor(self.threads, thread_name_prefix="hdf5-compress")
+        self._thread = threading.Thread(target=self._work, name="hdf5-writer", daemon=True)
+        self._thread.start()
 
     def write(self, index: int, values: dict[str, Any]) -> None:
-        """Queue keypoint ``index``'s values (arrays or JSON-ready objects): one pool job makes their chunks
-        and stores them once every keypoint queued before is stored. Blocks while ``queue_size`` + threads
-        keypoints are in flight (memory stays bounded when the disk or the compressor is the slower side)."""
+        """Queue keypoint ``index``'s values (arrays or JSON-ready objects): their chunks are made on the
+        thread pool now and stored in keypoint order by the writer thread."""
         self._raise_worker_error()
         assert self._pool is not None, "write() before begin()"
-        self._in_flight.acquire()
-        turn, done = self._stored_before, threading.Event()
-        self._stored_before = done
-        try:
-            self._pending.append(self._pool.submit(self._keypoint, index, values, turn, done))
-        except BaseException:
-            done.set()
-            self._in_flight.release()
-            raise
-        if len(self._pending) > 64:
-            self._pending = [job for job in self._pending if not job.done()]
+        jobs: dict[str, Any] = {}
+        for key, value in values.items():
+            if self._layouts[key].dtype == "json":
+                jobs[key] = value
+            else:
+                jobs[key] = self._pool.submit(self._chunk, key, index, value)
+        self._queue.put((index, jobs))
 
     def end(self) -> None:
         """Wait until every queued keypoint is written."""
@@ -281,7 +279,7 @@ class Hdf5SingleFileWriter:
         self._streams[layout.key] = ChunkStream()
 
     def _chunk(self, key: str, index: int, value: Any) -> np.ndarray | bytes | None:
-        """Keypoint ``index``'s stored chunk of ``key`` (on the pool): the encoded array, or for gzip
+        """Keypoint ``index``'s stored chunk of ``key`` (runs on the pool): the encoded array, or for gzip
         the shuffled and deflated bytes; None when the pass is derived on read."""
         layout, stored = self._layouts[key], self._stored[key]
         if isinstance(value, EncodedArray) and value.tag != _tag(stored, layout):
@@ -304,57 +302,46 @@ class Hdf5SingleFileWriter:
             return deflate(shuffled(encoded) if stored.shuffle else encoded, self.level)
         return encoded
 
-    def _keypoint(self, index: int, values: dict[str, Any], turn: threading.Event | None,
-                  done: threading.Event) -> None:
-        """One keypoint on the pool: its chunks (JSON values as they are), then - after the keypoint queued
-        before it (``turn``) - stored; ``done`` is set when stored or failed. The first error is kept for the
-        producer thread; later keypoints are then dropped."""
-        try:
-            jobs: dict[str, Any] = {}
-            if self._error is None:
-                for key, value in values.items():
-                    jobs[key] = value if self._layouts[key].dtype == "json" else self._chunk(key, index, value)
-            if turn is not None:
-                turn.wait()
-            if self._error is None:
-                assert self._file is not None
-                self._store(self._file, index, jobs)
-        except BaseException as exc:  # surfaced to the producer thread
-            if self._error is None:
+    def _work(self) -> None:
+        h5 = self._file
+        assert h5 is not None
+        while True:
+            item = self._queue.get()
+            if item is _STOP:
+                return
+            if self._error is not None:
+                continue  # keep draining so producers never block
+            try:
+                self._store(h5, *item)
+            except BaseException as exc:  # surfaced to the producer thread
                 self._error = exc
-        finally:
-            done.set()
-            self._in_flight.release()
 
     def _store(self, h5: h5py.File, index: int, jobs: dict[str, Any]) -> None:
-        """Store keypoint ``index``: per key a JSON value, or its chunk (bytes, an array, None for a pass
-        derived on read)."""
-        for key, chunk in jobs.items():
+        """Store keypoint ``index``: per key a JSON value, or its chunk (a Future of it, or the chunk itself:
+        bytes, an array, None for a pass derived on read)."""
+        for key, job in jobs.items():
             dset = self._datasets[key]
             if self._layouts[key].dtype == "json":
-                _write_text(dset, index, json.dumps(chunk))
+                _write_text(dset, index, json.dumps(job))
                 continue
+            chunk = job.result() if isinstance(job, Future) else job
             if chunk is None:
                 continue
-            stream = self._streams[key]
             if isinstance(chunk, bytes) or self.compression == "none":
                 # gzip: deflated bytes; none: the array's bytes are the chunk as HDF5 stores it
                 offset = (index,) + (0,) * len(self._stored[key].shape)
                 dset.id.write_direct_chunk(offset, chunk)
-                stream.add(offset, 0, chunk)
+                self._streams[key].add(offset, 0, chunk)
             else:  # HDF5 filters it (lzf): the stored bytes are read back by the seal
                 dset[index] = chunk
                 self._streams[key] = _UNKNOWN
         self.frames_written += 1
 
     def _drain(self) -> None:
-        """Wait until every queued keypoint is stored (or dropped after an error); raise the first error. A job
-        leaves the list only once it is done, so an interrupted drain (SIGTERM's SystemExit) is finished by the
-        next one (``abort``) before the file is closed."""
-        while self._pending:
-            self._pending[0].result()  # _keypoint never raises: its errors are kept in self._error
-            self._pending.pop(0)
-        self._stored_before = None
+        if self._thread is not None:
+            self._queue.put(_STOP)
+            self._thread.join()
+            self._thread = None
         self._raise_worker_error()
 
     def _raise_worker_error(self) -> None:

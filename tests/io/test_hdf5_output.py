@@ -193,32 +193,3 @@ def test_writes_block_while_the_writer_is_behind(tmp_path, monkeypatch):
     with h5py.File(tmp_path / "x.hdf5") as f:
         np.testing.assert_array_equal(f["depth"][3], _depth(3))
 
-
-def test_an_interrupted_drain_is_finished_before_the_file_closes(tmp_path, monkeypatch):
-    """SIGTERM's SystemExit can arrive while end() waits for the pool: abort() still waits for the keypoints in
-    flight before it closes the file (a pool thread never writes into a closed file)."""
-    writer = _small_writer(tmp_path / "x.hdf5", threads=1)
-    release, chunk, events = threading.Event(), writer._chunk, []
-    monkeypatch.setattr(writer, "_chunk", lambda *args: (release.wait(10), chunk(*args))[1])
-    store = writer._store
-    monkeypatch.setattr(writer, "_store", lambda *args: (store(*args), events.append("stored"))[0])
-    writer.write(0, {"depth": _depth(0), "records": []})
-
-    class Interrupted:
-        def __init__(self, job):
-            self.job = job
-
-        def result(self):
-            threading.Timer(0.3, release.set).start()  # the keypoint finishes after the interruption
-            writer._pending[0] = self.job
-            raise SystemExit(143)
-
-        def done(self):
-            return self.job.done()
-    writer._pending[0] = Interrupted(writer._pending[0])
-    with pytest.raises(SystemExit):
-        writer.end()
-    close = writer._file.close
-    monkeypatch.setattr(writer._file, "close", lambda: (events.append("closed"), close())[1])
-    writer.abort()
-    assert events == ["stored", "closed"] and list(tmp_path.iterdir()) == []
