@@ -11,6 +11,7 @@ from typing import Any, Callable, Iterable, Protocol, Sequence
 
 import numpy as np
 
+from .. import stop_request
 from .._version import __version__
 from ..errors import InputError
 from ..io.frame_sink import FrameSink, PassLayout
@@ -104,6 +105,7 @@ def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Prod
             for producer in prefetching:
                 producer.prefetch(chosen[0], keypoints[chosen[0]])  # type: ignore[attr-defined]
         for local, index in enumerate(chosen):
+            stop_request.raise_if_requested()  # a SIGTERM whose SystemExit a finalizer swallowed
             pose_objects(index)
             ahead = chosen[local + 1] if local + 1 < n else None
             if ahead is not None and varies and not same_view(scene, index, ahead):
@@ -121,6 +123,7 @@ def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Prod
                 bar.update(1)
         if bar is not None:
             bar.close()
+        stop_request.raise_if_requested()  # never finish (seal) the sinks' output after a stop request
         for sink in sinks:
             sink.end()
     finally:

@@ -29,6 +29,7 @@ from typing import Any, Callable, Iterator, Mapping, Sequence
 
 import h5py
 
+from .. import stop_request
 from ..errors import InputError
 from ..io.atomic import prepare_output_dir
 from ..io.integrity import verify
@@ -179,6 +180,7 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
     try:
         refill()
         while pending:
+            stop_request.raise_if_requested()  # a SIGTERM whose SystemExit a finalizer swallowed
             done, _ = wait(list(pending), return_when=FIRST_COMPLETED)
             for future in done:
                 unit = pending.pop(future)
@@ -188,6 +190,7 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
                 if unit.chunk == 0:
                     expand(unit, total)
             refill()
+        stop_request.raise_if_requested()  # nothing is consolidated or indexed after a stop request
         interrupted = False
     finally:
         pool.shutdown(interrupted)

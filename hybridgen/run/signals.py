@@ -18,6 +18,7 @@ from contextlib import contextmanager
 from types import FrameType
 from typing import Iterator
 
+from .. import stop_request
 from ..io.atomic import remove_live_temporaries
 
 EXIT_SIGTERM = 128 + signal.SIGTERM  # 143
@@ -27,17 +28,19 @@ _ACTIVE: list[bool] = []  # stop_on_signals blocks in progress
 
 
 def _terminate(signum: int, frame: FrameType | None) -> None:
-    raise SystemExit(EXIT_SIGTERM)
+    stop_request.request_stop(EXIT_SIGTERM)  # recorded too: a SystemExit raised inside a finalizer is lost
 
 
 @contextmanager
 def stop_on_signals() -> Iterator[None]:
-    """In the main thread: SIGTERM raises ``SystemExit(143)`` for the block; on any interruption this
-    process's temporary files are deleted. Elsewhere (threads) nothing is installed."""
+    """In the main thread: SIGTERM raises ``SystemExit(143)`` for the block, and again at the next keypoint
+    if the first one was swallowed (:mod:`hybridgen.stop_request`); on any interruption this process's
+    temporary files are deleted. Elsewhere (threads) nothing is installed."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     previous = signal.signal(signal.SIGTERM, _terminate)
+    stop_request.clear()
     _ACTIVE.append(True)
     try:
         yield
@@ -47,6 +50,7 @@ def stop_on_signals() -> Iterator[None]:
     finally:
         _ACTIVE.pop()
         signal.signal(signal.SIGTERM, previous)
+        stop_request.clear()
 
 
 def reclaim_sigterm() -> None:
