@@ -46,7 +46,7 @@ each launch size once per process (its kernel cache on disk keeps them across pr
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -87,10 +87,6 @@ class SurfaceLobes:
 
         return SurfaceLobes(values("metallic"), values("transmission"), np.clip(0.08 * values("specular"), 0, 0.999),
                             values("ior"), np.array([can_be_specular_like(m) for m in materials], dtype=bool))
-
-    def take(self, index: np.ndarray) -> "SurfaceLobes":
-        return SurfaceLobes(*(getattr(self, f)[index] for f in
-                              ("metallic", "transmission", "specular_f0", "ior", "specular_like")))
 
 
 def can_be_specular_like(material: Material) -> bool:
@@ -246,7 +242,7 @@ class SpecularGuideTracer:
         direction = rays @ rotation.T
         direction /= np.linalg.norm(direction, axis=1, keepdims=True)
         rows = self._row_lut[np.clip(ids[pixels], 0, len(self._row_lut) - 1)]
-        split = split_surface(self.lobes.take(rows), base,
+        split = split_surface(_take(self.lobes, rows), base,
                               np.clip(-np.einsum("ij,ij->i", direction, facing), 1e-6, 1.0), np.zeros(len(rows), bool))
         deferred = ~split.features_here
         pixels, direction, rows = pixels[deferred], direction[deferred], rows[deferred]
@@ -261,10 +257,10 @@ class SpecularGuideTracer:
         same = hits.valid & (hits.row == rows)  # else (a silhouette sub-pixel) the raster values stay
         cos_signed = -np.einsum("ij,ij->i", paths.direction, hits.normal)
         facing = np.where((cos_signed < 0)[:, None], -hits.normal, hits.normal)
-        split = split_surface(self.lobes.take(np.maximum(hits.row, 0)), hits.base, np.abs(cos_signed), cos_signed < 0)
+        split = split_surface(_take(self.lobes, np.maximum(hits.row, 0)), hits.base, np.abs(cos_signed), cos_signed < 0)
         keep = same & ~split.features_here
-        pixels, paths, hits, split, facing = (pixels[keep], _take(paths, keep), _take_hits(hits, keep),
-                                              _take_split(split, keep), facing[keep])
+        pixels, paths, hits, split, facing = (pixels[keep], _take(paths, keep), _take(hits, keep),
+                                              _take(split, keep), facing[keep])
         n = len(pixels)
         paths.pixel = np.arange(n)
         paths = self._children(paths, hits, split, facing)
@@ -273,11 +269,11 @@ class SpecularGuideTracer:
             hits = self._intersect(paths.origin, paths.direction)
             escaped = ~hits.valid
             add_at(out_albedo, paths.pixel[escaped], paths.weight[escaped] * self.world_color)
-            paths, hits = _take(paths, ~escaped), _take_hits(hits, ~escaped)
+            paths, hits = _take(paths, ~escaped), _take(hits, ~escaped)
             glowing = paths.final & self.emissive[hits.row]  # past a lobe limit: only an emitter still shows
             add_at(out_albedo, paths.pixel[glowing], paths.weight[glowing] * hits.base[glowing])
-            paths, hits = _take(paths, ~paths.final), _take_hits(hits, ~paths.final)
-            lobes = self.lobes.take(np.maximum(hits.row, 0))
+            paths, hits = _take(paths, ~paths.final), _take(hits, ~paths.final)
+            lobes = _take(self.lobes, np.maximum(hits.row, 0))
             lobes = SurfaceLobes(lobes.metallic, lobes.transmission, lobes.specular_f0, lobes.ior,
                                  lobes.specular_like & (hits.row >= 0))
             cos_signed = -np.einsum("ij,ij->i", paths.direction, hits.normal)
@@ -288,7 +284,7 @@ class SpecularGuideTracer:
             add_at(out_albedo, paths.pixel[here], paths.weight[here] * hits.base[here])
             add_at(out_normal, paths.pixel[here], paths.probability[here, None] * (facing[here] @ rotation))
             go = ~here
-            paths, hits, split, facing = (_take(paths, go), _take_hits(hits, go), _take_split(split, go), facing[go])
+            paths, hits, split, facing = (_take(paths, go), _take(hits, go), _take(split, go), facing[go])
             paths = self._children(paths, hits, split, facing)
         albedo.reshape(-1, 3)[pixels] = out_albedo
         normals.reshape(-1, 3)[pixels] = out_normal
@@ -331,7 +327,8 @@ class SpecularGuideTracer:
                              for x in (origin, direction))
         ray = mi.Ray3f(mi.Point3f(*origin), mi.Vector3f(*direction))
         si = self.mi_scene.ray_intersect(ray)
-        base, valid, shapes = si.bsdf().eval_diffuse_reflectance(si), si.is_valid(), dr.reinterpret_array(mi.UInt32, si.shape)
+        base, valid = si.bsdf().eval_diffuse_reflectance(si), si.is_valid()
+        shapes = dr.reinterpret_array(mi.UInt32, si.shape)
         dr.eval(base, valid, shapes, si.p, si.n, si.sh_frame.n)  # one kernel (each read would launch its own)
         valid = np.array(valid, dtype=bool)
         shape_ids = np.array(shapes, dtype=np.int64)
@@ -348,13 +345,9 @@ def add_at(target: np.ndarray, index: np.ndarray, values: np.ndarray) -> None:
         np.add.at(target, index, values)
 
 
-def _take(paths: _Branches, keep: np.ndarray) -> _Branches:
-    return _Branches(**{f.name: getattr(paths, f.name)[keep] for f in fields(_Branches)})
+_Rows = TypeVar("_Rows", "SurfaceLobes", "SurfaceSplit", "_Branches", "_Hits")
 
 
-def _take_hits(hits: _Hits, keep: np.ndarray) -> _Hits:
-    return _Hits(**{f.name: getattr(hits, f.name)[keep] for f in fields(_Hits)})
-
-
-def _take_split(split: SurfaceSplit, keep: np.ndarray) -> SurfaceSplit:
-    return SurfaceSplit(**{f.name: getattr(split, f.name)[keep] for f in fields(SurfaceSplit)})
+def _take(record: _Rows, keep: np.ndarray) -> _Rows:
+    """The lanes ``keep`` (a mask or indices) of every per-lane array field of ``record``."""
+    return type(record)(**{f.name: getattr(record, f.name)[keep] for f in fields(record)})
