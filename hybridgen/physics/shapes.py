@@ -3,9 +3,10 @@ disk) and the mass properties of the resulting solid.
 
 A decomposition is computed once per mesh and parameter set and cached under
 ``$HYBRIDGEN_CACHE_DIR`` (default ``$XDG_CACHE_HOME/hybridgen`` or ``~/.cache/hybridgen``), in
-``coacd/<sha256>.npz`` (nothing is cached with ``HYBRIDGEN_CACHE_DIR=off``); the key hashes the mesh's vertex and face bytes (object frame, before any scale),
-the CoACD parameters and CoACD's version. Scale and shear of an object's pose are applied to the parts
-afterwards (a linear map keeps a convex part convex), so the cache serves every scale of a mesh.
+``coacd/<sha256>.npz`` (nothing is cached with ``HYBRIDGEN_CACHE_DIR=off``); the key hashes the mesh's
+vertex and face bytes (object frame, before any scale), the CoACD parameters and CoACD's version. Scale and
+shear of an object's pose are applied to the parts afterwards (a linear map keeps a convex part convex), so the
+cache serves every scale of a mesh.
 """
 from __future__ import annotations
 

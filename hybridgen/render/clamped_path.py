@@ -27,8 +27,8 @@ stays complete, as at ``max_depth``) and then ends. Glossy counts glossy and spe
 transmission counts glossy and specular transmission; passing through a ``mask`` (alpha) counts as none.
 
 Singular surfaces as Cycles': a principled metal or glass (no diffuse lobe) whose roughness (after the glossy
-filter's floor) is at most :data:`SINGULAR_ROUGHNESS` gets no next-event estimation and its BSDF samples count as delta for MIS (a hit
-emitter's full weight), as Cycles drops ``SD_BSDF_HAS_EVAL`` for microfacet closures with
+filter's floor) is at most :data:`SINGULAR_ROUGHNESS` gets no next-event estimation and its BSDF samples count
+as delta for MIS (a hit emitter's full weight), as Cycles drops ``SD_BSDF_HAS_EVAL`` for microfacet closures with
 ``alpha_x alpha_y <= 2e-10`` (``BSDF_ROUGHNESS_SQ_THRESH``). Mitsuba's principled BSDF keeps a minimum alpha
 instead, so a roughness-0 glass or mirror showed a point light's highlight Cycles does not render: a sub-pixel
 spot of enormous radiance that even a 2048-spp reference does not resolve. Measured on the materials scene of

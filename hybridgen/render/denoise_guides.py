@@ -77,7 +77,9 @@ class DenoiseGuides:
 
     def _tracer_for(self, path_view: Any) -> SpecularGuideTracer | None:
         """The tracer of ``path_view``'s Mitsuba scene (rebuilt with it), or None where nothing is traced."""
-        if path_view is None or not self.follow_specular or not any(can_be_specular_like(o.material) for o in self.raster.scene.objects):
+        if path_view is None or not self.follow_specular:
+            return None
+        if not any(can_be_specular_like(o.material) for o in self.raster.scene.objects):
             return None
         from .mitsuba_variant import is_jit
 

@@ -68,9 +68,9 @@ class PathTraceSettings:
     Sampling (see :mod:`hybridgen.render.adaptive_sampling`): with ``samples`` not given, every pixel is
     sampled adaptively from ``min_samples`` (0, the default: Cycles' automatic minimum for the threshold, 80 at
     0.005, 64 at 0.01) until its noise estimate is below ``noise_threshold`` (default
-    :data:`DEFAULT_NOISE_THRESHOLD`, 0.005; Cycles' meaning when given) or it has :data:`DEFAULT_MAX_SAMPLES`. An explicit ``samples: N`` is a
-    plain N-spp estimate in every pixel, unless ``noise_threshold`` is given too: then N is the maximum
-    (Cycles' meaning of samples with adaptive sampling on).
+    :data:`DEFAULT_NOISE_THRESHOLD`, 0.005; Cycles' meaning when given) or it has :data:`DEFAULT_MAX_SAMPLES`.
+    An explicit ``samples: N`` is a plain N-spp estimate in every pixel, unless ``noise_threshold`` is given
+    too: then N is the maximum (Cycles' meaning of samples with adaptive sampling on).
 
     ``clamp_indirect`` (linear radiance; 0 = off) is the firefly control of
     :mod:`hybridgen.render.clamped_path`, Cycles' ``sample_clamp_indirect`` (default 10, Cycles' default):

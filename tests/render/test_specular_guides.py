@@ -105,7 +105,8 @@ def test_guides_behind_smooth_glass_are_the_floor_times_the_fresnel_transmittanc
     assert traced == albedo.shape[0] * albedo.shape[1] * 9  # every sub-pixel sees the slab
     np.testing.assert_allclose(raster[0][_interior(albedo.shape[:2])], 1.0, atol=1e-6)  # raster: the glass itself
     # a parallel slab: the same angle at both faces, so (1 - F(theta))^2 passes; the reflections escape (black)
-    transmitted = _filtered(scene, lambda rays: (1.0 - dielectric_fresnel(np.abs(rays[..., 2:]), np.array(1.5))[0]) ** 2)
+    transmitted = _filtered(scene,
+                            lambda rays: (1.0 - dielectric_fresnel(np.abs(rays[..., 2:]), np.array(1.5))[0]) ** 2)
     inner = _interior(albedo.shape[:2])
     np.testing.assert_allclose(albedo[inner], (transmitted * np.array(TARGET))[inner], rtol=1e-4)
     floor_normal = scene.camera.keypoints[0][:3, :3].T @ np.array([0.0, 0.0, 1.0])  # camera axes
