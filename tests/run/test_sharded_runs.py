@@ -66,17 +66,36 @@ def test_one_or_two_workers_same_bytes(gl_context, tmp_path, write_config):
     assert _digests(out) == one and len(one) == 10
 
 
+def _shard_files(out: Path) -> set[str]:
+    return {p.name for p in (out / "shards").iterdir()} if (out / "shards").is_dir() else set()
+
+
+def _first_shard_write(process: subprocess.Popen, out: Path) -> None:
+    """Returns once the run creates a file under shards/ that was not there when it started (or once it ends);
+    polled every 5 ms."""
+    before = _shard_files(out)
+    while process.poll() is None and _shard_files(out) <= before:
+        time.sleep(0.005)
+
+
 def test_sigkill_at_random_moments_then_rerun_gives_identical_files(gl_context, tmp_path, write_config):
+    """Kill moments are drawn within the working phase measured on the reference run (first shard file to exit),
+    so they land mid-run on a fast machine as on a slow one."""
     config = write_config(CONFIG)
     out = tmp_path / "out"
-    assert _cli(config, out).wait(timeout=300) == 0
+    process = _cli(config, out)
+    _first_shard_write(process, out)
+    working = time.monotonic()
+    assert process.wait(timeout=300) == 0
+    working = time.monotonic() - working
     reference = _digests(out)
     _clear(out)
     rng = random.Random(3)
     kills = 0
     for _ in range(12):
         process = _cli(config, out)
-        time.sleep(rng.uniform(0.8, 3.0))
+        _first_shard_write(process, out)
+        time.sleep(rng.uniform(0.0, 0.8) * working)
         if process.poll() is None:
             os.kill(process.pid, signal.SIGKILL)
             process.wait()
