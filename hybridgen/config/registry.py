@@ -15,44 +15,6 @@ if TYPE_CHECKING:
     from ..modules.base import Module
 
 ENTRY_POINT_GROUP = "hybridgen.modules"
-_BUILTIN_PACKAGES = (
-    "hybridgen.modules.main_initializer",
-    "hybridgen.modules.obj_loader",
-    "hybridgen.modules.primitive_loader",
-    "hybridgen.modules.camera_loader",
-    "hybridgen.modules.camera_sampler",
-    "hybridgen.modules.light_loader",
-    "hybridgen.modules.surface_lighting",
-    "hybridgen.modules.manipulators",
-    "hybridgen.modules.object_placement",
-    "hybridgen.modules.physics_positioning",
-    "hybridgen.modules.object_swapper",
-    "hybridgen.modules.segmap_renderer",
-    "hybridgen.modules.rgb_renderer",
-    "hybridgen.modules.hdf5_writer",
-    "hybridgen.modules.coco_writer",
-    "hybridgen.modules.bop_writer",
-    "hybridgen.modules.floor_extractor",
-    "hybridgen.modules.world_manipulator",
-    "hybridgen.modules.state_writers",
-    "hybridgen.modules.bop_loader",
-    "hybridgen.modules.material_library",
-    "hybridgen.modules.haven_loaders",
-    "hybridgen.modules.shapenet_loader",
-    "hybridgen.modules.front3d_loader",
-    "hybridgen.modules.object_dataset_loaders",
-    "hybridgen.modules.scenenet_loader",
-    "hybridgen.modules.material_randomizer",
-    "hybridgen.modules.hide_objects",
-    "hybridgen.modules.camera_object_sampler",
-    "hybridgen.modules.random_room",
-    "hybridgen.modules.room_camera_samplers",
-    "hybridgen.modules.empty_initializer",
-    "hybridgen.modules.calibration_board",
-    "hybridgen.modules.texture_loader",
-    "hybridgen.modules.shading",
-)
-
 _BUILTIN_NAMES = {
     "main.Initializer": "hybridgen.modules.main_initializer",
     "loader.ObjLoader": "hybridgen.modules.obj_loader",
@@ -102,6 +64,10 @@ _BUILTIN_NAMES = {
 }
 """Built-in module name -> the file registering it: :func:`get_module` imports that file alone (importing all
 of them costs ~0.2 s of every run's start); a name missing here, or a plugin's, loads every module first."""
+
+_BUILTIN_PACKAGES = tuple(dict.fromkeys(_BUILTIN_NAMES.values()))
+"""Every file registering built-in modules, in a fixed order (what :func:`all_modules` imports): derived from
+:data:`_BUILTIN_NAMES`, so a module added there is listed by ``hybridgen modules`` too."""
 
 MODULES: dict[str, type["Module"]] = {}
 _loaded = False
