@@ -11,6 +11,16 @@ def closest(name: str, known: Iterable[str]) -> str:
     return f" (did you mean {' or '.join(repr(m) for m in matches)}?)" if matches else ""
 
 
+def reject_unknown_keys(mapping: Iterable[str], known: Iterable[str], where: str = "") -> None:
+    """Raises :class:`ConfigError` at the first key of ``mapping`` not in ``known``: located at ``<where>.<key>``
+    (or ``<key>`` when ``where`` is empty), with the closest known names and the list of known ones."""
+    names = list(known)
+    for key in mapping:
+        if key not in names:
+            raise ConfigError(f"unknown key{closest(key, names)}; known: {', '.join(map(str, names))}",
+                              key=f"{where}.{key}" if where else str(key))
+
+
 class HybridgenError(Exception):
     """Base of every error that is the user's input, not a bug: shown as one line, exit status 2."""
 

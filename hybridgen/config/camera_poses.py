@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError, InputError, closest
+from ..errors import ConfigError, InputError, closest, reject_unknown_keys
 from ..io.bounded_read import MAX_POSE_FILE_BYTES, read_bounded_text
 from ..scene.camera import Intrinsics
 from ..scene.frames import BLENDER_TO_OPENCV, euler_xyz_to_matrix, forward_to_rotation_blender, look_at_blender, \
@@ -183,9 +183,7 @@ def intrinsics_from_config(config: dict[str, Any]) -> Intrinsics:
     """Intrinsics from ``{resolution_x, resolution_y, cam_K | fov, fov_axis, clip_start, clip_end}``."""
     known = ("resolution_x", "resolution_y", "cam_K", "fov", "fov_axis", "clip_start", "clip_end",
              "depth_of_field")  # depth_of_field: the camera modules read it (hybridgen.config.depth_of_field)
-    for key in config:
-        if key not in known:
-            raise ConfigError(f"unknown key{closest(key, known)}; known: {list(known)}", key=f"intrinsics.{key}")
+    reject_unknown_keys(config, known, "intrinsics")
     res = []
     for key in ("resolution_x", "resolution_y"):
         value = config.get(key, 512)

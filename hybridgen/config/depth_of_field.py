@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError, HybridgenError, closest
+from ..errors import ConfigError, HybridgenError, reject_unknown_keys
 from ..scene.depth_of_field import DepthOfField
 from ..scene.scene import Scene
 from .notices import notice
@@ -28,9 +28,7 @@ def depth_of_field_from_config(value: Any, scene: Scene, rng: np.random.Generato
 
     if not isinstance(value, dict):
         raise ConfigError("depth_of_field is a mapping {fstop, focal_object | depth_of_field_dist}", key=key)
-    for name in value:
-        if name not in DOF_KEYS:
-            raise ConfigError(f"unknown key{closest(name, DOF_KEYS)}; known: {list(DOF_KEYS)}", key=f"{key}.{name}")
+    reject_unknown_keys(value, DOF_KEYS, key)
     distances = [name for name in ("depth_of_field_dist", "focal_distance") if name in value]
     if len(distances) + ("focal_object" in value) != 1:
         raise ConfigError("give exactly one of focal_object and depth_of_field_dist", key=key)

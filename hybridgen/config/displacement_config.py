@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from ..errors import ConfigError
+from ..errors import ConfigError, reject_unknown_keys
 from ..input_paths import locate_input
 from ..scene.displacement import TEXTURE_COORDS, Displacement
 from .schema import closest
@@ -17,10 +17,7 @@ def displacement_from_config(config: dict[str, Any], key: str = "displace") -> D
     """The modifier of ``config``; errors name ``<key>.<entry>``."""
     if not isinstance(config, dict):
         raise ConfigError("must be a mapping {texture, strength, mid_level, subdiv_level, ...}", key=key)
-    for name in config:
-        if name not in KNOWN_KEYS:
-            raise ConfigError(f"unknown key{closest(name, KNOWN_KEYS)}; supported: {', '.join(KNOWN_KEYS)}",
-                              key=f"{key}.{name}")
+    reject_unknown_keys(config, KNOWN_KEYS, key)
     texture = config.get("texture")
     if not isinstance(texture, str) or not texture:
         raise ConfigError("must be the path of a height image (Blender's procedural textures are not available)",

@@ -5,7 +5,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping
 
-from ..errors import ConfigError, closest
+from ..errors import ConfigError, closest, reject_unknown_keys
 
 REQUIRED = object()
 """Default marker of a parameter that has to be given."""
@@ -94,10 +94,7 @@ def validate_config(params: Mapping[str, Param], given: Mapping[str, Any],
     are ignored (they are meant for other modules).
     """
     out: dict[str, Any] = {}
-    for key in given:
-        if key not in params:
-            raise ConfigError(f"unknown key{closest(key, params)}; known keys: {', '.join(sorted(params))}",
-                              key=str(key))
+    reject_unknown_keys(given, sorted(params))
     for name, param in params.items():
         if name in given:
             out[name] = param.validate(given[name])

@@ -10,7 +10,7 @@ from ..config.camera_poses import intrinsics_from_config, pose_from_entry
 from ..config.depth_of_field import depth_of_field_from_config
 from ..config.registry import register_module
 from ..config.schema import Param, positive
-from ..errors import ConfigError, InputError, closest
+from ..errors import ConfigError, InputError, reject_unknown_keys
 from ..render.raster import RasterView
 from ..run.context import RunContext
 from ..sampling.camera_checks import NoveltyCheck, ProximityChecks
@@ -68,9 +68,7 @@ class CameraSampler(Module):
                 where = f"cam_poses[{index}]"
                 if not isinstance(entry, dict):
                     raise ConfigError("a pose entry is a mapping", key=where)
-                for key in entry:
-                    if key not in ENTRY_KEYS:
-                        raise ConfigError(f"unknown key{closest(key, ENTRY_KEYS)}", key=f"{where}.{key}")
+                reject_unknown_keys(entry, ENTRY_KEYS, where)
                 count = int(entry.get("number_of_samples", 1))
                 checks = self._checks(entry, context, where)
                 draw_ctx = DrawContext(context.rng, context.scene)

@@ -11,7 +11,7 @@ from typing import Any
 
 from ..config.registry import register_module
 from ..config.schema import Param
-from ..errors import ConfigError, HybridgenError, closest
+from ..errors import ConfigError, HybridgenError, reject_unknown_keys
 from ..io.mesh_loader import unique_blender_name
 from ..run.context import RunContext
 from ..scene.empty import EMPTY_TYPES, Empty
@@ -51,9 +51,7 @@ class BasicEmptyInitializer(Module):
             where = f"empties_to_add[{index}]"
             if not isinstance(entry, dict):
                 raise ConfigError("an empty is a mapping {name, type, location, rotation, scale}", key=where)
-            for key in entry:
-                if key not in ENTRY_KEYS:
-                    raise ConfigError(f"unknown key{closest(key, ENTRY_KEYS)}", key=f"{where}.{key}")
+            reject_unknown_keys(entry, ENTRY_KEYS, where)
             name = entry.get("name")
             if not isinstance(name, str) or not name:
                 raise ConfigError("every empty needs a name", key=f"{where}.name")
