@@ -29,7 +29,7 @@ if TYPE_CHECKING:  # what static analysers see; at run time the same names come 
 
     from .io.hdf5_single import Hdf5SingleFileWriter
     from .io.memory_sink import MemorySink
-    from .io.mesh_loader import load_objects
+    from .io.mesh_cache import load_objects_cached as load_objects
     from .render.label_request import LabelRequest
     from .render.path_trace import PathTraceSettings
     from .render.raster import RasterView
@@ -41,21 +41,25 @@ if TYPE_CHECKING:  # what static analysers see; at run time the same names come 
     from .scene.primitives import make_primitive
 
 _LAZY = {
-    "Hdf5SingleFileWriter": ".io.hdf5_single", "MemorySink": ".io.memory_sink", "load_objects": ".io.mesh_loader",
+    "Hdf5SingleFileWriter": ".io.hdf5_single", "MemorySink": ".io.memory_sink",
+    "load_objects": ".io.mesh_cache:load_objects_cached",
     "LabelRequest": ".render.label_request", "PathTraceSettings": ".render.path_trace", "RasterView": ".render.raster",
     "render_color": ".render.render_color", "render_labels": ".render.render_labels", "run_config": ".run.pipeline",
     "Camera": ".scene", "Intrinsics": ".scene", "Light": ".scene", "Material": ".scene", "MeshObject": ".scene",
     "Scene": ".scene", "World": ".scene", "blender_to_opencv": ".scene.frames", "make_pose": ".scene.frames",
     "object_pose": ".scene.frames", "opencv_to_blender": ".scene.frames", "make_primitive": ".scene.primitives",
 }
-"""Public name -> the module that defines it (relative to this package), imported when the name is first used."""
+"""Public name -> the module that defines it (relative to this package), imported when the name is first used;
+``module:attribute`` where the module's name for it differs (``load_objects`` is the cached loader, so a
+script's second run reads its meshes without importing trimesh: :mod:`hybridgen.io.mesh_cache`)."""
 
 
 def __getattr__(name: str) -> Any:
     module = _LAZY.get(name)
     if module is None:
         raise AttributeError(f"module 'hybridgen' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module, __name__), name)
+    module, _, attribute = module.partition(":")
+    value = getattr(importlib.import_module(module, __name__), attribute or name)
     globals()[name] = value  # later lookups skip this function
     return value
 

@@ -1,16 +1,23 @@
-"""The parsed-mesh cache (hybridgen.io.mesh_cache): a hit gives exactly the objects a fresh parse gives,
-content (not file times) decides, entries are written atomically, and a run writes the same bytes cold
-and warm."""
+"""The parsed-mesh cache (hybridgen.io.mesh_cache, the Python API's hg.load_objects): a hit gives exactly the
+objects a fresh parse gives without importing trimesh, content (not file times) decides, entries are written
+atomically, missing MTL/texture files are the loader's error or notice every time, and a run writes the same
+bytes cold and warm."""
 from __future__ import annotations
 
 import hashlib
+import pickle
 import shutil
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 
 import hybridgen as hg
+from hybridgen.config import notices
 from hybridgen.io.mesh_cache import load_objects_cached
+from hybridgen.io.mesh_loader import load_objects
+from hybridgen.io.mesh_references import LENIENT_ENV
 from tests.conftest import REPO
 
 POSE = hg.object_pose([0.3, -1.1, 0.25], [0.4, -0.2, 1.3], 0.35)
@@ -43,15 +50,14 @@ def test_hit_equals_a_fresh_parse(cache, tmp_path, up_axis):
     mesh = tmp_path / "knot.obj"
     for name in ("knot.obj", "knot.mtl", "knot.png"):
         shutil.copy(REPO / "configs/assets" / name, tmp_path / name)
-    fresh = hg.load_objects(mesh, name="k", category_id=3, local2world=POSE, up_axis=up_axis,
-                            attributes={"a": 1})
+    fresh = load_objects(mesh, name="k", category_id=3, local2world=POSE, up_axis=up_axis, attributes={"a": 1})
     cold = load_objects_cached(mesh, name="k", category_id=3, local2world=POSE, up_axis=up_axis, attributes={"a": 1})
     assert len(list(cache.glob("*.pickle"))) == 1 and not list(cache.glob("*.tmp"))
     warm = load_objects_cached(mesh, name="k", category_id=3, local2world=POSE, up_axis=up_axis, attributes={"a": 1})
     _same(fresh, cold)
     _same(fresh, warm)
     unposed = load_objects_cached(mesh, name="k", category_id=7, up_axis=up_axis)
-    _same(hg.load_objects(mesh, name="k", category_id=7, up_axis=up_axis), unposed)
+    _same(load_objects(mesh, name="k", category_id=7, up_axis=up_axis), unposed)
     assert len(list(cache.glob("*.pickle"))) == 1  # pose, category and attributes are not part of the key
     # content decides: an edited texture (named by the MTL) is a new entry
     (tmp_path / "knot.png").write_bytes((tmp_path / "knot.png").read_bytes() + b"\0")
@@ -61,7 +67,7 @@ def test_hit_equals_a_fresh_parse(cache, tmp_path, up_axis):
 
 def test_damaged_entry_is_a_miss_and_off_turns_it_off(cache, tmp_path, monkeypatch):
     mesh = REPO / "configs/assets/crate.obj"
-    fresh = hg.load_objects(mesh, category_id=1)
+    fresh = load_objects(mesh, category_id=1)
     load_objects_cached(mesh, category_id=1)
     (entry,) = cache.glob("*.pickle")
     entry.write_bytes(entry.read_bytes()[:100])  # truncated
@@ -76,6 +82,56 @@ def test_damaged_entry_is_a_miss_and_off_turns_it_off(cache, tmp_path, monkeypat
 def test_missing_file_is_the_loaders_error(cache, tmp_path):
     with pytest.raises(hg.InputError, match="not found"):
         load_objects_cached(tmp_path / "nope.obj")
+
+
+
+WARM_LOAD = """
+import pickle, sys
+import hybridgen as hg
+objects = hg.load_objects(sys.argv[1], name="k", category_id=4, local2world=%r, attributes={"a": 2})
+heavy = sorted(name for name in ("trimesh", "scipy", "networkx") if name in sys.modules)
+sys.stdout.buffer.write(pickle.dumps((heavy, objects)))
+"""
+
+
+def test_the_python_apis_warm_load_does_not_import_trimesh(cache, tmp_path):
+    """hg.load_objects is the cached loader: a script's second run reads the entry, imports neither trimesh nor
+    SciPy (they cost ~0.6 s of its start), and gets the objects a fresh parse gives."""
+    assert hg.load_objects is load_objects_cached
+    mesh = tmp_path / "knot.obj"
+    for name in ("knot.obj", "knot.mtl", "knot.png"):
+        shutil.copy(REPO / "configs/assets" / name, tmp_path / name)
+    script = WARM_LOAD % POSE.tolist()
+    runs = [subprocess.run([sys.executable, "-c", script, str(mesh)], capture_output=True, check=True, cwd=REPO)
+            for _ in range(2)]  # cold (parses, writes the entry), then warm
+    (cold_heavy, cold), (warm_heavy, warm) = (pickle.loads(run.stdout) for run in runs)
+    assert "trimesh" in cold_heavy and warm_heavy == []
+    assert len(list(cache.glob("*.pickle"))) == 1
+    fresh = load_objects(mesh, name="k", category_id=4, local2world=POSE, attributes={"a": 2})
+    _same(fresh, cold)
+    _same(fresh, warm)
+
+
+def test_missing_texture_is_the_loaders_error_or_notice_every_time(cache, tmp_path, monkeypatch):
+    """A file whose MTL names a missing texture is never cached: without --lenient every load raises the
+    loader's error, with it every load gives the loader's notice (a hit would give neither)."""
+    (tmp_path / "skin.mtl").write_text("newmtl skin\nKd 1 1 1\nmap_Kd skin.png\n")
+    mesh = tmp_path / "thing.obj"
+    mesh.write_text("mtllib skin.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl skin\n"
+                    "f 1/1 2/2 3/3\n")
+    lines: list[str] = []
+    notices.set_sink(lines.append)
+    try:
+        for _ in range(2):
+            with pytest.raises(hg.InputError, match=r"missing file\(s\) it names: '.*skin.png'"):
+                hg.load_objects(mesh)
+        monkeypatch.setenv(LENIENT_ENV, "1")
+        for count in (1, 2):
+            _same(load_objects(mesh), hg.load_objects(mesh))
+            assert sum("skin.png" in line for line in lines) == 2 * count  # the fresh parse's and the API's
+    finally:
+        notices.set_sink(None)
+    assert not cache.exists() or not list(cache.glob("*.pickle"))
 
 
 CONFIG = """
