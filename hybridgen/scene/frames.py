@@ -6,6 +6,7 @@ by a rotation of pi about the camera x axis: ``cam2world_cv = cam2world_blender 
 """
 from __future__ import annotations
 
+import math
 from typing import Any, Sequence
 
 import numpy as np
@@ -78,9 +79,34 @@ def euler_xyz_to_matrix(angles: Sequence[float]) -> np.ndarray:
     values = np.asarray(angles, dtype=np.float64).ravel()
     if values.size != 3:
         raise ValueError(f"Euler XYZ rotation needs 3 angles, got {list(values)}")
-    if not values.any():  # no rotation (every loader's default): SciPy's exact identity, without importing it
+    if not values.any():  # no rotation (every loader's default): SciPy's exact identity
         return np.eye(3)
-    return _rotation().from_euler("xyz", values).as_matrix()
+    quaternion = [0.0, 0.0, 0.0, 1.0]
+    for axis, angle in enumerate(values.tolist()):  # extrinsic: each turn composed on the left
+        turn = [0.0, 0.0, 0.0, math.cos(angle / 2.0)]
+        turn[axis] = math.sin(angle / 2.0)
+        quaternion = turn if axis == 0 else _compose_quaternions(turn, quaternion)
+    return _quaternion_matrix(quaternion)
+
+
+def _compose_quaternions(p: list[float], q: list[float]) -> list[float]:
+    """The (x, y, z, w) quaternion ``p * q`` (``q``'s turn first), in SciPy's ``compose_quat`` operation
+    order, so :func:`euler_xyz_to_matrix` gives SciPy's ``Rotation.from_euler("xyz", ...).as_matrix()`` bit for
+    bit without importing SciPy (``scipy.spatial`` costs ~0.17 s of a process's start; held against SciPy in
+    tests/scene/test_rotations_scipy.py)."""
+    cross = (p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0])
+    return [p[3] * q[0] + q[3] * p[0] + cross[0], p[3] * q[1] + q[3] * p[1] + cross[1],
+            p[3] * q[2] + q[3] * p[2] + cross[2], p[3] * q[3] - p[0] * q[0] - p[1] * q[1] - p[2] * q[2]]
+
+
+def _quaternion_matrix(quaternion: list[float]) -> np.ndarray:
+    """3x3 rotation of an (x, y, z, w) quaternion, in SciPy's ``as_matrix`` operation order (not normalised)."""
+    x, y, z, w = quaternion
+    x2, y2, z2, w2 = x * x, y * y, z * z, w * w
+    xy, zw, xz, yw, yz, xw = x * y, z * w, x * z, y * w, y * z, x * w
+    return np.array([[x2 - y2 - z2 + w2, 2 * (xy - zw), 2 * (xz + yw)],
+                     [2 * (xy + zw), -x2 + y2 - z2 + w2, 2 * (yz - xw)],
+                     [2 * (xz - yw), 2 * (yz + xw), -x2 - y2 + z2 + w2]])
 
 
 def matrix_to_euler_xyz(rotation: np.ndarray) -> np.ndarray:

@@ -36,3 +36,26 @@ def test_axis_angle_right_hand_rule():
     np.testing.assert_allclose(np.trace(r), 1 + 2 * np.cos(0.7), atol=1e-14)
     with pytest.raises(ValueError):
         euler_xyz_to_matrix([0.1, 0.2])
+
+
+def test_euler_xyz_is_scipys_matrix_bit_for_bit_without_importing_it():
+    """euler_xyz_to_matrix computes SciPy's from_euler("xyz").as_matrix() itself (a process that poses objects
+    need not import scipy.spatial): the same float64 bits for random, rounded and axis-aligned angles."""
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(7)
+    angles = [*rng.uniform(-7.0, 7.0, (3000, 3)), *np.round(rng.uniform(-4.0, 4.0, (1000, 3)), 1),
+              *(np.pi / 2 * rng.integers(-4, 5, (200, 3))), [0.0, 0.0, 1e-300], [-0.0, 0.0, 0.5], [1e6, -3e5, 2.0]]
+    for values in angles:
+        expected = Rotation.from_euler("xyz", values).as_matrix()
+        assert np.array_equal(euler_xyz_to_matrix(values), expected), values
+
+
+def test_posing_objects_imports_no_scipy():
+    import subprocess
+    import sys
+
+    script = ("import sys, hybridgen as hg; hg.object_pose([1, 2, 3], [0.3, -0.2, 1.1]); "
+              "print('scipy' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "False"
