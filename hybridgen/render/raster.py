@@ -30,7 +30,8 @@ from .raster_passes import RASTER_PASSES
 from .readback import RasterOutput
 from .projection import near_plane_corner_distance, projection_from_K
 from .shader_source import shader_source
-from .triangle_clusters import TriangleClusters, build_clusters, draw_commands, visible_clusters
+from .cluster_cache import mesh_clusters
+from .triangle_clusters import TriangleClusters, draw_commands, visible_clusters
 
 NORMAL_SPACES = ("camera", "world")
 READBACKS = ("direct", "pbo")
@@ -185,7 +186,8 @@ class RasterView:
                 content.append((cutout.uv_buffer, "2f", "in_uv"))
         vao = ctx.vertex_array(program, content, index_buffer=indices, index_element_size=4)
         extra = cutout.resources() if cutout is not None else []
-        clusters, indirect = (build_clusters(vertices, faces) if self.cull_clusters else None), None
+        # the clusters of obj's triangles (those of a flat mesh's corner vertices are the same), built once
+        clusters, indirect = (mesh_clusters(obj.vertices, obj.faces) if self.cull_clusters else None), None
         if clusters is not None:
             indirect = ctx.buffer(reserve=20 * clusters.size)
             extra.append(indirect)

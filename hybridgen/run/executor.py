@@ -10,6 +10,7 @@ from concurrent.futures import Future
 from typing import TYPE_CHECKING, Any, Callable
 
 if TYPE_CHECKING:  # imported where used: the command line reads EXECUTORS without loading the run machinery
+    from ..config.config_file import ConfigFile
     from ..logs import Log
     from .unit_task import UnitTask
     from .units import WorkUnit
@@ -35,13 +36,13 @@ class InProcessExecutor(Executor):
     consecutive units of one scene build it once (:mod:`hybridgen.run.scene_reuse`)."""
 
     def __init__(self, task: UnitTask, progress: Callable[[int, str], Any] | None = None,
-                 reuse_scenes: bool = False, log: Log | None = None) -> None:
+                 reuse_scenes: bool = False, log: Log | None = None, config: ConfigFile | None = None) -> None:
         from .scene_reuse import SceneReuse
 
         self.task = task
         self.progress = progress
         self.log = log
-        self.scenes = SceneReuse() if reuse_scenes else None
+        self.scenes = SceneReuse(config) if reuse_scenes else None  # config: the task's, already loaded
 
     def submit(self, unit: WorkUnit) -> Future:
         future: Future = Future()

@@ -97,7 +97,7 @@ def run_config(path: str | Path, args: Sequence[str] = (), *, env: Mapping[str, 
         if staged is not None:  # rendered in verified parts, merged into the same bytes: a killed run resumes
             return run_sharded(staged, path, args, env, workers=1, shard=None, executor="pool", address=None,
                                log=say, start=start, policy=policy, max_tasks_per_child=max_tasks_per_child,
-                               progress=progress)
+                               progress=progress, config=config)
         context = execute(config, modules, progress=progress, log=log,
                           attributes={FINGERPRINT_ATTR: policy.fingerprint_text})
     return RunSummary(context.frames_rendered, time.perf_counter() - start, context.outputs)

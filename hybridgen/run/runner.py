@@ -30,6 +30,7 @@ from typing import Any, Callable, Iterator, Mapping, Sequence
 import h5py
 
 from .. import stop_request
+from ..config.config_file import ConfigFile
 from ..errors import InputError
 from ..io.atomic import prepare_output_dir
 from ..io.integrity import verify
@@ -72,17 +73,18 @@ def check_executor_options(kind: str, max_tasks_per_child: int) -> None:
 def open_executor(kind: str, task: UnitTask, *, workers: int, address: str | None = None,
                   max_tasks_per_child: int = DEFAULT_MAX_TASKS_PER_CHILD,
                   progress: Callable[[int, str], Any] | None = None, reuse_scenes: bool = False,
-                  log: Log | None = None) -> Executor:
+                  log: Log | None = None, config: ConfigFile | None = None) -> Executor:
     """The executor ``kind`` (checked by :func:`check_executor_options`; ``pool``: this process for one
     worker, else a process pool; ``ray``: Ray at ``address`` or a local cluster) for ``workers`` parallel
     units of ``task``. Units run in this process report to ``log``; pool workers log through
-    :func:`hybridgen.logs.log_line`, set up as this process is."""
+    :func:`hybridgen.logs.log_line`, set up as this process is. ``config``: the task's config, already
+    loaded here (units reusing scenes in this process then do not parse it again)."""
     if kind == "ray":
         from .executor_ray import RayExecutor
 
         return RayExecutor(task, address, workers)
     if workers == 1:
-        return InProcessExecutor(task, progress, reuse_scenes, log)
+        return InProcessExecutor(task, progress, reuse_scenes, log, config)
     return PoolExecutor(task, workers, max_tasks_per_child)
 
 
@@ -135,9 +137,10 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
                 workers: int, shard: tuple[int, int] | None, executor: str, address: str | None,
                 log: Log, start: float, policy: ResumePolicy,
                 max_tasks_per_child: int = DEFAULT_MAX_TASKS_PER_CHILD,
-                progress: Callable[[int, str], Any] | None = None) -> RunSummary:
+                progress: Callable[[int, str], Any] | None = None, config: ConfigFile | None = None) -> RunSummary:
     """Execute the plan's missing units, then build the index (or merge a staged plan's parts) when all
-    exist. ``progress`` makes progress bars of units run in this process."""
+    exist. ``progress`` makes progress bars of units run in this process; ``config``: the one at ``path``
+    with ``args`` and ``env``, already loaded by the caller."""
     check_executor_options(executor, max_tasks_per_child)
     index, count = shard or (0, 1)
     if not 0 <= index < count:
@@ -151,7 +154,8 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
             log(f"--restart: discarded {removed} existing file(s)")
     task = UnitTask(str(path), tuple(args), dict(env) if env is not None else None, policy.fingerprint_text)
     pool = open_executor(executor, task, workers=workers, address=address, max_tasks_per_child=max_tasks_per_child,
-                         progress=progress, reuse_scenes=plan.staged, log=log)  # staged: parts share one scene
+                         progress=progress, reuse_scenes=plan.staged, log=log,  # staged: parts share one scene
+                         config=config)
     scene_units = _scene_units(plan, index, count)
     ready: deque[WorkUnit] = deque()  # later chunks of scenes whose first chunk is known
     pending: dict[Future, WorkUnit] = {}

@@ -34,10 +34,12 @@ class _Built:
 
 class SceneReuse:
     """Builds each scene once for the units that follow; :meth:`close` runs the builders' cleanups.
-    ``builds`` counts how often scene-building modules ran in this process."""
+    ``builds`` counts how often scene-building modules ran in this process. ``config``: the run's config,
+    already loaded by the caller from the same path, arguments and environment (then not parsed again)."""
 
-    def __init__(self) -> None:
+    def __init__(self, config: ConfigFile | None = None) -> None:
         self._built: _Built | None = None
+        self._loaded = config
         self.builds = 0
 
     def execute(self, path: str, args: Sequence[str], env: Mapping[str, str] | None, unit: WorkUnit, *,
@@ -49,7 +51,8 @@ class SceneReuse:
                tuple(sorted((attributes or {}).items())))
         if self._built is None or self._built.key != key:
             self.close()
-            config = load_config(path, args, env)
+            loaded = self._loaded
+            config = loaded if loaded is not None and loaded.path == str(path) else load_config(path, args, env)
             modules = build_modules(config)
             stage = scene_stage(modules)
             if stage is None:
