@@ -68,7 +68,8 @@ class Hdf5Writer(Module):
         if cfg["layout"] == "blenderproc":
             self.writer = BlenderProcHdf5Writer(cfg["output_dir"], options, append=cfg["append_to_existing_output"])
         elif context.unit is not None:  # one work unit of a sharded run (or part of a staged one): its own file
-            writer_class = JournalingWriter if context.unit.folder != SHARD_FOLDER else Hdf5SingleFileWriter
+            plain = context.unit.folder == SHARD_FOLDER or context.unit.whole  # whole: a staged run's only part
+            writer_class = Hdf5SingleFileWriter if plain else JournalingWriter
             self.writer = writer_class(context.unit.shard_path(cfg["output_dir"]), options)
         else:
             self.writer = Hdf5SingleFileWriter(Path(cfg["output_dir"]) / cfg["file_name"], options)

@@ -53,7 +53,7 @@ class RunContext:
     def run_attributes(self) -> dict[str, Any]:
         """Attributes every output file records: seed, resolved config and those renderers added."""
         attrs: dict[str, Any] = {"seed": self.seed}
-        if self.unit is not None:
+        if self.unit is not None and not self.unit.whole:  # a whole unit's file is the direct run's file
             attrs.update({"scene_index": self.unit.scene, "chunk_index": self.unit.chunk,
                           "scene_keypoints": len(self.scene.camera)})
         if self.config is not None:

@@ -20,6 +20,7 @@ Results never depend on how units are spread over workers.
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections import deque
 from concurrent.futures import FIRST_COMPLETED, Future, wait
@@ -152,6 +153,10 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
         removed = discard_outputs(plan, shard)
         if removed:
             log(f"--restart: discarded {removed} existing file(s)")
+    whole = None
+    if plan.staged:  # where a run of one part writes its file (scene_reuse.py); one left by a killed run is stale
+        whole = dataclasses.replace(plan.unit(0), whole=True).shard_path(plan.output_dir)
+        whole.unlink(missing_ok=True)
     task = UnitTask(str(path), tuple(args), dict(env) if env is not None else None, policy.fingerprint_text)
     pool = open_executor(executor, task, workers=workers, address=address, max_tasks_per_child=max_tasks_per_child,
                          progress=progress, reuse_scenes=plan.staged, log=log,  # staged: parts share one scene
@@ -203,8 +208,13 @@ def run_sharded(plan: ShardingPlan, path: str | Path, args: Sequence[str], env: 
 
             remove_empty_staging(plan.output_dir / plan.folder)
     outputs = []
-    shards = complete_shards(plan)
-    if shards is not None and plan.staged:
+    shards = None if whole is not None and whole.is_file() else complete_shards(plan)
+    if whole is not None and whole.is_file():  # a staged run's only part wrote the run's file itself
+        from .staged_output import remove_staging
+
+        outputs.append(whole.replace(plan.output_dir / plan.file_name))
+        remove_staging(plan.output_dir / plan.folder)
+    elif shards is not None and plan.staged:
         from .staged_output import consolidate, remove_staging
 
         outputs.append(consolidate(plan.output_dir / plan.file_name, shards))

@@ -6,7 +6,10 @@ sampling, ...) build the scene and draw from the run's generator; the renderers 
 render and write the unit's keypoints (per-keypoint seeds derive from the scene seed and the keypoint
 index, never from the generator). So the scene-building modules run once, and every unit runs the
 renderers and writers on a deep copy of the built state (scene, generator, attributes): the bytes are those
-of rebuilding the scene per unit. Configs with a scene-changing module after a renderer rebuild per unit.
+of rebuilding the scene per unit. The scene's last unit runs on the built state itself (nothing later reads
+it; a unit asked for afterwards builds the scene again), and a scene's only unit is made *whole*: it writes
+the run's final file (:class:`~hybridgen.run.units.WorkUnit`), so there are no parts to merge. Configs with a
+scene-changing module after a renderer rebuild per unit.
 """
 from __future__ import annotations
 
@@ -20,7 +23,7 @@ from ..modules.base import Module
 from .context import RunContext
 from .plan import scene_stage
 from .steps import build_modules, execute, run_cleanups, run_modules
-from .units import WorkUnit
+from .units import WorkUnit, chunk_count
 
 
 @dataclasses.dataclass
@@ -69,11 +72,23 @@ class SceneReuse:
             self.builds += 1
             self._built = _Built(key, config, modules, stage, base)
         built = self._built
-        context = _copy_for(built.context, unit)
+        last = unit.chunk >= chunk_count(len(built.context.scene.camera), unit.chunk_size) - 1
+        if last and unit.chunk == 0:  # the run's only part writes the run's file itself: nothing to merge
+            unit = dataclasses.replace(unit, whole=True)
+        if not last:
+            context = _copy_for(built.context, unit)
+        else:  # no later unit of this scene: it runs on the built state itself, which is then forgotten
+            self._built = None
+            context = dataclasses.replace(built.context, unit=unit, sinks=list(built.context.sinks),
+                                          outputs=list(built.context.outputs), cleanups=[])
+            context.rng = built.context.rng  # replace() seeded a new generator
+            context.log = built.context.log
         try:
             run_modules(built.config, built.modules[built.stage:], context)
         finally:
             run_cleanups(context)
+            if last:
+                run_cleanups(built.context)
         return context
 
     def close(self) -> None:

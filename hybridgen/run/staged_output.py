@@ -19,6 +19,12 @@ attributes). :func:`consolidate` replays those calls through the same
 (compressed) bytes copied verbatim from its part (``read_direct_chunk`` / ``write_direct_chunk``: nothing
 is decompressed or encoded again). The result is the file an uninterrupted direct run writes, byte for
 byte, whether or not the run was interrupted; the staging folder is removed afterwards.
+
+A run whose keypoints fit in one part (the default for label runs of up to
+:data:`DEFAULT_LABEL_CHUNK_KEYPOINTS` keypoints) has nothing to merge: its only part is a *whole* unit
+(:mod:`hybridgen.run.scene_reuse`) that writes the direct run's file under a name of its own in the staging
+folder, and the runner renames it into place. A killed attempt leaves at most a temporary file there; it is
+rendered again from the start, as before (a part that is never complete is never resumed).
 """
 from __future__ import annotations
 

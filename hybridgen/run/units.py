@@ -20,20 +20,23 @@ SHARD_FOLDER = "shards"
 class WorkUnit:
     """Scene ``scene``, keypoints ``[chunk * chunk_size, (chunk + 1) * chunk_size)`` (all when chunk_size is 0);
     its file goes to ``<output_dir>/<folder>`` (``shards``, or the hidden staging folder of a resumable
-    non-sharded run, :mod:`hybridgen.run.staged_output`)."""
+    non-sharded run, :mod:`hybridgen.run.staged_output`). ``whole``: the only part of a staged run, which
+    writes the run's final file itself (under a name of its own in the staging folder)."""
 
     scene: int
     chunk: int = 0
     chunk_size: int = 0
     folder: str = SHARD_FOLDER
+    whole: bool = False
 
     @property
     def name(self) -> str:
         return f"scene_{self.scene:06d}_chunk_{self.chunk:05d}"
 
     def shard_path(self, output_dir: str | Path, suffix: str = ".hdf5") -> Path:
-        """Where this unit's output goes: ``<output_dir>/<folder>/<name><suffix>``."""
-        return Path(output_dir) / self.folder / f"{self.name}{suffix}"
+        """Where this unit's output goes: ``<output_dir>/<folder>/<name><suffix>`` (``whole_<name><suffix>`` for
+        a whole unit: never taken for a part)."""
+        return Path(output_dir) / self.folder / f"{'whole_' if self.whole else ''}{self.name}{suffix}"
 
     def keypoints(self, total: int) -> range:
         """The keypoint indices of the scene this unit renders."""
