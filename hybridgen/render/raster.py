@@ -242,7 +242,7 @@ class RasterView:
     def _rays(self, intr: Intrinsics) -> np.ndarray:
         key = (intr.K.tobytes(), intr.width, intr.height)
         if self._ray_key != key:
-            self._ray_lengths = np.linalg.norm(intr.pixel_rays(), axis=-1).astype(np.float32)
+            self._ray_lengths = intr.pixel_ray_lengths()
             self._ray_key = key
         assert self._ray_lengths is not None
         return self._ray_lengths

@@ -98,6 +98,15 @@ class Intrinsics:
         fx, fy, cx, cy = self.K[0, 0], self.K[1, 1], self.K[0, 2], self.K[1, 2]
         return np.stack([(u - cx) / fx, (v - cy) / fy, np.ones_like(u)], axis=-1)
 
+    def pixel_ray_lengths(self) -> np.ndarray:
+        """(H, W) float32 length of every :meth:`pixel_rays` direction: the same bits as
+        ``np.linalg.norm(self.pixel_rays(), axis=-1).astype(np.float32)`` (the same float64 operations in the
+        same order), from one row and one column instead of an (H, W, 3) array (~10x less CPU)."""
+        fx, fy, cx, cy = self.K[0, 0], self.K[1, 1], self.K[0, 2], self.K[1, 2]
+        x = (np.arange(self.width, dtype=np.float64) - cx) / fx
+        y = (np.arange(self.height, dtype=np.float64) - cy) / fy
+        return np.sqrt(x * x + (y * y)[:, None] + 1.0).astype(np.float32)
+
 
 @dataclass
 class Camera:

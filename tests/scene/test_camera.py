@@ -39,3 +39,20 @@ def test_keypoint_must_be_rigid():
     pose = hg.look_at([1, 2, 3], [0, 0, 0])
     cam.add_keypoint(pose)
     np.testing.assert_allclose(cam.world2cam(0) @ pose, np.eye(4), atol=1e-12)
+
+
+def test_pixel_ray_lengths_are_the_norms_of_pixel_rays_bit_for_bit():
+    """The raster view's per-pixel ray lengths (distance = depth x length) from one row and one column equal the
+    float32 norms of the (H, W, 3) rays exactly, for odd sizes and principal points off and outside the image."""
+    rng = np.random.default_rng(7)
+    for _ in range(12):
+        width, height = int(rng.integers(1, 700)), int(rng.integers(1, 500))
+        K = np.array([[rng.uniform(40, 3000), 0, rng.uniform(-60, width + 60)],
+                      [0, rng.uniform(40, 3000), rng.uniform(-60, height + 60)], [0, 0, 1]])
+        intr = hg.Intrinsics(K, width, height)
+        expected = np.linalg.norm(intr.pixel_rays(), axis=-1).astype(np.float32)
+        lengths = intr.pixel_ray_lengths()
+        assert lengths.dtype == np.float32 and lengths.shape == (height, width)
+        assert np.array_equal(lengths.view(np.uint32), expected.view(np.uint32))
+    corner = hg.Intrinsics(np.array([[2.0, 0, 0.0], [0, 4.0, 0.0], [0, 0, 1]]), 3, 2).pixel_ray_lengths()
+    assert corner[1, 2] == np.float32(np.sqrt(1 + 1 + 1 / 16))  # pixel (u 2, v 1): (1, 0.25, 1)
