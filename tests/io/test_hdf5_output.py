@@ -193,3 +193,21 @@ def test_writes_block_while_the_writer_is_behind(tmp_path, monkeypatch):
     with h5py.File(tmp_path / "x.hdf5") as f:
         np.testing.assert_array_equal(f["depth"][3], _depth(3))
 
+
+
+@pytest.mark.parametrize("dtype", ["<f4", ">f4", "<f8", "<u2", ">i2", "<c8", "<c16"])
+def test_shuffled_bytes_are_hdf5s_shuffle_filter_output(tmp_path, dtype):
+    """The writer deflates ``shuffled(chunk)`` itself: its bytes must be what HDF5's shuffle filter makes of the
+    chunk (read back unfiltered from a file HDF5 shuffled), for the word sizes of the fast path (2, 4, 8 bytes)
+    and the strided fallback (16), in either byte order."""
+    from hybridgen.io.hdf5_single import shuffled
+
+    rng = np.random.default_rng(7)
+    values = rng.normal(0, 1e3, size=(1, 37, 29)) * (1 + 1j if dtype[1] == "c" else 1)
+    array = values.astype(dtype)
+    with h5py.File(tmp_path / "s.hdf5", "w") as f:
+        dset = f.create_dataset("x", data=array, chunks=array.shape, shuffle=True)
+        mask, stored = dset.id.read_direct_chunk((0, 0, 0))
+    assert mask == 0 and len(stored) == array.nbytes
+    assert shuffled(array[0]).tobytes() == stored
+    assert bytes(shuffled(array[0])) != array.tobytes()  # the filter did reorder them
