@@ -10,7 +10,9 @@ layer (io, run, physics) can use it.
 from __future__ import annotations
 
 import os
+import tempfile
 from pathlib import Path
+from typing import BinaryIO, Callable
 
 CACHE_ENV = "HYBRIDGEN_CACHE_DIR"
 OFF_VALUES = ("off", "0", "none")
@@ -29,3 +31,21 @@ def cache_path(name: str) -> Path | None:
     if os.environ.get(CACHE_ENV, "").lower() in OFF_VALUES:
         return None
     return cache_root() / name
+
+
+def write_entry(entry: Path, write: Callable[[BinaryIO], None]) -> None:
+    """Store a cache entry: ``write`` fills a new private temporary file beside ``entry``, which is then renamed
+    to it (atomic: a reader sees the old entry or the whole new one). A cache that cannot be written is
+    silently skipped (the caller computed the value anyway)."""
+    try:
+        entry.parent.mkdir(parents=True, exist_ok=True)
+        handle, temp = tempfile.mkstemp(dir=entry.parent, prefix=f".{entry.name}.", suffix=".tmp")
+        try:
+            with os.fdopen(handle, "wb") as out:
+                write(out)
+            os.replace(temp, entry)
+        except BaseException:
+            Path(temp).unlink(missing_ok=True)
+            raise
+    except OSError:
+        pass

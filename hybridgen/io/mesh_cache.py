@@ -20,9 +20,7 @@ Entries are pickles: the cache folder must be writable only by its user (as any 
 from __future__ import annotations
 
 import hashlib
-import os
 import pickle
-import tempfile
 from functools import cache
 from pathlib import Path
 from typing import Any, Callable
@@ -30,7 +28,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .._version import __version__
-from .cache_folder import cache_path
+from .cache_folder import cache_path, write_entry
 from .file_identity import content_sha256
 from .mesh_references import check_references, referenced_files
 
@@ -150,15 +148,4 @@ def _read(entry: Path) -> dict[str, Any] | None:
 
 def _write(entry: Path, value: dict[str, Any]) -> None:
     """Store ``value`` under ``entry`` atomically; a cache that cannot be written is silently skipped."""
-    try:
-        entry.parent.mkdir(parents=True, exist_ok=True)
-        handle, temp = tempfile.mkstemp(dir=entry.parent, prefix=f".{entry.name}.", suffix=".tmp")
-        try:
-            with os.fdopen(handle, "wb") as out:
-                pickle.dump(value, out, protocol=pickle.HIGHEST_PROTOCOL)
-            os.replace(temp, entry)
-        except BaseException:
-            Path(temp).unlink(missing_ok=True)
-            raise
-    except OSError:
-        pass
+    write_entry(entry, lambda out: pickle.dump(value, out, protocol=pickle.HIGHEST_PROTOCOL))

@@ -17,8 +17,6 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import os
-import tempfile
 import threading
 import zipfile
 from collections import OrderedDict
@@ -27,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.cache_folder import cache_path
+from ..io.cache_folder import cache_path, write_entry
 from . import triangle_clusters
 from .triangle_clusters import MIN_TRIANGLES, TriangleClusters, build_clusters
 
@@ -104,15 +102,4 @@ def _read(entry: Path) -> TriangleClusters | None:
 
 def _write(entry: Path, clusters: TriangleClusters) -> None:
     """Store ``clusters`` under ``entry`` atomically; a cache that cannot be written is silently skipped."""
-    try:
-        entry.parent.mkdir(parents=True, exist_ok=True)
-        handle, temp = tempfile.mkstemp(dir=entry.parent, prefix=f".{entry.name}.", suffix=".tmp")
-        try:
-            with os.fdopen(handle, "wb") as out:
-                np.savez(out, **{name: getattr(clusters, name) for name in _FIELDS})
-            os.replace(temp, entry)
-        except BaseException:
-            Path(temp).unlink(missing_ok=True)
-            raise
-    except OSError:
-        pass
+    write_entry(entry, lambda out: np.savez(out, **{name: getattr(clusters, name) for name in _FIELDS}))

@@ -109,3 +109,13 @@ def test_flat_mesh_corner_vertices_give_the_same_clusters():
     order = faces.ravel()  # what RasterView uploads for a mesh without vertex normals
     corners = build_clusters(vertices[order], np.arange(len(order)).reshape(-1, 3))
     _same(corners, build_clusters(vertices, faces))
+
+
+def test_a_cache_that_cannot_be_written_is_skipped(tmp_path, monkeypatch):
+    (tmp_path / "cache").write_text("a file where the cache folder would be")
+    monkeypatch.setenv("HYBRIDGEN_CACHE_DIR", str(tmp_path / "cache"))
+    cluster_cache.clear_memo()
+    vertices, faces = _grid(50)
+    _same(mesh_clusters(vertices, faces), build_clusters(vertices, faces))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cache"]
+    cluster_cache.clear_memo()
