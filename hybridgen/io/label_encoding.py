@@ -39,8 +39,7 @@ def ray_lengths(K: np.ndarray, width: int, height: int) -> np.ndarray:
     """(H, W) float32 |((u - cx) / fx, (v - cy) / fy, 1)| per pixel centre (the renderer's own arithmetic)."""
     from ..scene.camera import Intrinsics
 
-    rays = Intrinsics(np.asarray(K, dtype=np.float64), width, height).pixel_rays()
-    return np.linalg.norm(rays, axis=-1).astype(np.float32)
+    return Intrinsics(np.asarray(K, dtype=np.float64), width, height).pixel_ray_lengths()
 
 
 def distance_from_depth(depth: np.ndarray, K: np.ndarray, background: float) -> np.ndarray:
