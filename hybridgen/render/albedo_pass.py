@@ -14,6 +14,7 @@ import numpy as np
 
 from ..scene.camera import Intrinsics
 from ..scene.mesh_object import MeshObject
+from .gl_context import compile_program
 from .material_textures import alpha_coverage
 from .projection import projection_from_K
 from .raster import RasterView
@@ -53,8 +54,8 @@ class AlbedoPass:
     def __init__(self, view: RasterView) -> None:
         self.view = view
         ctx = view.ctx
-        self.program = ctx.program(vertex_shader=shader_source("albedo.vert"),
-                                   fragment_shader=shader_source("albedo.frag"))
+        self.program = compile_program(ctx, vertex_shader=shader_source("albedo.vert"),
+                                       fragment_shader=shader_source("albedo.frag"))
         self._draws: list[tuple[Any, Any, Any, MeshObject]] = []
         self._resources: list[Any] = []
         for gpu, obj in zip(view.gpu_objects, view.scene.objects):

@@ -10,6 +10,7 @@ import os
 import threading
 from typing import Any
 
+from .. import stop_request
 from ..errors import SystemSetupError
 
 MIN_GL_VERSION = 430
@@ -76,7 +77,8 @@ def create_context(device_index: int | None = None) -> Any:
 
     index = egl_device_index(device_index)
     try:
-        ctx = moderngl.create_standalone_context(backend="egl", device_index=index)
+        with stop_request.deferred():  # moderngl parses the context's settings through Python callbacks
+            ctx = moderngl.create_standalone_context(backend="egl", device_index=index)
     except Exception as exc:  # glcontext raises plain Exceptions with EGL codes
         raise SystemSetupError(f"cannot create an EGL OpenGL context on device {index} ({exc}); {_FIX}") from exc
     if ctx.version_code < MIN_GL_VERSION:
@@ -85,6 +87,15 @@ def create_context(device_index: int | None = None) -> Any:
         raise SystemSetupError(f"OpenGL {version // 100}.{version % 100 // 10} found, hybridgen needs 4.3 "
                                "(storage buffers); update Mesa (libgl1-mesa-dri)")
     return ctx
+
+
+def compile_program(ctx: Any, **shaders: str) -> Any:
+    """``ctx.program(**shaders)`` that a stop request (SIGTERM, SIGINT) cannot interrupt: moderngl builds the
+    program's uniforms and attributes by calling back into Python and uses the results unchecked, so an
+    exception raised there by a signal handler crashed the process (SIGSEGV) instead of stopping it. The
+    request is raised when the program is made (:func:`hybridgen.stop_request.deferred`)."""
+    with stop_request.deferred():
+        return ctx.program(**shaders)
 
 
 def shared_context(device_index: int | None = None) -> Any:

@@ -23,7 +23,7 @@ from ..scene.scene import Scene
 from .alpha_cutout import Cutout, set_cutout_uniforms, upload_cutout
 from .framebuffer_ring import FramebufferRing, Shape
 from .gl_calls import gl_calls
-from .gl_context import shared_context
+from .gl_context import compile_program, shared_context
 from .label_targets import LabelTargets
 from .shared_geometry import geometry_key
 from .raster_passes import RASTER_PASSES
@@ -123,7 +123,7 @@ class RasterView:
             vertex, fragment = (text.replace("\n", "\n#define ALPHA_CUTOUT\n", 1) for text in (vertex, fragment))
         if targets is not None:
             fragment = fragment.replace("\n", f"\n{targets.defines()}\n", 1)
-        return self.ctx.program(vertex_shader=vertex, fragment_shader=fragment)
+        return compile_program(self.ctx, vertex_shader=vertex, fragment_shader=fragment)
 
     def _programs(self) -> list[Any]:
         return [p for p in (self.program, self._cutout_program, *self._packed_programs.values()) if p is not None]

@@ -31,15 +31,23 @@ def _terminate(signum: int, frame: FrameType | None) -> None:
     stop_request.request_stop(EXIT_SIGTERM)  # recorded too: a SystemExit raised inside a finalizer is lost
 
 
+def _interrupt(signum: int, frame: FrameType | None) -> None:
+    stop_request.request_stop(EXIT_SIGINT)  # KeyboardInterrupt, as Python's handler, but deferrable
+
+
 @contextmanager
 def stop_on_signals() -> Iterator[None]:
-    """In the main thread: SIGTERM raises ``SystemExit(143)`` for the block, and again at the next keypoint
-    if the first one was swallowed (:mod:`hybridgen.stop_request`); on any interruption this process's
-    temporary files are deleted. Elsewhere (threads) nothing is installed."""
+    """In the main thread: SIGTERM raises ``SystemExit(143)`` and SIGINT ``KeyboardInterrupt`` for the block,
+    again at the next keypoint if the first one was swallowed, and only after a :func:`hybridgen.stop_request.deferred`
+    block ends (:mod:`hybridgen.stop_request`); on any interruption this process's temporary files are deleted.
+    Elsewhere (threads) nothing is installed."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     previous = signal.signal(signal.SIGTERM, _terminate)
+    previous_int = signal.getsignal(signal.SIGINT)
+    if previous_int is signal.default_int_handler:  # an ignored SIGINT (nohup, a parent's choice) stays ignored
+        signal.signal(signal.SIGINT, _interrupt)
     stop_request.clear()
     _ACTIVE.append(True)
     try:
@@ -50,6 +58,8 @@ def stop_on_signals() -> Iterator[None]:
     finally:
         _ACTIVE.pop()
         signal.signal(signal.SIGTERM, previous)
+        if previous_int is signal.default_int_handler:
+            signal.signal(signal.SIGINT, previous_int)
         stop_request.clear()
 
 

@@ -94,3 +94,65 @@ def test_without_a_request_the_run_finishes():
         assert run_keypoints(_scene(3), [sink], [_Counter()]) == 3
     assert sink.written == [0, 1, 2] and sink.ended
     assert [float(f["value"][0]) for f in sink.frames] == [0.0, 1.0, 2.0]
+
+
+SIGNAL_IN_PROGRAM_CALLBACK = """
+import os, signal, sys
+import _moderngl
+import hybridgen as hg
+from hybridgen.run.signals import stop_on_signals
+
+original = _moderngl.make_attribute
+
+
+def make_attribute(*args):  # moderngl's C code calls this while it makes a program, and uses the result unchecked
+    os.kill(os.getpid(), getattr(signal, sys.argv[1]))  # the handler runs at the next bytecode: in this callback
+    return original(*args)
+
+
+_moderngl.make_attribute = make_attribute
+scene = hg.Scene()
+scene.add(hg.make_primitive("sphere", 1.0, name="ball", category_id=1))
+scene.camera.intrinsics = hg.Intrinsics.from_fov(0.8, 16, 12)
+scene.camera.add_keypoint(hg.look_at([0.0, -4.0, 1.0], [0.0, 0.0, 0.0]))
+with stop_on_signals():
+    hg.render_labels(scene, [hg.MemorySink()], hg.LabelRequest(depth=True))
+    print("not stopped", flush=True)
+"""
+
+
+@pytest.mark.parametrize("signame,status", [("SIGTERM", 143), ("SIGINT", -signal.SIGINT)])
+def test_signal_while_moderngl_makes_a_program_stops_the_run_instead_of_crashing(gl_context, signame, status):
+    """A SystemExit/KeyboardInterrupt raised inside moderngl's callback crashed the process with SIGSEGV (exit
+    -11; measured in about 1 of 15 SIGTERMed runs); the request now waits for the program to be made. Python
+    ends an uncaught KeyboardInterrupt by dying of SIGINT."""
+    import subprocess
+    import sys
+
+    from tests.conftest import REPO
+
+    result = subprocess.run([sys.executable, "-c", SIGNAL_IN_PROGRAM_CALLBACK, signame], cwd=REPO,
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == status, result.stderr[-2000:]
+    assert "not stopped" not in result.stdout
+
+
+def test_a_request_inside_a_deferred_block_is_raised_when_the_block_ends():
+    import os
+
+    reached = []
+    with pytest.raises(SystemExit) as stopped:
+        with signals.stop_on_signals():
+            with stop_request.deferred():
+                with stop_request.deferred():
+                    os.kill(os.getpid(), signal.SIGTERM)
+                    reached.append("inner")  # the handler has run (between bytecodes) and only recorded
+                reached.append("outer")
+            reached.append("after")
+    assert stopped.value.code == signals.EXIT_SIGTERM and reached == ["inner", "outer"]
+    with pytest.raises(KeyboardInterrupt):
+        with signals.stop_on_signals():
+            with stop_request.deferred():
+                os.kill(os.getpid(), signal.SIGINT)
+                reached.append("interrupted")
+    assert reached[-1] == "interrupted"
