@@ -169,6 +169,28 @@ class PixelTracer:
         table = pixel_filter.inverse_cdf_table(filter_width)
         # offsets from the pixel's corner (the centre is at +0.5), as the sample warp's lookup table
         self._filter_table = mi.Float((table + 0.5).astype(np.float32))
+        self._world_radiance: Any = None  # hybridgen/render/world_guide.py, found on the first guide_world()
+        self.world_guide: Any = None  # the guide of the last guide_world() (None: the world is not light-sampled)
+
+    def guide_world(self) -> None:
+        """Learns, for the sensor's current pose, where an enclosed constant world is seen from
+        (:mod:`hybridgen.render.world_guide`, off unless ``world_guide.ENABLED``) and hands it to the
+        integrator; nothing for integrators without the hook (Mitsuba's own) or scenes whose world is
+        light-sampled already or open."""
+        from . import world_guide
+
+        if not hasattr(self.integrator, "world_guide"):
+            return
+        if not world_guide.ENABLED:
+            self.world_guide = self.integrator.world_guide = None
+            return
+        if self._world_radiance is None:
+            self._world_radiance = world_guide.constant_world_radiance(self.mi_scene) or False
+        guide = world_guide.learn(self.mi_scene, self.sensor) if self._world_radiance else None
+        if guide is not None and guide.open_fraction >= world_guide.MAX_OPEN_FRACTION:
+            guide = None
+        self.world_guide = guide
+        self.integrator.world_guide = None if guide is None else world_guide.JitGuide.of(guide, self._world_radiance)
 
     def trace(self, pixels: np.ndarray, spp: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
         """Sums of linear RGB over the first and the second half of ``spp`` samples of every pixel in
@@ -280,6 +302,8 @@ def launch_counts(spp: int, sampler: str) -> list[int]:
 def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """Linear RGB (float32 H x W x 3) and samples per pixel (uint32 H x W) of one keypoint."""
     h, w = tracer.height, tracer.width
+    if isinstance(tracer, PixelTracer):
+        tracer.guide_world()
     sum_a, sum_b = np.zeros((h * w, 3)), np.zeros((h * w, 3))
     count = np.zeros(h * w, dtype=np.uint32)
     active = np.arange(h * w)

@@ -46,7 +46,7 @@ from __future__ import annotations
 from functools import lru_cache
 from typing import Any
 
-from . import glossy_filter, transparent_shadows
+from . import glossy_filter, transparent_shadows, world_guide
 
 PLUGIN_NAME = "hybridgen_clamped_path"
 SINGULAR_ROUGHNESS = 2e-10 ** 0.25
@@ -85,6 +85,8 @@ def register(variant: str) -> None:
             self.filter_glossy = float(props.get("filter_glossy", 0.0))  # Cycles' blur_glossy (render/glossy_filter.py)
             # hybridgen/render/camera_hidden_emission.py: emitters the camera sees as their BSDF (set after load)
             self.hidden_shapes: list[Any] = []
+            # hybridgen/render/world_guide.py: light samples of an enclosed constant world (set per keypoint)
+            self.world_guide: Any = None  # world_guide.JitGuide
 
         def _camera_hidden(self, si: Any) -> Any:
             """True where ``si`` lies on one of :attr:`hidden_shapes`."""
@@ -134,6 +136,9 @@ def register(variant: str) -> None:
             last_segment = mi.Bool(False)  # a lobe limit was exceeded: collect emission, then stop
             filter_glossy = self.filter_glossy
             min_ray_pdf = mi.Float(dr.inf)  # smallest BSDF-sampling pdf of the path so far (filter glossy)
+            guide = self.world_guide if not transparent else None
+            world_radiance = guide.radiance if guide is not None else None
+            guided_prev = mi.Bool(False)  # the previous vertex took a guided world sample (MIS for world hits)
 
             while dr.hint(active, max_iterations=-1, label="hybridgen clamped path"):
                 si = scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=depth == 0, active=active)
@@ -144,6 +149,9 @@ def register(variant: str) -> None:
                 # Emission found by the previous BSDF sample (or seen directly), MIS-weighted against NEE.
                 ds = mi.DirectionSample3f(scene, si=si, ref=si_prev)
                 em_pdf = scene.pdf_emitter_direction(si_prev, ds, ~bsdf_delta_prev)
+                if guide is not None:  # a world hit: the previous vertex's guided world sample could find it too
+                    em_pdf = dr.select(guided_prev & ~si.is_valid(),
+                                       world_guide.pdf(guide, si_prev.p, ray.d, active), em_pdf)
                 mis_bsdf = dr.select(depth == 0, 1.0, mis_weight(bsdf_pdf_prev, em_pdf))
                 emitted = throughput * mis_bsdf * ds.emitter.eval(si, active)
                 if has_hidden:  # camera rays see such an emitter's BSDF only, other rays its emission only
@@ -169,6 +177,16 @@ def register(variant: str) -> None:
                 mis_em = dr.select(ds_em.delta, 1.0, mis_weight(ds_em.pdf, bsdf_pdf))
                 lit = dr.select(active_em, throughput * bsdf_val * em_weight * mis_em, 0.0)
                 radiance += self._clamped(lit, depth >= 1)
+                if guide is not None:  # one more light sample: the world, in directions learned for this place
+                    active_world = active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth) & ~singular
+                    d_world, pdf_world = world_guide.sample(guide, si.p, sampler.next_1d(), sampler.next_2d(),
+                                                            active_world)
+                    active_world &= ~scene.ray_test(si.spawn_ray(d_world), active_world)
+                    val_world, pdf_bsdf_world = bsdf.eval_pdf(bsdf_ctx, si, si.to_local(d_world), active_world)
+                    sky = throughput * val_world * world_radiance * \
+                        (mis_weight(pdf_world, pdf_bsdf_world) / dr.maximum(pdf_world, 1e-20))
+                    radiance += self._clamped(dr.select(active_world, sky, 0.0), depth >= 1)
+                    guided_prev = mi.Bool(active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth) & ~singular)
 
                 # BSDF sampling: the next segment.
                 bsdf_sample, bsdf_weight = bsdf.sample(bsdf_ctx, si, sampler.next_1d(), sampler.next_2d(),
