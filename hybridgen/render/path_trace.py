@@ -54,6 +54,17 @@ guides and denoising in the process, loaded 2-core machine, 2 runs each), thresh
 adds at most 0.14 dB more."""
 
 
+SERIAL_SCENE_LOAD = True
+"""Mitsuba loads the scene dictionary on one thread. Its parallel loader (the default) instantiates the scene's
+objects on several threads, and the order they finish in decides, e.g., which index the environment emitter gets
+- a literal in the traced path kernels (the IR of two runs of the tabletop of tools/color_quality.py differed in
+exactly that: 1 or 2). A kernel that differs misses Dr.Jit's kernel cache, so warm runs compiled the path kernels
+again (~0.5 s of CPU each): with 16 and 20 processes of that scene in one cache, a second variant appeared after 2
+and 7 runs with the parallel loader, none in 20 serial ones (with the aligned mesh buffers of
+:func:`hybridgen.render.mitsuba_scene.jit_buffer`). hybridgen hands Mitsuba built meshes and BSDFs, so there is
+little left to parallelise; the image bytes are the same either way."""
+
+
 @dataclass(frozen=True)
 class PathTraceSettings:
     """Integrator and sampling settings in BlenderProc's (Cycles') terms.
@@ -226,8 +237,8 @@ class PathTraceView:
             hidden_emission=bool(hidden))
         first = scene.camera.keypoints[0] if scene.camera.keypoints else np.eye(4)
         description["sensor"] = sensor_dict(self.intrinsics, first, self.variant, scene.camera.depth_of_field)
-        try:
-            self.mi_scene = mi.load_dict(description)
+        try:  # serially: see SERIAL_SCENE_LOAD
+            self.mi_scene = mi.load_dict(description, parallel=not SERIAL_SCENE_LOAD)
         except RuntimeError as exc:
             raise InputError(f"Mitsuba could not build the scene: {str(exc).splitlines()[-1]}") from None
         self.sensor = self.mi_scene.sensors()[0]
