@@ -107,9 +107,8 @@ def jit_buffer(array: Any, dtype: Any) -> np.ndarray:
     from process to process - the IR of two runs differed in one mesh's texcoord gather, a packet load of the
     pair in one and two scalar gathers in the other - and a varied kernel misses Dr.Jit's kernel cache: on the
     tabletop of tools/color_quality.py 3 of 8 warm runs compiled the three path kernels again (~1.5 s of CPU
-    each time). With aligned buffers: 0 of 8; across the four scenes about 1 warm run in 30 still met a second
-    variant of the tabletop's kernels (its source is not found; aligning the texture bitmaps did not remove it).
-    The image bytes are the same either way."""
+    each time). With aligned buffers: 0 of 8. (The other cause of such misses was Mitsuba's parallel scene
+    loader: :data:`hybridgen.render.path_trace.SERIAL_SCENE_LOAD`.) The image bytes are the same either way."""
     flat = np.asarray(array, dtype=dtype).reshape(-1)
     raw = np.empty(flat.size + JIT_ALIGNMENT // flat.itemsize, dtype=dtype)
     start = (-raw.ctypes.data % JIT_ALIGNMENT) // flat.itemsize
