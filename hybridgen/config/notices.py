@@ -9,7 +9,8 @@ variable ``HYBRIDGEN_STRICT=1`` that it sets for worker processes) every notice 
 from __future__ import annotations
 
 import os
-from typing import Callable
+from contextlib import contextmanager
+from typing import Any, Callable, Iterator
 
 from ..errors import ConfigError
 from ..logs import log_line
@@ -17,6 +18,7 @@ from ..logs import log_line
 STRICT_ENV = "HYBRIDGEN_STRICT"
 _seen: set[str] = set()
 _sink: Callable[[str], None] | None = None
+_recorders: list[list[dict[str, Any]]] = []
 
 
 def set_strict(strict: bool) -> None:
@@ -41,6 +43,8 @@ def set_sink(sink: Callable[[str], None] | None) -> None:
 def notice(message: str, *, file: str | None = None, module: str | None = None, index: int | None = None,
            key: str | None = None) -> None:
     """Report one difference: a line on stderr (once per process), or a ConfigError in strict mode."""
+    for recorded in _recorders:
+        recorded.append({"message": message, "file": file, "module": module, "index": index, "key": key})
     error = ConfigError(message, file=file, module=module, index=index, key=key)
     if is_strict():
         raise ConfigError(f"{message} (an error because of --strict)", file=file, module=module, index=index,
@@ -52,3 +56,16 @@ def notice(message: str, *, file: str | None = None, module: str | None = None, 
     if line not in _seen:
         _seen.add(line)
         log_line(str(error), "notice")  # the CLI prints "hybridgen: notice: ..."
+
+
+@contextmanager
+def recording_notices() -> Iterator[list[dict[str, Any]]]:
+    """Within the block, every notice is also recorded (as :func:`notice`'s arguments) in the list the block
+    gets, before strict mode turns it into an error: work that is cached (a parsed mesh) keeps the notices it
+    issued and gives them again, with :func:`notice`, when its result is read back."""
+    recorded: list[dict[str, Any]] = []
+    _recorders.append(recorded)
+    try:
+        yield recorded
+    finally:
+        _recorders.remove(recorded)

@@ -28,11 +28,12 @@ from typing import Any, Callable
 import numpy as np
 
 from .._version import __version__
+from ..config.notices import notice, recording_notices
 from .cache_folder import cache_path, write_entry
 from .file_identity import content_sha256
 from .mesh_references import check_references, referenced_files
 
-_FORMAT = 2
+_FORMAT = 3
 """Bumped when what an entry holds changes (2: notices of missing MTL/texture files are never stored)."""
 
 
@@ -101,9 +102,11 @@ def load_objects_cached(path: str | Path, *, name: str | None = None, category_i
     base = np.eye(4) if base is None else base
     entry = folder / f"{cache_key(file, {'name': name, 'up_axis': str(up_axis)})}.pickle"
     cached = _read(entry)
+    hit = cached is not None
     if cached is None:
         notices: list[str] = []
-        objects = load_objects(file, name=name, up_axis=up_axis, notify=notices.append)
+        with recording_notices() as issued:  # e.g. repaired vertex normals: given again on every hit
+            objects = load_objects(file, name=name, up_axis=up_axis, notify=notices.append)
         if not all(_exact_under_any_pose(obj.local2world) for obj in objects):  # e.g. glTF node transforms
             for line in notices:
                 if notify is not None:
@@ -112,11 +115,13 @@ def load_objects_cached(path: str | Path, *, name: str | None = None, category_i
                                 up_axis=up_axis, attributes=attributes)
         for obj in objects:  # what the label pass asks of every object, computed once
             _ = obj.face_normals, obj.is_closed
-        cached = {"objects": objects, "notices": notices}
+        cached = {"objects": objects, "notices": notices, "issued": issued}
         _write(entry, cached)
     for line in cached["notices"]:
         if notify is not None:
             notify(line)
+    for issued_notice in cached["issued"] if hit else ():  # a miss has issued them already
+        notice(**issued_notice)
     objects = cached["objects"]
     for obj in objects:
         obj.local2world = base @ obj.local2world  # exact: a signed permutation (see _exact_under_any_pose)
@@ -143,7 +148,7 @@ def _read(entry: Path) -> dict[str, Any] | None:
             value = pickle.load(handle)
     except (OSError, EOFError, pickle.UnpicklingError, AttributeError, ImportError, TypeError, ValueError):
         return None
-    return value if isinstance(value, dict) and "objects" in value else None
+    return value if isinstance(value, dict) and "objects" in value and "issued" in value else None
 
 
 def _write(entry: Path, value: dict[str, Any]) -> None:

@@ -159,3 +159,24 @@ def test_run_writes_the_same_bytes_cold_and_warm(gl_context, cache, tmp_path, ru
         digests.append(hashlib.sha256((tmp_path / "out/data.hdf5").read_bytes()).hexdigest())
         assert len(list(cache.glob("*.pickle"))) == 1
     assert digests[0] == digests[1]
+
+
+def test_notices_of_the_parse_are_given_again_on_every_hit(cache, tmp_path, monkeypatch):
+    """A vertex normal of zero length is repaired with a notice when the file is parsed; a hit (no parse) gives
+    the same notice, and under --strict the same error, as a fresh parse does."""
+    mesh = tmp_path / "zero.obj"
+    mesh.write_text("v 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 -1\nvn 0 0 0\nvn 0.57735 0.57735 0.57735\n"
+                    "f 1//1 2//2 3//2\nf 1//1 4//2 2//2\n")
+    lines: list[str] = []
+    notices.set_sink(lines.append)
+    try:
+        for count in (1, 2, 3):  # a miss, then two hits
+            _same(load_objects(mesh), hg.load_objects(mesh))
+            assert sum("1 zero-length vertex normal(s) recomputed" in line for line in lines) == 2 * count
+        assert len(list(cache.glob("*.pickle"))) == 1
+        notices.set_strict(True)
+        with pytest.raises(hg.ConfigError, match="zero-length vertex normal.*--strict"):
+            hg.load_objects(mesh)  # a hit
+    finally:
+        notices.set_strict(False)
+        notices.set_sink(None)
