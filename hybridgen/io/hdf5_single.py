@@ -49,10 +49,17 @@ def deflate(data: Any, level: int) -> bytes:
     (measured: 2 of 320 compressions of one 192-byte segmap by 8 threads at once; 0 of 480 under the lock;
     it made resumed runs differ from direct ones at random). One ISA-L call at a time (~400 MB/s
     on one core here) still outpaces the label pass; the compressor threads overlap everything else."""
-    if 1 <= level <= 3 and _isal is not None:
+    if 1 <= level <= 3 and _isal is not None and memoryview(data).nbytes >= ISAL_MIN_BYTES:
         with _ISAL_LOCK:
             return _isal.compress(data, level)
     return zlib.compress(data, level)
+
+
+ISAL_MIN_BYTES = 16384
+"""Smaller inputs are deflated by zlib: ISA-L gave other (valid) streams for the same small input even under the
+lock - the 192-byte id maps of a 16x12 test run compressed to 42 or 43 bytes from run to run in one long process
+under load (session 6: resumed and direct files differed by a few bytes, about 1 run in 5-20) - and zlib costs
+nothing at these sizes. Every image of 128x128 pixels or more still goes through ISA-L."""
 
 
 _ISAL_LOCK = threading.Lock()
