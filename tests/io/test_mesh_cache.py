@@ -45,6 +45,15 @@ def cache(tmp_path, monkeypatch):
     return folder / "meshes"
 
 
+@pytest.fixture
+def notice_lines():
+    """The notice lines given while the test runs (instead of stderr)."""
+    lines: list[str] = []
+    notices.set_sink(lines.append)
+    yield lines
+    notices.set_sink(None)
+
+
 @pytest.mark.parametrize("up_axis", ["auto", "Z"])
 def test_hit_equals_a_fresh_parse(cache, tmp_path, up_axis):
     mesh = tmp_path / "knot.obj"
@@ -112,25 +121,20 @@ def test_the_python_apis_warm_load_does_not_import_trimesh(cache, tmp_path):
     _same(fresh, warm)
 
 
-def test_missing_texture_is_the_loaders_error_or_notice_every_time(cache, tmp_path, monkeypatch):
+def test_missing_texture_is_the_loaders_error_or_notice_every_time(cache, tmp_path, monkeypatch, notice_lines):
     """A file whose MTL names a missing texture is never cached: without --lenient every load raises the
     loader's error, with it every load gives the loader's notice (a hit would give neither)."""
     (tmp_path / "skin.mtl").write_text("newmtl skin\nKd 1 1 1\nmap_Kd skin.png\n")
     mesh = tmp_path / "thing.obj"
     mesh.write_text("mtllib skin.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl skin\n"
                     "f 1/1 2/2 3/3\n")
-    lines: list[str] = []
-    notices.set_sink(lines.append)
-    try:
-        for _ in range(2):
-            with pytest.raises(hg.InputError, match=r"missing file\(s\) it names: '.*skin.png'"):
-                hg.load_objects(mesh)
-        monkeypatch.setenv(LENIENT_ENV, "1")
-        for count in (1, 2):
-            _same(load_objects(mesh), hg.load_objects(mesh))
-            assert sum("skin.png" in line for line in lines) == 2 * count  # the fresh parse's and the API's
-    finally:
-        notices.set_sink(None)
+    for _ in range(2):
+        with pytest.raises(hg.InputError, match=r"missing file\(s\) it names: '.*skin.png'"):
+            hg.load_objects(mesh)
+    monkeypatch.setenv(LENIENT_ENV, "1")
+    for count in (1, 2):
+        _same(load_objects(mesh), hg.load_objects(mesh))
+        assert sum("skin.png" in line for line in notice_lines) == 2 * count  # the fresh parse's and the API's
     assert not cache.exists() or not list(cache.glob("*.pickle"))
 
 
@@ -161,22 +165,19 @@ def test_run_writes_the_same_bytes_cold_and_warm(gl_context, cache, tmp_path, ru
     assert digests[0] == digests[1]
 
 
-def test_notices_of_the_parse_are_given_again_on_every_hit(cache, tmp_path, monkeypatch):
+def test_notices_of_the_parse_are_given_again_on_every_hit(cache, tmp_path, notice_lines):
     """A vertex normal of zero length is repaired with a notice when the file is parsed; a hit (no parse) gives
     the same notice, and under --strict the same error, as a fresh parse does."""
     mesh = tmp_path / "zero.obj"
     mesh.write_text("v 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 -1\nvn 0 0 0\nvn 0.57735 0.57735 0.57735\n"
                     "f 1//1 2//2 3//2\nf 1//1 4//2 2//2\n")
-    lines: list[str] = []
-    notices.set_sink(lines.append)
+    for count in (1, 2, 3):  # a miss, then two hits
+        _same(load_objects(mesh), hg.load_objects(mesh))
+        assert sum("1 zero-length vertex normal(s) recomputed" in line for line in notice_lines) == 2 * count
+    assert len(list(cache.glob("*.pickle"))) == 1
+    notices.set_strict(True)
     try:
-        for count in (1, 2, 3):  # a miss, then two hits
-            _same(load_objects(mesh), hg.load_objects(mesh))
-            assert sum("1 zero-length vertex normal(s) recomputed" in line for line in lines) == 2 * count
-        assert len(list(cache.glob("*.pickle"))) == 1
-        notices.set_strict(True)
         with pytest.raises(hg.ConfigError, match="zero-length vertex normal.*--strict"):
             hg.load_objects(mesh)  # a hit
     finally:
         notices.set_strict(False)
-        notices.set_sink(None)
