@@ -3,7 +3,7 @@ with the setup message rather than pass silently."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Iterator
 
 import numpy as np
 import pytest
@@ -34,6 +34,17 @@ def run_cli(capsys: pytest.CaptureFixture[str]) -> Callable[..., tuple[int, str,
         return code, out.out, out.err
 
     return run
+
+
+@pytest.fixture
+def notice_lines() -> Iterator[list[str]]:
+    """The notice lines (hybridgen.config.notices) given while the test runs, collected instead of printed."""
+    from hybridgen.config import notices
+
+    lines: list[str] = []
+    notices.set_sink(lines.append)
+    yield lines
+    notices.set_sink(None)
 
 
 @pytest.fixture

@@ -45,15 +45,6 @@ def cache(tmp_path, monkeypatch):
     return folder / "meshes"
 
 
-@pytest.fixture
-def notice_lines():
-    """The notice lines given while the test runs (instead of stderr)."""
-    lines: list[str] = []
-    notices.set_sink(lines.append)
-    yield lines
-    notices.set_sink(None)
-
-
 @pytest.mark.parametrize("up_axis", ["auto", "Z"])
 def test_hit_equals_a_fresh_parse(cache, tmp_path, up_axis):
     mesh = tmp_path / "knot.obj"

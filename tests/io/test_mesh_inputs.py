@@ -5,18 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hybridgen.config import notices
 from hybridgen.errors import InputError
 from hybridgen.io.mesh_loader import load_objects
 from hybridgen.io.mesh_references import LENIENT_ENV
-
-
-@pytest.fixture
-def notice_lines():
-    lines: list[str] = []
-    notices.set_sink(lines.append)
-    yield lines
-    notices.set_sink(None)
 
 
 def test_zero_vertex_normals_are_recomputed_from_faces(tmp_path, notice_lines):
