@@ -52,6 +52,14 @@ PLUGIN_NAME = "hybridgen_clamped_path"
 SINGULAR_ROUGHNESS = 2e-10 ** 0.25
 """Principled roughness (Blender's; alpha = roughness^2) at or below which a lobe is singular, as in Cycles:
 ``alpha_x alpha_y <= BSDF_ROUGHNESS_SQ_THRESH = 2e-10``, i.e. roughness <= 0.00376."""
+LOOP_STATE = ("active", "bsdf_ctx", "bsdf_delta_prev", "bsdf_pdf_prev", "depth", "eta", "filter_glossy", "guide",
+              "guided_prev", "hidden", "last_segment", "max_depth", "max_diffuse", "max_glossy", "max_transmission",
+              "min_ray_pdf", "mis_weight", "n_diffuse", "n_glossy", "n_transmission", "n_transparent", "radiance",
+              "ray", "rr_depth", "sampler", "scene", "self", "si_prev", "throughput", "transparent", "world_radiance")
+"""The path loop's state (``dr.while_loop`` labels), in the order the body takes and returns it. It is the state
+``@dr.syntax`` derived from the former ``while`` loop (every name the loop reads or writes, sorted), so the
+traced kernels - and the Dr.Jit kernel-cache keys - are the ones that loop traced; the explicit loop only saves
+re-parsing this file's source in every process (~0.15 s)."""
 
 
 def is_singular(bsdf: Any, si: Any, active: Any = True) -> Any:
@@ -109,11 +117,10 @@ def register(variant: str) -> None:
             scale = dr.select(indirect & (largest > self.clamp_indirect), self.clamp_indirect / largest, 1.0)
             return contribution * scale
 
-        @dr.syntax
         def sample(self, scene: Any, sampler: Any, ray: Any, medium: Any = None, active: Any = True) -> Any:
-            import drjit as dr  # (dr.syntax re-creates this function without the enclosing scope)
-            import mitsuba as mi
-
+            """Radiance of one path per lane. The bounce loop is an explicit ``dr.while_loop`` (traced once into
+            the kernel); branches on Python values (``filter_glossy > 0``, ``guide is not None`` ...) are plain
+            ifs decided while tracing - there is no branch on a Dr.Jit value, all per-lane choices are masks."""
             mis_weight = self._mis_weight
             transparent = self.transparent_shadows
             has_hidden = len(self.hidden_shapes) > 0
@@ -140,7 +147,13 @@ def register(variant: str) -> None:
             world_radiance = guide.radiance if guide is not None else None
             guided_prev = mi.Bool(False)  # the previous vertex took a guided world sample (MIS for world hits)
 
-            while dr.hint(active, max_iterations=-1, label="hybridgen clamped path"):
+            def bounce(active: Any, bsdf_ctx: Any, bsdf_delta_prev: Any, bsdf_pdf_prev: Any, depth: Any, eta: Any,
+                       filter_glossy: Any, guide: Any, guided_prev: Any, hidden: Any, last_segment: Any,
+                       max_depth: Any, max_diffuse: Any, max_glossy: Any, max_transmission: Any, min_ray_pdf: Any,
+                       mis_weight: Any, n_diffuse: Any, n_glossy: Any, n_transmission: Any, n_transparent: Any,
+                       radiance: Any, ray: Any, rr_depth: Any, sampler: Any, scene: Any, self: Any, si_prev: Any,
+                       throughput: Any, transparent: Any, world_radiance: Any) -> tuple[Any, ...]:
+                """One path vertex. Takes and returns the loop state (:data:`LOOP_STATE`, in that order)."""
                 si = scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=depth == 0, active=active)
                 if filter_glossy > 0:  # roughness floor for the wrapped principled roughness (glossy_filter.py)
                     si.time = glossy_filter.roughness_floor(filter_glossy, min_ray_pdf)
@@ -226,8 +239,20 @@ def register(variant: str) -> None:
                 throughput[rr_active] *= dr.rcp(rr_prob)
                 rr_continue = sampler.next_1d() < rr_prob
                 active = active_next & (~rr_active | rr_continue) & (throughput_max != 0.0)
+                return (active, bsdf_ctx, bsdf_delta_prev, bsdf_pdf_prev, depth, eta, filter_glossy, guide,
+                        guided_prev, hidden, last_segment, max_depth, max_diffuse, max_glossy, max_transmission,
+                        min_ray_pdf, mis_weight, n_diffuse, n_glossy, n_transmission, n_transparent, radiance, ray,
+                        rr_depth, sampler, scene, self, si_prev, throughput, transparent, world_radiance)
 
-            return radiance, mi.Bool(True), []
+            assert bounce.__code__.co_varnames[:bounce.__code__.co_argcount] == LOOP_STATE
+            state = dr.while_loop(
+                (active, bsdf_ctx, bsdf_delta_prev, bsdf_pdf_prev, depth, eta, filter_glossy, guide, guided_prev,
+                 hidden, last_segment, max_depth, max_diffuse, max_glossy, max_transmission, min_ray_pdf,
+                 mis_weight, n_diffuse, n_glossy, n_transmission, n_transparent, radiance, ray, rr_depth, sampler,
+                 scene, self, si_prev, throughput, transparent, world_radiance),
+                lambda active, *rest: active, bounce, labels=LOOP_STATE, max_iterations=-1,
+                label="hybridgen clamped path")
+            return state[LOOP_STATE.index("radiance")], mi.Bool(True), []
 
         def aov_names(self) -> list[str]:
             return []
