@@ -110,6 +110,10 @@ def _ours_worker(conn: Any, checkout: str | None = None) -> None:
             conn.send(len(keypoints) / label_pass(scene, view, keypoints, [StoredFormSink()]))
         elif kind == "hdf5":  # writer built, every keypoint written, file finalized: all timed
             compression = options[0]
+            if compression == "blosc2-depth":  # a variant measured: Blosc2 for float depth only
+                import hybridgen.io.hdf5_single as hs
+                compression, chunks = "blosc2", hs.blosc2_chunks
+                hs.blosc2_chunks = lambda stored, level, chunks=chunks: chunks(stored, level) if stored.shuffle else None
             with tempfile.TemporaryDirectory() as tmp:
                 path = Path(tmp) / "data.hdf5"
                 start = time.perf_counter()
@@ -119,6 +123,8 @@ def _ours_worker(conn: Any, checkout: str | None = None) -> None:
                 writer.finalize({"object_states": [o.state() for o in scene.objects]})
                 elapsed = time.perf_counter() - start
                 conn.send((len(keypoints) / elapsed, path.stat().st_size / len(keypoints)))
+            if options[0] == "blosc2-depth":
+                hs.blosc2_chunks = chunks
         elif kind == "frame":
             raw = view.render_raw(keypoints[0])
             conn.send((depth_pass(raw), raw.instance.astype(np.int32)))
@@ -465,32 +471,36 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
 
 
 def e2e_table(names: list[str], resolutions: list[str], count: int, rounds: int, ask: Any,
-              checkouts: list[str]) -> None:
+              checkouts: list[str], compressions: list[str]) -> None:
     """Raw vs end-to-end label fps in process (the e2e/raw goal) per scene and resolution: medians of ``rounds``
-    rounds; in each round every checkout's raw pass and default-writer run, in an order that alternates."""
+    rounds; in each round every checkout's raw pass and writer run per compression ("default": the writer's
+    default), in an order that alternates."""
     print(f"\nin process, {count} keypoints per measurement, {rounds} alternating rounds, medians; raw = the label "
           "pass making the stored forms, no writer; e2e = the same with the default HDF5 writer (created, every "
           "keypoint written, finalized); ratio = median over rounds of e2e / raw of the same round; load average "
           f"{os.getloadavg()[0]:.1f} at the start")
-    print(f"{'scene':<20} {'resolution':<10} {'checkout':<9} {'raw fps':>8} {'e2e fps':>8} {'e2e/raw':>7} {'MB/kp':>6}")
+    print(f"{'scene':<20} {'resolution':<10} {'checkout':<9} {'writer':<13} {'raw fps':>8} {'e2e fps':>8} "
+          f"{'e2e/raw':>7} {'MB/kp':>6}")
     for name in names:
         for resolution in resolutions:
             fps: dict[tuple[str, str], list[float]] = {}
-            size: dict[str, float] = {}
+            size: dict[tuple[str, str], float] = {}
             for r in range(rounds):
-                runs = [(checkout, kind) for checkout in checkouts for kind in ("raw", "hdf5")]
+                runs = [(checkout, kind) for checkout in checkouts for kind in ("raw", *compressions)]
                 for checkout, kind in (runs if r % 2 == 0 else runs[::-1]):
                     if kind == "raw":
                         fps.setdefault((checkout, kind), []).append(ask(checkout, "raw", name, resolution, count))
                     else:
-                        value, size[checkout] = ask(checkout, "hdf5", name, resolution, count, "default")
+                        value, size[checkout, kind] = ask(checkout, "hdf5", name, resolution, count, kind)
                         fps.setdefault((checkout, kind), []).append(value)
             for checkout in checkouts:
-                raw, e2e = fps[checkout, "raw"], fps[checkout, "hdf5"]
-                ratio = statistics.median(b / a for a, b in zip(raw, e2e))
-                print(f"{name:<20} {resolution:<10} {'this' if checkout == 'ours' else checkout:<9} "
-                      f"{statistics.median(raw):>8.1f} {statistics.median(e2e):>8.1f} {ratio:>7.2f} "
-                      f"{size[checkout] / 1e6:>6.2f}", flush=True)
+                raw = fps[checkout, "raw"]
+                for compression in compressions:
+                    e2e = fps[checkout, compression]
+                    ratio = statistics.median(b / a for a, b in zip(raw, e2e))
+                    print(f"{name:<20} {resolution:<10} {'this' if checkout == 'ours' else checkout:<9} "
+                          f"{compression:<13} {statistics.median(raw):>8.1f} {statistics.median(e2e):>8.1f} "
+                          f"{ratio:>7.2f} {size[checkout, compression] / 1e6:>6.2f}", flush=True)
     print(f"load average at the end: {os.getloadavg()[0]:.1f}")
 
 
@@ -517,6 +527,10 @@ def main() -> None:
                         "goal), --rounds alternating rounds per scene and resolution")
     parser.add_argument("--e2e-keypoints", type=int, default=E2E_KEYPOINTS, help="keypoints of each in-process raw "
                         "and end-to-end measurement (writer created, every keypoint written, file finalized)")
+    parser.add_argument("--e2e-compression", nargs="+", default=["default"],
+                        choices=["default", "gzip", "blosc2", "blosc2-depth", "lzf", "none"],
+                        help="with --e2e-only: writer compressions timed in the same rounds (blosc2-depth: Blosc2 for "
+                        "the float depth only, a variant)")
     parser.add_argument("--baseline", type=Path, help="with --e2e-only: also time another checkout's hybridgen "
                         "(e.g. git archive <commit> | tar -x -C /tmp/base) in the same rounds")
     parser.add_argument("--cache-dir", type=Path, help="HYBRIDGEN_CACHE_DIR of the whole-process runs "
@@ -561,7 +575,8 @@ def main() -> None:
     print(f"{frames} keypoints per round, {rounds} rounds, median frames/s; ours = depth + normals + instance + class; "
           f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f} (other processes skew absolute numbers)")
     if args.e2e_only:
-        e2e_table(names, resolutions, args.e2e_keypoints, args.rounds, ask, ["ours", *workers.keys() & {"baseline"}])
+        e2e_table(names, resolutions, args.e2e_keypoints, args.rounds, ask, ["ours", *workers.keys() & {"baseline"}],
+                  args.e2e_compression)
         for conn, process in workers.values():
             conn.send(None)
             process.join(timeout=10)

@@ -19,6 +19,7 @@ import h5py
 import numpy as np
 
 from ..errors import InputError
+from ..io.hdf5_filters import enable_filters
 from ..render.passes import RECORDS, exact
 from .decode import blenderproc_camera, blenderproc_normals, decode_attribute, decode_text
 
@@ -28,7 +29,9 @@ _NUMBERED = re.compile(r"(\d+)\.hdf5")
 
 
 def open_hdf5(path: Path) -> h5py.File:
-    """``path`` opened read-only; an InputError naming it when it is missing or not HDF5."""
+    """``path`` opened read-only (hdf5plugin's filters registered first: ``compression: blosc2`` files); an
+    InputError naming it when it is missing or not HDF5."""
+    enable_filters()
     try:
         return h5py.File(path, "r")
     except FileNotFoundError:

@@ -37,6 +37,7 @@ from ..render.tonemap import to_srgb8
 from ..run.shard_index import check_index_sources
 from .atomic import prepare_output_dir
 from .depth_png import depth_png_values
+from .hdf5_filters import enable_filters
 from .integrity import DIGEST_ATTR, verify
 from .label_encoding import decode_dataset
 from .image_files import json_bytes, npy_bytes, png_bytes, write_exr_file, write_file
@@ -159,6 +160,7 @@ class ExtractResult:
 def _open(path: Path) -> h5py.File:
     if path.is_dir():
         raise InputError(f"'{path}' is a directory, not an HDF5 file")
+    enable_filters()  # compression: blosc2 files
     try:
         h5 = h5py.File(path, "r")
     except FileNotFoundError:

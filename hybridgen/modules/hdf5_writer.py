@@ -7,6 +7,7 @@ from typing import Any
 from ..config.options import from_config, option_params
 from ..config.registry import register_module
 from ..config.schema import Param
+from ..errors import ConfigError
 from ..io.hdf5_blenderproc import BlenderProcHdf5Writer
 from ..io.hdf5_single import Hdf5Options, Hdf5SingleFileWriter
 from ..run.context import RunContext
@@ -66,6 +67,9 @@ class Hdf5Writer(Module):
         options = from_config(Hdf5Options, cfg)
         self.writer: Hdf5SingleFileWriter | BlenderProcHdf5Writer
         if cfg["layout"] == "blenderproc":
+            if options.compression == "blosc2":  # BlenderProc's tools (plain h5py) cannot read Blosc2 chunks
+                raise ConfigError("'blosc2' is for the single layout; layout: blenderproc stores gzip (or lzf, "
+                                  "none) for BlenderProc's tools", key="compression")
             self.writer = BlenderProcHdf5Writer(cfg["output_dir"], options, append=cfg["append_to_existing_output"])
         elif context.unit is not None:  # one work unit of a sharded run (or part of a staged one): its own file
             plain = context.unit.folder == SHARD_FOLDER or context.unit.whole  # whole: a staged run's only part

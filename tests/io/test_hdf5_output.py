@@ -96,7 +96,7 @@ def test_same_config_and_seed_give_identical_bytes(gl_context, tmp_path, run_cli
 
 
 @pytest.mark.parametrize("encoding", ["compact", "plain"])
-@pytest.mark.parametrize("compression", ["gzip", "lzf", "none"])
+@pytest.mark.parametrize("compression", ["gzip", "blosc2", "lzf", "none"])
 def test_compressions_read_back_identically(gl_context, tmp_path, compression, encoding):
     scene = hg.Scene()
     scene.add(hg.make_primitive("sphere", 1.0, name="s", category_id=4))
@@ -109,7 +109,10 @@ def test_compressions_read_back_identically(gl_context, tmp_path, compression, e
     writer.finalize({"object_states": [o.state() for o in scene.objects]})
     view = hg.RasterView(scene, depth_background=-1.0)
     with h5py.File(tmp_path / "x.hdf5") as f:
-        assert f["depth"].compression == (None if compression == "none" else compression)
+        if compression == "blosc2":  # HDF5's Blosc2 filter (hdf5plugin); see tests/io/test_blosc2_output.py
+            assert "32026" in f["depth"]._filters
+        else:
+            assert f["depth"].compression == (None if compression == "none" else compression)
         for i, pose in enumerate(scene.camera.keypoints):
             expected = request.compute(view.render_raw(pose), request.tables(view))
             for key in ("depth", "distance", "instance_segmaps", "category_id_segmaps"):
@@ -148,12 +151,13 @@ def _depth(index):
     return np.random.default_rng(index).random((16, 16), dtype=np.float32)
 
 
-def test_keypoints_are_stored_in_order_whatever_finishes_first(tmp_path, monkeypatch):
+@pytest.mark.parametrize("compression", ["gzip", "blosc2"])
+def test_keypoints_are_stored_in_order_whatever_finishes_first(tmp_path, monkeypatch, compression):
     """Keypoint 0's chunk is made last (its job waits until the others are compressed): the file still holds the
     chunks in keypoint order, byte for byte the file one thread writes."""
     files = {}
     for threads in (1, 3):
-        writer = _small_writer(tmp_path / f"{threads}.hdf5", threads=threads)
+        writer = _small_writer(tmp_path / f"{threads}.hdf5", threads=threads, compression=compression)
         if threads == 3:
             made, chunk = threading.Event(), writer._chunk
 

@@ -78,19 +78,26 @@ def reference(gl_context, tmp_path, write_config, run_cli):
     return config, out, data
 
 
-def test_staged_file_is_the_directly_written_file(gl_context, tmp_path, write_config, run_cli):
-    """Merging parts gives the bytes of the file the writer streams directly (color, labels and JSON)."""
+def direct_bytes(config: Path, out: Path) -> bytes:
+    """The bytes of ``config``'s data.hdf5 written directly (in process, no staging) into ``out``; the file is
+    removed again so that a staged run can write the same folder."""
     from hybridgen.config.config_file import load_config
     from hybridgen.run.fingerprint import FINGERPRINT_ATTR, fingerprint_text, run_fingerprint
     from hybridgen.run.pipeline import build_modules, execute
 
-    config = write_config(COLOR.replace("SEED", "2"))
-    out = tmp_path / "out"
     loaded = load_config(str(config), [str(out)])
     context = execute(loaded, build_modules(loaded),
                       attributes={FINGERPRINT_ATTR: fingerprint_text(run_fingerprint(loaded))})
     direct = context.outputs[0].read_bytes()
     (out / "data.hdf5").unlink()
+    return direct
+
+
+def test_staged_file_is_the_directly_written_file(gl_context, tmp_path, write_config, run_cli):
+    """Merging parts gives the bytes of the file the writer streams directly (color, labels and JSON)."""
+    config = write_config(COLOR.replace("SEED", "2"))
+    out = tmp_path / "out"
+    direct = direct_bytes(config, out)
     code, _, err = run_cli("run", str(config), str(out))
     assert code == 0, err
     assert len(_units_rendered(err)) == PARTS
