@@ -293,5 +293,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 0
 
 
+def console_main() -> None:
+    """The ``hybridgen`` command (console script, ``python -m hybridgen``): :func:`main`, then the process ends
+    through :func:`hybridgen.process_exit.end_process` (a successful run skips the interpreter's teardown)."""
+    from .process_exit import end_process
+
+    end_process(main())
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    console_main()
