@@ -74,6 +74,7 @@ import numpy as np
 
 from ..errors import InputError
 from . import pixel_filter
+from .owen_sobol import MAX_SAMPLES as MAX_SOBOL_PATTERN, OwenSobol, mix
 
 CYCLES_THRESHOLD_SCALE = 5.0
 """The error estimate is compared with ``noise_threshold`` times this (Cycles' own factor, in its
@@ -173,6 +174,10 @@ class PixelTracer:
             type(integrator).__module__ != mi.SamplingIntegrator.__module__  # a plugin written in Python
         self._world_radiance: Any = None  # hybridgen/render/world_guide.py, found on the first guide_world()
         self.world_guide: Any = None  # the guide of the last guide_world() (None: the world is not light-sampled)
+        # hybridgen's own sampler in place of Mitsuba's low-discrepancy one where the integrator takes any sampler
+        # object (render/owen_sobol.py); another sensor sampler (e.g. tests' "independent") is kept
+        self.owen_sobol = OWEN_SOBOL and self._python_integrator and \
+            sensor.sampler().class_name() == "LowDiscrepancySampler"
 
     def guide_world(self) -> None:
         """Learns, for the sensor's current pose, where an enclosed constant world is seen from
@@ -198,13 +203,14 @@ class PixelTracer:
         """Sums of linear RGB over the first and the second half of ``spp`` samples of every pixel in
         ``pixels`` (flat indices ``v * width + u``): two float64 arrays of shape (len(pixels), 3).
 
-        The sensor's sampler may only accept some sample counts (stratified patterns: powers of two for
+        hybridgen's Owen-Sobol sampler (:data:`OWEN_SOBOL`) traces ``spp`` as one pattern per pixel. The sensor's
+        Mitsuba sampler may only accept some sample counts (stratified patterns: powers of two for
         ``ldsampler``), so ``spp`` is split into counts it accepts (:func:`launch_counts`); equal counts are
         one launch (a pattern per count and pixel), each launch with its own seed derived from ``seed``; each
         pattern's first half of samples goes to the first sum.
         An odd ``spp`` (fixed-count rendering only) leaves the odd sample in the first sum."""
         sum_a, sum_b = np.zeros((len(pixels), 3)), np.zeros((len(pixels), 3))
-        counts = launch_counts(spp, self.sensor.sampler().class_name())
+        counts = launch_counts(spp, "OwenSobol" if self.owen_sobol else self.sensor.sampler().class_name())
         launches = [(count, len(list(same))) for count, same in itertools.groupby(counts)]
         for index, (count, copies) in enumerate(launches):
             a, b = self._launch(pixels, count, copies,
@@ -222,18 +228,19 @@ class PixelTracer:
 
         n = len(pixels) * copies
         pixels = np.repeat(pixels, copies)
-        sampler = self.sensor.sampler().fork()
-        sampler.set_sample_count(pattern_size(spp, sampler.class_name()))
-        sampler.set_samples_per_wavefront(spp)
-        sampler.seed(dr.opaque(mi.UInt32, seed % 2**32), n * spp)
         spp_o, width_o = dr.opaque(mi.UInt32, spp), dr.opaque(mi.UInt32, self.width)
         index = dr.arange(mi.UInt32, n * spp)
         local = index // spp_o
         pixel = dr.gather(mi.UInt32, mi.UInt32(np.ascontiguousarray(pixels, np.uint32)), local)
         v = pixel // width_o
         u = pixel - v * width_o
-        if ROTATE_DIMENSIONS and self._python_integrator:
-            sampler = RotatedDimensions(sampler, local, dr.opaque(mi.UInt32, round_seed(seed, LAUNCH_STREAM, 0)))
+        if self.owen_sobol:  # each pixel (copy) one pattern of spp samples, seeded by the launch and the pixel
+            sampler = OwenSobol(index - local * spp_o, mix(local ^ dr.opaque(mi.UInt32, mix(seed % 2**32))))
+        else:
+            sampler = self.sensor.sampler().fork()
+            sampler.set_sample_count(pattern_size(spp, sampler.class_name()))
+            sampler.set_samples_per_wavefront(spp)
+            sampler.seed(dr.opaque(mi.UInt32, seed % 2**32), n * spp)
         offset = self._filter_offset(sampler.next_2d())
         position = mi.Point2f((mi.Float(u) + offset.x) / self.width, (mi.Float(v) + offset.y) / self.height)
         ray, weight = self.sensor.sample_ray(0.0, sampler.next_1d(), position, sampler.next_2d())
@@ -267,56 +274,20 @@ class PixelTracer:
         return mi.Point2f(axis(sample.x), axis(sample.y))
 
 
-ROTATE_DIMENSIONS = False
-"""Whether each sample dimension of a pixel's pattern gets its own random toroidal shift
-(:class:`RotatedDimensions`). Off: it removes the low-discrepancy sampler's bias (window room of
-tools/color_quality.py, 80x60, 512 spp, 3 seeds: image mean 0.13905 plain, 0.13807 rotated, 0.13802 with
-independent random numbers) but is noisier at equal spp (320x240, PSNR against the benchmark's 4096-spp
-references at 16 / 64 spp: tabletop 38.65 / 45.19 -> 38.31 / 45.06 dB, materials 31.45 / 38.38 -> 31.22 /
-38.02 dB; window room 24.56 / 32.09 -> 24.61 / 31.99 dB against its biased reference) for ~5 % more CPU: the
-correlation that biases also stratifies across bounces. docs/color_quality.md."""
-
-
-class RotatedDimensions:
-    """Mitsuba's low-discrepancy sampler with an independent Cranley-Patterson rotation per dimension and
-    sequence (one pixel's pattern in a launch): ``u' = frac(u + r)``, ``r`` a hash of the sequence, the launch's
-    seed and the dimension, the same for all samples of the sequence. The sampler's dimensions are permuted
-    copies of one (0, 2)-sequence whose permutation seeds differ by one per dimension and are hashed with
-    two rounds of TEA (Mitsuba 3.9 ``permute``), and all dimensions share one XOR scramble, so dimensions are
-    correlated: the window room of tools/color_quality.py came out 0.75 % brighter than with independent random
-    numbers. Independent rotations make every pair of dimensions uniform in expectation and keep each
-    dimension's stratification. Used with hybridgen's Python integrators, which take any object with
-    ``next_1d`` / ``next_2d``; its fields are Dr.Jit state (``DRJIT_STRUCT``), so a symbolic loop carries the
-    dimension counter from one iteration to the next."""
-
-    DRJIT_STRUCT = {"sampler": object, "sequence": object, "seed": object, "dimension": object}
-
-    def __init__(self, sampler: Any = None, sequence: Any = None, seed: Any = None, dimension: Any = None) -> None:
-        import mitsuba as mi
-
-        self.sampler, self.sequence, self.seed = sampler, sequence, seed
-        self.dimension = mi.UInt32(0) if dimension is None else dimension
-
-    def _shift(self) -> Any:
-        import mitsuba as mi
-
-        self.dimension = self.dimension + 1
-        return mi.sample_tea_float32(self.sequence, self.seed + self.dimension * 0x9E3779B9, 6)
-
-    @staticmethod
-    def _wrap(value: Any) -> Any:
-        import drjit as dr
-
-        return dr.minimum(dr.select(value >= 1.0, value - 1.0, value), 0.99999994)
-
-    def next_1d(self, active: Any = True) -> Any:
-        return self._wrap(self.sampler.next_1d(active) + self._shift())
-
-    def next_2d(self, active: Any = True) -> Any:
-        import mitsuba as mi
-
-        sample = self.sampler.next_2d(active)
-        return mi.Point2f(self._wrap(sample.x + self._shift()), self._wrap(sample.y + self._shift()))
+OWEN_SOBOL = True
+"""Whether hybridgen's Python integrators (:mod:`hybridgen.render.clamped_path`: every default color render in
+a JIT variant) draw their samples from :class:`hybridgen.render.owen_sobol.OwenSobol` (one shuffled,
+Owen-scrambled Sobol pattern per pixel and launch, Cycles' Sobol-Burley) instead of the sensor's Mitsuba sampler
+(``ldsampler``, :data:`hybridgen.render.path_trace.SAMPLER`). Mitsuba 3.9's ``ldsampler`` is biased: its
+dimensions share one scramble and permutation seeds one apart, so the x of a pixel's first and third 2D sample
+correlate (z = 150 over 65536 16-sample patterns, tests/render/test_owen_sobol.py), and the window room of
+tools/color_quality.py rendered 0.69 % brighter than with independent random numbers (80x60, 512 spp, 8 seeds:
+image mean 0.13901 vs 0.13806 +- 0.00003; Owen-Sobol 0.13806, Mitsuba's stratified / multijitter / orthogonal
+0.13809 / 0.13806 / 0.13807). At equal spp Owen-Sobol is as clean as ``ldsampler`` (320x240, variance between
+two seeds in 8-bit sRGB at 16 / 64 spp: window room 221 / 39.2 -> 212 / 39.2, tabletop 9.25 / 1.85 -> 8.79 /
+1.89, HDRI tabletop 75.1 / 5.11 -> 47.2 / 5.56, materials 45.4 / 9.04 -> 43.9 / 9.48; independent numbers 1.5-8x
+noisier) and 5-15 % cheaper per sample (Mitsuba's ``permute`` loops per dimension; stratified / multijitter /
+orthogonal cost 1.3-2x ``ldsampler``'s CPU). docs/color_quality.md."""
 
 
 def pattern_size(spp: int, sampler: str) -> int:
@@ -334,7 +305,8 @@ def pattern_size(spp: int, sampler: str) -> int:
 
 def launch_counts(spp: int, sampler: str) -> list[int]:
     """``spp`` as a sum of sample counts ``sampler`` (a Mitsuba sampler's class name) takes exactly, largest
-    first: ``spp`` itself for samplers that take any count (``IndependentSampler``); for the low-discrepancy
+    first: ``spp`` itself for samplers that take any count (``IndependentSampler``; ``OwenSobol``, hybridgen's own,
+    in patterns of at most :data:`hybridgen.render.owen_sobol.MAX_SAMPLES`); for the low-discrepancy
     sampler (``LowDiscrepancySampler``) whole patterns of 4^k points (at most :data:`MAX_PATTERN`), each as
     often as it fits, and a rest below 4 as 2 (half of a 4-point pattern) and 1. Equal counts are traced in
     one launch (:meth:`PixelTracer.trace`), each copy of a pixel with its own scramble.
@@ -345,6 +317,9 @@ def launch_counts(spp: int, sampler: str) -> list[int]:
     tabletop of tools/color_quality.py (160x120, PSNR against a 2048-spp reference, 3 seeds) 64 + 64 + 2 x 64
     samples are 49.65 dB where 64 + 64 + half of 256 were 49.19 dB and two halves of 256 48.45 dB (one
     256-point pattern: 49.56 dB)."""
+    if sampler == "OwenSobol":  # hybridgen's (render/owen_sobol.py): any count, one pattern up to its maximum
+        whole, rest = divmod(spp, MAX_SOBOL_PATTERN)
+        return [MAX_SOBOL_PATTERN] * whole + ([rest] if rest else [])
     if sampler != "LowDiscrepancySampler":
         return [spp]
     out, rest = [], spp

@@ -36,7 +36,9 @@ def _half_lit_scene() -> hg.Scene:
 
 def test_adaptive_sampling_spends_samples_where_the_noise_is(variant):
     scene = _half_lit_scene()
-    settings = PathTraceSettings(samples=512, noise_threshold=0.01, min_samples=8, max_bounces=1)
+    # threshold 0.003: with the Owen-scrambled Sobol sampler most floor pixels are already below 0.01 at 8 spp
+    # (their measured error against an 8192-spp image: 0.008 in Cycles' relative measure, the bound is 0.05)
+    settings = PathTraceSettings(samples=512, noise_threshold=0.003, min_samples=8, max_bounces=1)
     view = PathTraceView(scene, settings, variant=variant)
     pose = scene.camera.keypoints[0]
     image, counts = view.render_with_counts(pose, seed=4)
