@@ -15,6 +15,7 @@ import tempfile
 from pathlib import Path
 
 from ..errors import InputError
+from ..stop_request import deferred
 
 TEMP_SUFFIX = ".incomplete"
 _RANDOM_PART = 8 + 2  # mkstemp's random characters plus the dots around them
@@ -72,17 +73,20 @@ def temporary_path(final: Path) -> Path:
     final = check_file_name(Path(final))
     room = name_max(final.parent) - _RANDOM_PART - len(TEMP_SUFFIX) - 1
     stem = os.fsdecode(os.fsencode(final.name)[:room]) if room > 0 else ""
-    try:
-        fd, name = tempfile.mkstemp(prefix=f".{stem}.", suffix=TEMP_SUFFIX, dir=final.parent)
-    except UnicodeDecodeError:  # cut inside a multi-byte character: drop the final name from the temp name
-        fd, name = tempfile.mkstemp(prefix=".", suffix=TEMP_SUFFIX, dir=final.parent)
-    except OSError as exc:
-        raise InputError(f"cannot write in '{final.parent}': {exc.strerror or exc}") from None
-    os.close(fd)
-    temp = Path(name)
     if len(_LIVE) >= _PRUNE_AT:
         _LIVE.difference_update([p for p in _LIVE if not os.path.lexists(p)])
-    _LIVE.add(temp)
+    # A stop request (SIGTERM's SystemExit) between creating the file and listing it would leave it behind:
+    # the two happen inside stop_request.deferred(), which raises the request once the file is listed.
+    with deferred():
+        try:
+            fd, name = tempfile.mkstemp(prefix=f".{stem}.", suffix=TEMP_SUFFIX, dir=final.parent)
+        except UnicodeDecodeError:  # cut inside a multi-byte character: drop the final name from the temp name
+            fd, name = tempfile.mkstemp(prefix=".", suffix=TEMP_SUFFIX, dir=final.parent)
+        except OSError as exc:
+            raise InputError(f"cannot write in '{final.parent}': {exc.strerror or exc}") from None
+        temp = Path(name)
+        _LIVE.add(temp)
+        os.close(fd)
     return temp
 
 
