@@ -9,6 +9,7 @@ is a Dr.Jit kernel-cache miss, ~0.5 s of CPU per path kernel).
 
     git worktree add /tmp/base <commit> --detach
     .venv/bin/python tools/color_process_ab.py /tmp/base . --scenes tabletop,materials --runs 4
+    .venv/bin/python tools/color_process_ab.py . . --base-args="--exit interpreter"   # one tree, two ways to end
 
 The machine's load average is printed at start and end; on a shared machine compare CPU seconds and ratios.
 """
@@ -17,27 +18,30 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shlex
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Sequence
 
 PHASES = ("wall", "cpu", "start", "build", "render", "after")
 """Per run (s): spawn to exit, CPU (user + system of the child), spawn to ``import hybridgen`` done, the scene
 build, ``render_color``, and from its end to the process's exit (PNG, interpreter shutdown)."""
 
 
-def run_once(tree: Path, caches: Path, scene: str, resolution: str, png: Path) -> dict[str, float]:
-    """One whole process of ``tree``'s tools/default_color_process.py with the caches under ``caches``."""
+def run_once(tree: Path, caches: Path, scene: str, resolution: str, png: Path,
+             extra: Sequence[str] = ()) -> dict[str, float]:
+    """One whole process of ``tree``'s tools/default_color_process.py (options ``extra``) with the caches under
+    ``caches``."""
     env = {**os.environ, "PYTHONPATH": str(tree), "DRJIT_CACHE_DIR": str(caches / "drjit"),
            "HYBRIDGEN_CACHE_DIR": str(caches / "hybridgen")}
     env.setdefault("HYBRIDGEN_THREADS", "2")  # the issue's 2 CPU threads
     env.pop("PYTHONDONTWRITEBYTECODE", None)  # byte-compiled sources, as an installed package
     command = [sys.executable, str(tree / "tools" / "default_color_process.py"), scene, resolution, str(png),
-               str(caches / "work")]
+               str(caches / "work"), *extra]
     (caches / "work").mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryFile() as output:
         spawned, start = time.time(), time.perf_counter()
@@ -59,17 +63,19 @@ def kernel_count(caches: Path) -> int:
     return len(list((caches / "drjit").glob("*.bin")))
 
 
-def compare(trees: dict[str, Path], scene: str, resolution: str, runs: int, root: Path) -> dict[str, Any]:
-    """One scene: warm-up runs, then ``runs`` timed runs per tree (ABBA); medians and kernel-cache misses."""
+def compare(trees: dict[str, Path], scene: str, resolution: str, runs: int, root: Path,
+            extra: dict[str, Sequence[str]]) -> dict[str, Any]:
+    """One scene: warm-up runs, then ``runs`` timed runs per tree (ABBA); medians and kernel-cache misses.
+    ``extra``: the options each tree's process gets."""
     caches = {name: root / name for name in trees}
     pngs = {name: root / f"{scene}_{name}.png" for name in trees}
     for name, tree in trees.items():
-        run_once(tree, caches[name], scene, resolution, pngs[name])
+        run_once(tree, caches[name], scene, resolution, pngs[name], extra[name])
     before = {name: kernel_count(caches[name]) for name in trees}
     timed: dict[str, list[dict[str, float]]] = {name: [] for name in trees}
     for index in range(runs):
         for name in (list(trees) if index % 2 == 0 else list(trees)[::-1]):
-            row = run_once(trees[name], caches[name], scene, resolution, pngs[name])
+            row = run_once(trees[name], caches[name], scene, resolution, pngs[name], extra[name])
             timed[name].append(row)
             print(f"{scene} {name}: " + " ".join(f"{key} {row[key]:.2f}" for key in PHASES), flush=True)
     medians = {name: {key: statistics.median(row[key] for row in rows) for key in PHASES}
@@ -88,12 +94,15 @@ def main() -> None:
     parser.add_argument("--scenes", default="tabletop,materials,window_room,hdri_tabletop")
     parser.add_argument("--runs", type=int, default=3, help="timed runs per tree and scene")
     parser.add_argument("--res", default="320x240")
+    parser.add_argument("--base-args", default="", help="options of base's default_color_process.py runs")
+    parser.add_argument("--new-args", default="", help="options of new's default_color_process.py runs")
     args = parser.parse_args()
+    extra = {"base": shlex.split(args.base_args), "new": shlex.split(args.new_args)}
     trees = {"base": args.base.resolve(), "new": args.new.resolve()}
     print(f"load average {os.getloadavg()[0]:.2f} at start; {os.cpu_count()} cores", flush=True)
     with tempfile.TemporaryDirectory(prefix="color_process_ab_") as root:
         for scene in args.scenes.split(","):
-            result = compare(trees, scene, args.res, args.runs, Path(root) / scene)
+            result = compare(trees, scene, args.res, args.runs, Path(root) / scene, extra)
             line = " | ".join(f"{name}: " + " ".join(f"{key} {value:.2f}" for key, value in m.items())
                               for name, m in result["medians"].items())
             print(f"{scene} medians of {args.runs}: {line} | new/base wall {result['ratio_wall']:.3f} cpu "
