@@ -8,7 +8,8 @@ from typing import Any, Mapping, Sequence
 import yaml
 
 from ..errors import ConfigError, closest
-from .blenderproc import (BLENDER_PYTHON_PACKAGES, BLENDER_SETUP_KEYS, GLOBAL_IGNORED, translate_module)
+from .blenderproc import (BLENDER_PYTHON_PACKAGES, BLENDER_SETUP_KEYS, FAMILY_READ, GLOBAL_IGNORED,
+                          translate_module)
 from .blenderproc import finish as finish_translation
 from .notices import notice
 from .placeholders import resolve_placeholders
@@ -128,8 +129,15 @@ def load_config(path: str | Path, args: Sequence[str] = (), env: Mapping[str, st
         notice(f"ignored: {', '.join(blender_setup)} locate Blender; hybridgen renders without Blender",
                file=file, key="setup")
     _check_pip(config.setup.get("pip", []), file)
+    entries = resolved.get("modules")
+    if not isinstance(entries, list) or not entries:
+        raise ConfigError("'modules' must be a non-empty list of {module: ..., config: {...}}", file=file,
+                          key="modules")
+    blenderproc_form = version is not None or bool(blender_setup) or any(
+        isinstance(e, dict) and "module" in e for e in entries)
     global_section = _mapping(resolved.get("global"), file, "global")
     family_globals: dict[str, dict[str, Any]] = {}
+    family_read = FAMILY_READ if blenderproc_form else {}
     for key in global_section:
         if key != "all":
             if "." in str(key) or not isinstance(global_section[key], dict):
@@ -137,18 +145,12 @@ def load_config(path: str | Path, args: Sequence[str] = (), env: Mapping[str, st
                                   "settings", file=file, key=f"global.{key}")
             family_globals[str(key)] = {}
             for name, value in global_section[key].items():
-                if name in GLOBAL_IGNORED:
+                if name in GLOBAL_IGNORED and name not in family_read.get(str(key), ()):
                     notice(f"ignored: {GLOBAL_IGNORED[name]}", file=file, key=f"global.{key}.{name}")
                 else:
                     family_globals[str(key)][name] = value
     config.global_all = _mapping(global_section.get("all"), file, "global.all")
-    entries = resolved.get("modules")
-    if not isinstance(entries, list) or not entries:
-        raise ConfigError("'modules' must be a non-empty list of {module: ..., config: {...}}", file=file,
-                          key="modules")
-    blenderproc_form = version is not None or bool(blender_setup) or any(
-        isinstance(e, dict) and "module" in e for e in entries)
-    state: dict[str, Any] = {"blenderproc": blenderproc_form}
+    state: dict[str, Any] = {"blenderproc": blenderproc_form, "version": version}
     for index, entry in enumerate(entries):
         name, module_config = _module_entry(entry, index, file)
         family = family_globals.get(name.split(".", 1)[0])

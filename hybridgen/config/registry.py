@@ -21,6 +21,7 @@ _BUILTIN_NAMES = {
     "loader.PrimitiveLoader": "hybridgen.modules.primitive_loader",
     "camera.CameraLoader": "hybridgen.modules.camera_loader",
     "camera.CameraSampler": "hybridgen.modules.camera_sampler",
+    "camera.PixelAspect": "hybridgen.modules.pixel_aspect",
     "lighting.LightLoader": "hybridgen.modules.light_loader",
     "lighting.LightSampler": "hybridgen.modules.light_loader",
     "lighting.SurfaceLighting": "hybridgen.modules.surface_lighting",

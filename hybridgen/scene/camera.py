@@ -87,6 +87,29 @@ class Intrinsics:
         K[1, 2] = (K[1, 2] + 0.5) * sy - 0.5
         return Intrinsics(K, new_w, new_h, self.clip_start, self.clip_end)
 
+    def with_pixel_aspect(self, aspect_x: float, aspect_y: float = 1.0) -> "Intrinsics":
+        """The camera rendered with Blender's pixel aspect ``aspect_x : aspect_y`` (its render settings) instead of
+        the aspect it has now (``fy / fx``), the lens and sensor kept, as Blender does with sensor fit AUTO:
+        the sensor spans the side whose aspect-scaled size is larger (``width x aspect_x`` against
+        ``height x aspect_y``), then ``fy = fx x aspect_x / aspect_y``; the principal point stays.
+
+        BlenderProc 1.0's renderers set ``pixel_aspect_x`` when they render (e.g. its SUNCG and Replica examples:
+        4/3), which changes ``K`` without touching the camera's field-of-view setting."""
+        if not (aspect_x > 0 and aspect_y > 0 and math.isfinite(aspect_x) and math.isfinite(aspect_y)):
+            raise InputError(f"pixel aspect must be positive and finite, got {aspect_x} x {aspect_y}")
+        now, new = self.K[1, 1] / self.K[0, 0], aspect_x / aspect_y
+
+        def sensor_span(aspect: float) -> float:
+            """Pixels (in fx's units) the sensor's width or height spans at pixel aspect ``aspect``."""
+            return float(self.width) if self.width * aspect >= self.height else self.height / aspect
+
+        if abs(new - now) <= 1e-12 * new:  # already this aspect (applying it twice changes nothing)
+            return self
+        K = self.K.copy()
+        K[0, 0] = self.K[0, 0] * sensor_span(new) / sensor_span(now)
+        K[1, 1] = K[0, 0] * new
+        return Intrinsics(K, self.width, self.height, self.clip_start, self.clip_end)
+
     @property
     def resolution(self) -> tuple[int, int]:
         """(width, height) in pixels."""

@@ -170,7 +170,7 @@ def test_v1_name_form_with_top_level_global(tmp_path, notices):
         {
           "setup": {"blender_install_path": "/opt/blender/", "blender_version": "blender-2.80-linux",
                     "pip": ["h5py", "imageio", "surely-not-a-real-blender-pkg-zz @ git+https://example.org/x"]},
-          "global": {"all": {"output_dir": "<args:2>"}, "renderer": {"pixel_aspect_x": 1.0}},
+          "global": {"all": {"output_dir": "<args:2>"}, "renderer": {"pixel_aspect_x": 1.333333333}},
           "modules": [
             {"name": "main.Initializer", "config": {}},
             {"name": "loader.ObjLoader", "config": {"path": "<args:1>"}},
@@ -183,16 +183,21 @@ def test_v1_name_form_with_top_level_global(tmp_path, notices):
     """)
     loaded = load_config(config, [str(cams), str(obj), str(tmp_path / "out")])
     names = [m.name for m in loaded.modules]
-    assert names == ["main.Initializer", "loader.ObjLoader", "camera.CameraLoader", "renderer.SegMapRenderer",
-                     "writer.Hdf5Writer"]
-    normal = loaded.modules[3].config
+    # v1.0's renderers set Blender's pixel aspect when they render: a camera.PixelAspect before the renderer
+    assert names == ["main.Initializer", "loader.ObjLoader", "camera.CameraLoader", "camera.PixelAspect",
+                     "renderer.SegMapRenderer", "writer.Hdf5Writer"]
+    normal = loaded.modules[4].config
     assert normal["render_normals"] is True and not normal["render_depth"] and normal["map_by"] is None
     assert loaded.modules[2].config["intrinsics"] == {"fov": 1}  # v1.0 kept fov among the pose defaults
-    assert any("pixel_aspect_x" in n for n in notices)
+    assert not any("pixel_aspect_x" in n for n in notices)
     assert any("surely-not-a-real-blender-pkg-zz" in n for n in notices)  # a URL requirement: a notice
     modules = build_modules(loaded)
-    context = execute(loaded, modules[:3])
+    context = execute(loaded, modules[:4])
     assert [o.name for o in context.scene.objects] == ["Plane", "Cube", "Cube.001", "Cylinder"]
+    # Blender, 512 x 512 at pixel aspect 4/3 (sensor fit AUTO spans the width): fx from the 1 rad fov, fy 4/3 fx
+    K = context.scene.camera.intrinsics.K
+    assert K[0, 0] == pytest.approx(256 / np.tan(0.5), rel=1e-12)
+    assert K[1, 1] == pytest.approx(K[0, 0] * 1.333333333, rel=1e-12) and tuple(K[:2, 2]) == (255.5, 255.5)
 
 
 def test_module_and_name_together_and_unavailable_modules(tmp_path):

@@ -17,10 +17,10 @@ from ..registry import unavailable_reason
 from .common import Note, custom_properties
 from .names import ALIASES, UNAVAILABLE
 from .selectors import samplers_as_blenderproc, selector
-from .setup_keys import BLENDER_PYTHON_PACKAGES, BLENDER_SETUP_KEYS, GLOBAL_IGNORED
+from .setup_keys import BLENDER_PYTHON_PACKAGES, BLENDER_SETUP_KEYS, FAMILY_READ, GLOBAL_IGNORED
 from .translate import KEYS_ONLY_BLENDERPROC, TRANSLATORS, WRITERS, translate_module
 from .writers import finish
 
-__all__ = ["ALIASES", "BLENDER_PYTHON_PACKAGES", "BLENDER_SETUP_KEYS", "GLOBAL_IGNORED", "KEYS_ONLY_BLENDERPROC",
+__all__ = ["ALIASES", "BLENDER_PYTHON_PACKAGES", "BLENDER_SETUP_KEYS", "FAMILY_READ", "GLOBAL_IGNORED", "KEYS_ONLY_BLENDERPROC",
            "Note", "TRANSLATORS", "UNAVAILABLE", "WRITERS", "custom_properties", "finish", "samplers_as_blenderproc",
            "selector", "translate_module", "unavailable_reason"]

@@ -38,6 +38,21 @@ def _renderer_common(cfg: dict[str, Any], note: Note) -> None:
     pop_ignored(cfg, "output_is_temp", note, GLOBAL_IGNORED["output_is_temp"])
 
 
+def render_pixel_aspect(config: dict[str, Any], note: Note, version: Any) -> list[tuple[str, dict[str, Any]]]:
+    """A renderer's ``pixel_aspect_x`` (taken out of ``config``): BlenderProc 1.0's renderers set Blender's pixel
+    aspect when they render (their ``global.renderer`` default in its SUNCG and Replica examples: 4/3), so the
+    camera renders from then on with ``fy = fx x pixel_aspect_x`` - a ``camera.PixelAspect`` entry to run before
+    the renderer. BlenderProc 1.12's renderers do not read the key (a notice)."""
+    if "pixel_aspect_x" not in config:
+        return []
+    value = config.pop("pixel_aspect_x")
+    if version is not None:
+        note("ignored: BlenderProc 1.12's renderers do not read it (a camera module's intrinsics do)",
+             "pixel_aspect_x")
+        return []
+    return [("camera.PixelAspect", {"pixel_aspect_x": value})]
+
+
 def rgb(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]]]:
     cfg = dict(config)
     _output_keys(cfg, note, "colors")

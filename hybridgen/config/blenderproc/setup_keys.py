@@ -21,8 +21,15 @@ GLOBAL_IGNORED = {
                             "refractive (transmission_bounces)",
     "volume_bounces": "hybridgen renders no volumes",
     "output_is_temp": "hybridgen keeps no temporary per-frame files; writers write the final files",
-    "pixel_aspect_x": "hybridgen cameras have square pixels unless cam_K says otherwise",
-    "pixel_aspect_y": "hybridgen cameras have square pixels unless cam_K says otherwise",
+    "pixel_aspect_x": "not applied from here: set it in a camera module's intrinsics (BlenderProc 1.12) or in "
+                      "global.renderer (1.0)",
+    "pixel_aspect_y": "not applied from here: set it in a camera module's intrinsics (BlenderProc 1.12)",
     "avoid_rendering": "hybridgen always renders what the config's renderers ask",
 }
 """``global`` keys that only configure Blender or BlenderProc internals: ignored with a notice."""
+
+
+FAMILY_READ = {"renderer": ("pixel_aspect_x",)}
+"""BlenderProc 1.0 ``global.<family>`` keys that this family's modules read, although the same key in
+``global.all`` configures nothing: its renderers set ``pixel_aspect_x`` when they render (translated into a
+``camera.PixelAspect`` before the renderer, :func:`hybridgen.config.blenderproc.renderers.render_pixel_aspect`)."""

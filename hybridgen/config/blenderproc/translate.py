@@ -13,7 +13,7 @@ from .manipulators import entity, material
 from .names import ALIASES
 from .objects import (bop_loader, camera_loader, camera_sampler, loader, mesh_initializer, passthrough, physics,
                       pose_sampler, replacer)
-from .renderers import rgb, segmap, single_pass
+from .renderers import render_pixel_aspect, rgb, segmap, single_pass
 from .room_cameras import floor_extractor, ply_loader, room_sampler
 from .room import random_room
 from .selectors import samplers_as_blenderproc
@@ -81,7 +81,7 @@ def translate_module(name: str, config: dict[str, Any], note: Note,
         if not name.startswith("renderer."):
             return TRANSLATORS[name](config, note)
         image_type = take_image_type(config, note)
-        before = alpha_entries(config, note)
+        before = [*render_pixel_aspect(config, note, state.get("version")), *alpha_entries(config, note)]
         out = TRANSLATORS[name](config, note)
         if image_type is not None:
             for target, target_config in out:
