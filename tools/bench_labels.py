@@ -110,10 +110,11 @@ def _ours_worker(conn: Any, checkout: str | None = None) -> None:
             conn.send(len(keypoints) / label_pass(scene, view, keypoints, [StoredFormSink()]))
         elif kind == "hdf5":  # writer built, every keypoint written, file finalized: all timed
             compression = options[0]
-            if compression == "blosc2-depth":  # a variant measured: Blosc2 for float depth only
+            if compression == "blosc2-all":  # a variant measured: Blosc2 LZ4 for the normal codes too
                 import hybridgen.io.hdf5_single as hs
                 compression, chunks = "blosc2", hs.blosc2_chunks
-                hs.blosc2_chunks = lambda stored, level, chunks=chunks: chunks(stored, level) if stored.shuffle else None
+                hs.blosc2_chunks = lambda stored, level, chunks=chunks: chunks(stored, level) or (
+                    hs.Blosc2Chunks("lz4", level, "none", stored.dtype.itemsize) if stored.dtype.itemsize > 1 else None)
             with tempfile.TemporaryDirectory() as tmp:
                 path = Path(tmp) / "data.hdf5"
                 start = time.perf_counter()
@@ -123,7 +124,7 @@ def _ours_worker(conn: Any, checkout: str | None = None) -> None:
                 writer.finalize({"object_states": [o.state() for o in scene.objects]})
                 elapsed = time.perf_counter() - start
                 conn.send((len(keypoints) / elapsed, path.stat().st_size / len(keypoints)))
-            if options[0] == "blosc2-depth":
+            if options[0] == "blosc2-all":
                 hs.blosc2_chunks = chunks
         elif kind == "frame":
             raw = view.render_raw(keypoints[0])
@@ -528,9 +529,9 @@ def main() -> None:
     parser.add_argument("--e2e-keypoints", type=int, default=E2E_KEYPOINTS, help="keypoints of each in-process raw "
                         "and end-to-end measurement (writer created, every keypoint written, file finalized)")
     parser.add_argument("--e2e-compression", nargs="+", default=["default"],
-                        choices=["default", "gzip", "blosc2", "blosc2-depth", "lzf", "none"],
-                        help="with --e2e-only: writer compressions timed in the same rounds (blosc2-depth: Blosc2 for "
-                        "the float depth only, a variant)")
+                        choices=["default", "gzip", "blosc2", "blosc2-all", "lzf", "none"],
+                        help="with --e2e-only: writer compressions timed in the same rounds (blosc2-all: a variant, "
+                        "Blosc2 LZ4 for the normal codes too)")
     parser.add_argument("--baseline", type=Path, help="with --e2e-only: also time another checkout's hybridgen "
                         "(e.g. git archive <commit> | tar -x -C /tmp/base) in the same rounds")
     parser.add_argument("--cache-dir", type=Path, help="HYBRIDGEN_CACHE_DIR of the whole-process runs "

@@ -8,10 +8,12 @@ own compression makes the same kind of frame (or a b2nd one for chunks of rank 2
 
 Bytes are deterministic: one thread per compression (Blosc2's own threads place finished blocks in the
 order they finish), the same codec, level, filter and block size, and the frame header's fields fixed by
-them. They can change with the Blosc2 format version, as deflate's bytes can with the zlib/ISA-L version.
+them; c-blosc2's ``BLOSC_*`` environment overrides are refused (:func:`_one_thread_contexts`). They can change
+with the Blosc2 format version, as deflate's bytes can with the zlib/ISA-L version.
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from typing import Any
 
@@ -23,6 +25,12 @@ SHUFFLES = {"none": 0, "byte": 1, "bit": 2}
 """Blosc2 filters before the codec -> the filter's doshuffle (cd_values[5])."""
 
 
+OVERRIDING_ENVIRONMENT = ("BLOSC_BLOCKSIZE", "BLOSC_CLEVEL", "BLOSC_COMPRESSOR", "BLOSC_DELTA", "BLOSC_SHUFFLE",
+                          "BLOSC_SPLITMODE", "BLOSC_TYPESIZE")
+"""Variables c-blosc2 reads whenever it makes a compression context (``blosc2_create_cctx``), overriding the
+parameters given: with any of them set, the chunks would not be the codec this file records."""
+
+
 def _blosc2() -> Any:
     try:
         import blosc2
@@ -30,7 +38,26 @@ def _blosc2() -> Any:
         raise InputError("compression 'blosc2' needs the blosc2 package: pip install blosc2 "
                          "(or pip install 'hybridgen[blosc2]')") from None
     blosc2.set_releasegil(True)  # compress on the writer's pool threads while the render thread runs
+    _one_thread_contexts()
     return blosc2
+
+
+def _one_thread_contexts() -> None:
+    """Every Blosc2 context of this process gets one thread (``BLOSC_NTHREADS=1``, which c-blosc2 reads at
+    context creation). Our chunks ask for one thread anyway (with more, Blosc2 places compressed blocks in the
+    order they finish: other bytes), but serializing a frame compresses its offsets with a context of 4
+    threads that c-blosc2 makes itself (``frame.c``): it started and joined 4 threads for every chunk, ~1-3 ms
+    of wall time per frame for 0.1 ms of work (measured here, 2 cores, under load). The writer's pool is the
+    parallelism."""
+    given = [name for name in OVERRIDING_ENVIRONMENT if os.environ.get(name)]
+    threads = os.environ.get("BLOSC_NTHREADS")
+    if threads not in (None, "", "1"):
+        given.append("BLOSC_NTHREADS")
+    if given:
+        raise InputError(f"compression 'blosc2': unset the environment variable(s) {', '.join(given)}: c-blosc2 "
+                         "lets them override the codec, level, shuffle and threads hybridgen asks for, so the "
+                         "stored bytes would depend on them")
+    os.environ["BLOSC_NTHREADS"] = "1"
 
 
 @dataclass(frozen=True)
@@ -62,6 +89,6 @@ class Blosc2Chunks:
         """The stored chunk of ``data`` (a contiguous array or buffer): a one-chunk super-chunk frame."""
         blosc2 = _blosc2()
         view = memoryview(data).cast("B")
-        schunk = blosc2.SChunk(chunksize=view.nbytes, cparams=self._cparams())
+        schunk = blosc2.SChunk(chunksize=view.nbytes, cparams=self._cparams(), dparams={"nthreads": 1})
         schunk.append_data(view)
         return bytes(schunk.to_cframe())

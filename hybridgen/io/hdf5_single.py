@@ -98,12 +98,13 @@ _UNKNOWN = _UnknownStream()
 
 
 def blosc2_chunks(stored: StoredPass, level: int) -> Blosc2Chunks | None:
-    """The Blosc2 codec of a pass under ``compression: blosc2``, or None where deflate stays (items of one
-    byte: the id maps, which deflate makes smaller at the same speed, tools/bench_writer.py): LZ4 at ``level``,
-    float passes byte-shuffled (as gzip's shuffle filter), other passes (octahedral normal codes) as they are."""
-    if stored.dtype.itemsize == 1:
+    """The Blosc2 codec of a pass under ``compression: blosc2``: LZ4 at ``level`` over the byte-shuffled float
+    passes (depth: 0.5-0.75x ISA-L's CPU with the shuffle, ~18 % more bytes); None where deflate stays - the
+    octahedral normal codes (LZ4 gave 1.2-2.6x the bytes for 0.75-0.8x the CPU) and the id maps (LZ4 gave twice
+    the bytes at the same speed; tools/bench_writer.py, docs/label_pipeline.md)."""
+    if not stored.shuffle:
         return None
-    return Blosc2Chunks("lz4", level, "byte" if stored.shuffle else "none", stored.dtype.itemsize)
+    return Blosc2Chunks("lz4", level, "byte", stored.dtype.itemsize)
 
 
 def default_threads() -> int:
@@ -147,9 +148,10 @@ class Hdf5Options:
     (:func:`~hybridgen.config.options.option_params`)."""
 
     compression: str = option("gzip", "str", "dataset compression: gzip (any HDF5 reader), blosc2 (single layout: "
-                              "Blosc2 LZ4 for depth and normals, gzip for id maps; about a third less writer CPU, "
-                              "~10-40 % more bytes; readers need hdf5plugin: pip install hdf5plugin, then import "
-                              "hdf5plugin before h5py opens the file), lzf, none", choices=COMPRESSIONS)
+                              "depth byte-shuffled and LZ4-compressed by Blosc2 without a process-wide lock, the "
+                              "other passes gzip: ~20 % less writer CPU, 10-15 % more bytes, no faster end to end "
+                              "on 2 cores; plain h5py readers need hdf5plugin: pip install hdf5plugin, then import "
+                              "hdf5plugin before opening the file), lzf, none", choices=COMPRESSIONS)
     encoding: str = option("compact", "str", "single layout: compact (ids in the smallest integer type, normals "
                            "octahedral uint16 within 1e-4 rad, distance derived from depth; read them with "
                            "hybridgen.data or hybridgen.io.label_encoding.decode_dataset, docs/outputs.md) or plain "

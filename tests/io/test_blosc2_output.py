@@ -48,14 +48,15 @@ def files(gl_context, tmp_path_factory):
 
 
 def test_filters_per_pass(files):
-    """Depth (byte-shuffled) and the normal codes go through Blosc2 LZ4, the 1-byte id maps stay gzip; the file
-    says how to read it."""
+    """Depth (byte-shuffled) goes through Blosc2 LZ4, the normal codes and id maps stay gzip; the file says how
+    to read it."""
     with h5py.File(files[1]) as f:
         filters = {key: f[key]._filters for key in ("depth", "normals", "instance_segmaps", "category_id_segmaps")}
         assert "hdf5plugin" in f.attrs["filters_needed"]
-    depth, normals = filters["depth"][str(BLOSC2_FILTER_ID)], filters["normals"][str(BLOSC2_FILTER_ID)]
-    assert depth[4:7] == (1, 1, 1) and normals[4:7] == (1, 0, 1)  # level 1, byte shuffle / none, LZ4
-    assert set(filters["instance_segmaps"]) == {"gzip"} and set(filters["category_id_segmaps"]) == {"gzip"}
+    assert filters["depth"][str(BLOSC2_FILTER_ID)][4:7] == (1, 1, 1)  # level 1, byte shuffle, LZ4
+    assert set(filters["depth"]) == {str(BLOSC2_FILTER_ID)}
+    for key in ("normals", "instance_segmaps", "category_id_segmaps"):
+        assert set(filters[key]) == {"gzip"}, key
     with h5py.File(files[0]) as f:
         assert "filters_needed" not in f.attrs
 
@@ -201,3 +202,14 @@ def test_blenderproc_layout_refuses_blosc2(tmp_path, write_config, run_cli):
     code, _, err = run_cli("run", str(write_config(config)), str(tmp_path / "out"))
     assert code == 2 and "compression" in err and "blenderproc" in err, err
     assert not list((tmp_path / "out").glob("*.hdf5"))
+
+
+@pytest.mark.parametrize("variable,value", [("BLOSC_CLEVEL", "9"), ("BLOSC_NTHREADS", "4"), ("BLOSC_SHUFFLE", "0")])
+def test_environment_overrides_of_the_codec_are_refused(monkeypatch, variable, value):
+    """c-blosc2 lets BLOSC_* variables override a context's codec, level, shuffle or threads (other bytes, or
+    blocks in the order threads finish): the writer refuses them by name instead of writing such chunks."""
+    from hybridgen.errors import InputError
+
+    monkeypatch.setenv(variable, value)
+    with pytest.raises(InputError, match=variable):
+        Blosc2Chunks("lz4", 1, "byte", 4).encode(np.zeros((8, 8), np.float32))
