@@ -135,11 +135,17 @@ def choose_variant(requested: str | None = None) -> str:
 
 
 def activate(variant: str) -> None:
-    """Make ``variant`` the current Mitsuba variant of this process, with the threads it was given."""
+    """Make ``variant`` the current Mitsuba variant of this process, with the threads it was given. Mitsuba's
+    Python AD integrators, which the first switch to a JIT variant would execute, run on first use instead
+    (:mod:`hybridgen.render.deferred_ad_integrators`)."""
     import mitsuba as mi
 
     if mi.variant() != variant:
+        from . import deferred_ad_integrators
+
+        deferred = deferred_ad_integrators.defer() if is_jit(variant) else {}
         mi.set_variant(variant)
+        deferred_ad_integrators.register_forwarders(deferred)
     apply_thread_limit()
 
 
