@@ -99,8 +99,8 @@ _UNKNOWN = _UnknownStream()
 
 def blosc2_chunks(stored: StoredPass, level: int) -> Blosc2Chunks | None:
     """The Blosc2 codec of a pass under ``compression: blosc2``: LZ4 at ``level`` over the byte-shuffled float
-    passes (depth: 0.5-0.75x ISA-L's CPU with the shuffle, ~18 % more bytes); None where deflate stays - the
-    octahedral normal codes (LZ4 gave 1.2-2.6x the bytes for 0.75-0.8x the CPU) and the id maps (LZ4 gave twice
+    passes (depth: 0.5-0.63x ISA-L's CPU with the shuffle, ~18 % more bytes); None where deflate stays - the
+    octahedral normal codes (LZ4 gave 1.2-2.6x the bytes for 0.5-0.75x the CPU) and the id maps (LZ4 gave twice
     the bytes at the same speed; tools/bench_writer.py, docs/label_pipeline.md)."""
     if not stored.shuffle:
         return None
