@@ -443,7 +443,8 @@ def quality_row(name: str, scene: Any, content: str, refs: References, session: 
     from PIL import Image
 
     resolution = refs.resolution
-    row: dict[str, Any] = {"scene": name, "resolution": resolution, "reference_spp": refs.spp}
+    row: dict[str, Any] = {"scene": name, "resolution": resolution, "reference_spp": refs.spp, "lobes": refs.lobes,
+                           "hg_threshold": args.hg_threshold}
     ref, record = refs.hybridgen(name, scene, content, CLAMP)
     ref_unclamped, _ = refs.hybridgen(name, scene, content, 0.0)
     row["hg_ref_s"], row["hg_ref_cached"] = record["seconds"], record["cached"]
@@ -523,6 +524,14 @@ def run_quality(args: Any, bpy_python: Path | None) -> list[dict[str, Any]]:
     return rows
 
 
+def _row_name(row: dict[str, Any]) -> str:
+    """The scene's name in the table, with hybridgen's settings where they are not its defaults (rows of older
+    JSON files have no such keys)."""
+    notes = [f"{row['lobes']} lobes"] if row.get("lobes", "default") != "default" else []
+    notes += [f"threshold {row['hg_threshold']:g}"] if row.get("hg_threshold") is not None else []
+    return row["scene"] + (f" ({', '.join(notes)})" if notes else "")
+
+
 def print_table(rows: list[dict[str, Any]], reference_spp: int) -> None:
     """The rows as a Markdown table (goal: hybridgen's PSNR >= Cycles' and time ratio <= 0.5)."""
     if not rows:
@@ -540,10 +549,10 @@ def print_table(rows: list[dict[str, Any]], reference_spp: int) -> None:
         cpu_ratio = r["hg_cpu_s"] / r["cycles_cpu_s"] if r.get("cycles_cpu_s") else nan
         clean = r["hg_psnr"] >= r.get("cycles_psnr", nan)
         goal = " / ".join("yes" if clean and ratio <= 0.5 else "no" for ratio in (wall_ratio, cpu_ratio))
-        print(f"| {r['scene']} | {r['hg_psnr']:.1f} ({r['hg_mean_spp']:.0f}) | {r['hg_s']:.2f} | {r['hg_cpu_s']:.2f} | "
-              f"{r['hg_cold_s']:.2f} | {r['hg_inprocess_s']:.2f} | {r.get('cycles_psnr', nan):.1f} | "
-              f"{r.get('cycles_s', nan):.2f} | {r.get('cycles_cpu_s', nan):.2f} | {wall_ratio:.2f} | {cpu_ratio:.2f} | "
-              f"{goal} | {r['clamp_bias_psnr']:.1f} |")
+        print(f"| {_row_name(r)} | {r['hg_psnr']:.1f} ({r['hg_mean_spp']:.0f}) | {r['hg_s']:.2f} | "
+              f"{r['hg_cpu_s']:.2f} | {r['hg_cold_s']:.2f} | {r['hg_inprocess_s']:.2f} | "
+              f"{r.get('cycles_psnr', nan):.1f} | {r.get('cycles_s', nan):.2f} | {r.get('cycles_cpu_s', nan):.2f} | "
+              f"{wall_ratio:.2f} | {cpu_ratio:.2f} | {goal} | {r['clamp_bias_psnr']:.1f} |")
     print("\nclamp bias: PSNR of hybridgen's clamped reference against its unclamped one (higher = less bias; inf = "
           "none). Warm-run phases (s) per scene, startup / import / build / render / write / exit:")
     for r in rows:
