@@ -19,17 +19,16 @@ density gives the same expectation, so the estimate stays unbiased (tests/render
 learning pass uses a fixed pattern that depends on the pose only, so the result stays a pure function of the
 seed. Open scenes (the world visible over most of the hemisphere: the tabletops) are left as they were.
 
-Why it is off (measured in session 6, docs/color_quality.md; window room, 320x240 unless said, loaded 2-core
-machine): at 128 spp fixed the raw error drops 44 % (8-bit MSE against two 4096-spp references 19.9 -> 11.2;
-one direction grid for the whole scene instead of voxels: -17 %), but the extra shadow ray, BSDF evaluation and
-cell search per vertex cost +50 % kernel CPU (3.4 -> 5.1 s), and the default render scored 48.34 -> 46.61 dB
-against the benchmark's reference for 25.7 -> 36 s of sampling CPU. That reference is not the truth: Mitsuba's
-low-discrepancy sampler (``ldsampler``, hybridgen's default) makes the window room 0.75 % brighter than
-independent random numbers do (80x60, 512 spp, 3 seeds each: image mean 0.13905 vs 0.13802 +- 0.0001; direct
-light alone agrees within 0.07 %; the tabletop agrees within 0.02 %), while with this guide both samplers agree
-(0.13796 and 0.13805). So part of the lost score is the default's own sampler bias in the reference. To turn
-it on by default it must first cost less (fewer learned cells to search, the extra sample only where the
-world is reachable) and be scored against an unbiased reference.
+Why it is off (session 7, docs/color_quality.md; window room, 320x240, Owen-Sobol samples, loaded 2-core
+machine): at 128 spp fixed it halves the variance between two seeds (8-bit sRGB: 17.8 -> 7.9) for +60 % CPU
+(2.9-3.1 -> 5.0 s, learning included), 30 % less variance x CPU; but in the default pipeline (adaptive, 1024-spp
+cap, OIDN) it buys +0.3 dB (50.60 -> 50.90 dB against a 4096-spp reference) for +36 % sampling CPU (20.9 -> 28.5 s):
+the cap binds in most pixels and the denoiser evens out the rest, and the window room already meets the goal
+without it (49.1 dB vs Cycles' 48.9 at 0.44 of its CPU). Session 6's grid (4 x 4 x 4 voxels, 16 x 32 cells, 32
+learning rays per point) cost the same and kept more variance (9.7); the cell search and the MIS density per
+vertex are a third of the extra cost (no vertex guided: +0.56 s), the shadow ray and BSDF evaluation the rest;
+guiding only the first one or two vertices of a path kept most of the cost and little of the gain (variance 16.4 /
+13.4 at 3.96 / 4.33 s).
 """
 from __future__ import annotations
 
@@ -39,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-Z_CELLS, PHI_CELLS = 16, 32
+Z_CELLS, PHI_CELLS = 8, 16
 """Equal-area direction grid: bands of equal height in z (world up), sectors of equal azimuth."""
 UNIFORM_SHARE = 0.2
 """Share of the world's light samples drawn uniformly over the sphere (the rest from the learned counts)."""
@@ -50,11 +49,11 @@ MAX_OPEN_FRACTION = 0.25
 """The world is light-sampled only if fewer than this share of the learning rays reach it."""
 GRID = (64, 48)
 """Camera rays of the learning pass (film positions, cell centres)."""
-DIRECTIONS = 32
+DIRECTIONS = 128
 """Cosine-distributed rays per surface point of the learning pass."""
 
 
-VOXELS = (4, 4, 4)
+VOXELS = (8, 8, 8)
 """Cells of the box around the learning points (x, y, z), each with its own direction counts."""
 MIN_VOXEL_COUNT = 64
 """A voxel with fewer world-reaching learning rays uses the counts of all voxels together."""
