@@ -74,7 +74,7 @@ import numpy as np
 
 from ..errors import InputError
 from . import pixel_filter
-from .owen_sobol import MAX_SAMPLES as MAX_SOBOL_PATTERN, OwenSobol, mix
+from .owen_sobol import OwenSobol, mix
 
 CYCLES_THRESHOLD_SCALE = 5.0
 """The error estimate is compared with ``noise_threshold`` times this (Cycles' own factor, in its
@@ -199,18 +199,23 @@ class PixelTracer:
         self.world_guide = guide
         self.integrator.world_guide = None if guide is None else world_guide.JitGuide.of(guide, self._world_radiance)
 
-    def trace(self, pixels: np.ndarray, spp: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    def trace(self, pixels: np.ndarray, spp: int, seed: int,
+              first: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Sums of linear RGB over the first and the second half of ``spp`` samples of every pixel in
         ``pixels`` (flat indices ``v * width + u``): two float64 arrays of shape (len(pixels), 3).
 
-        hybridgen's Owen-Sobol sampler (:data:`OWEN_SOBOL`) traces ``spp`` as one pattern per pixel. The sensor's
-        Mitsuba sampler may only accept some sample counts (stratified patterns: powers of two for
-        ``ldsampler``), so ``spp`` is split into counts it accepts (:func:`launch_counts`); equal counts are
+        hybridgen's Owen-Sobol sampler (:data:`OWEN_SOBOL`) gives each pixel one pattern per ``seed`` (the
+        keypoint's: adaptive rounds continue it) and traces its samples number ``first`` (per pixel, 0 if not
+        given) to ``first + spp - 1``: a pixel's samples of all rounds are one prefix of its sequence, every
+        power-of-two part of it stratified. The sensor's Mitsuba sampler may only accept some sample counts
+        (stratified patterns: powers of two for ``ldsampler``), so ``spp`` is split into counts it accepts (:func:`launch_counts`); equal counts are
         one launch (a pattern per count and pixel), each launch with its own seed derived from ``seed``; each
         pattern's first half of samples goes to the first sum.
         An odd ``spp`` (fixed-count rendering only) leaves the odd sample in the first sum."""
+        if self.owen_sobol:
+            return self._launch(pixels, spp, 1, seed, np.zeros(len(pixels), np.uint32) if first is None else first)
         sum_a, sum_b = np.zeros((len(pixels), 3)), np.zeros((len(pixels), 3))
-        counts = launch_counts(spp, "OwenSobol" if self.owen_sobol else self.sensor.sampler().class_name())
+        counts = launch_counts(spp, self.sensor.sampler().class_name())
         launches = [(count, len(list(same))) for count, same in itertools.groupby(counts)]
         for index, (count, copies) in enumerate(launches):
             a, b = self._launch(pixels, count, copies,
@@ -219,10 +224,12 @@ class PixelTracer:
             sum_b += b
         return sum_a, sum_b
 
-    def _launch(self, pixels: np.ndarray, spp: int, copies: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    def _launch(self, pixels: np.ndarray, spp: int, copies: int, seed: int,
+                first: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """One wavefront of ``len(pixels) x copies x spp`` samples, pixel-major: ``copies`` patterns of ``spp``
         samples per pixel (each copy of a pixel is its own sequence for the sampler: its own scramble); the
-        halves' sums as :meth:`trace`, each half the sum of the copies' halves."""
+        halves' sums as :meth:`trace`, each half the sum of the copies' halves. With the Owen-Sobol sampler
+        (one copy) the samples are numbers ``first`` .. ``first + spp - 1`` of each pixel's pattern."""
         import drjit as dr
         import mitsuba as mi
 
@@ -234,8 +241,9 @@ class PixelTracer:
         pixel = dr.gather(mi.UInt32, mi.UInt32(np.ascontiguousarray(pixels, np.uint32)), local)
         v = pixel // width_o
         u = pixel - v * width_o
-        if self.owen_sobol:  # each pixel (copy) one pattern of spp samples, seeded by the launch and the pixel
-            sampler = OwenSobol(index - local * spp_o, mix(local ^ dr.opaque(mi.UInt32, mix(seed % 2**32))))
+        if self.owen_sobol:  # each pixel one pattern, seeded by the keypoint and the pixel
+            start = dr.gather(mi.UInt32, mi.UInt32(np.ascontiguousarray(first, np.uint32)), local)
+            sampler = OwenSobol(start + index - local * spp_o, mix(pixel ^ dr.opaque(mi.UInt32, mix(seed % 2**32))))
         else:
             sampler = self.sensor.sampler().fork()
             sampler.set_sample_count(pattern_size(spp, sampler.class_name()))
@@ -305,8 +313,7 @@ def pattern_size(spp: int, sampler: str) -> int:
 
 def launch_counts(spp: int, sampler: str) -> list[int]:
     """``spp`` as a sum of sample counts ``sampler`` (a Mitsuba sampler's class name) takes exactly, largest
-    first: ``spp`` itself for samplers that take any count (``IndependentSampler``; ``OwenSobol``, hybridgen's own,
-    in patterns of at most :data:`hybridgen.render.owen_sobol.MAX_SAMPLES`); for the low-discrepancy
+    first: ``spp`` itself for samplers that take any count (``IndependentSampler``); for the low-discrepancy
     sampler (``LowDiscrepancySampler``) whole patterns of 4^k points (at most :data:`MAX_PATTERN`), each as
     often as it fits, and a rest below 4 as 2 (half of a 4-point pattern) and 1. Equal counts are traced in
     one launch (:meth:`PixelTracer.trace`), each copy of a pixel with its own scramble.
@@ -317,9 +324,6 @@ def launch_counts(spp: int, sampler: str) -> list[int]:
     tabletop of tools/color_quality.py (160x120, PSNR against a 2048-spp reference, 3 seeds) 64 + 64 + 2 x 64
     samples are 49.65 dB where 64 + 64 + half of 256 were 49.19 dB and two halves of 256 48.45 dB (one
     256-point pattern: 49.56 dB)."""
-    if sampler == "OwenSobol":  # hybridgen's (render/owen_sobol.py): any count, one pattern up to its maximum
-        whole, rest = divmod(spp, MAX_SOBOL_PATTERN)
-        return [MAX_SOBOL_PATTERN] * whole + ([rest] if rest else [])
     if sampler != "LowDiscrepancySampler":
         return [spp]
     out, rest = [], spp
@@ -350,7 +354,10 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int) -> tuple
         per_chunk = max(1, MAX_WAVEFRONT // spp)
         for chunk, start in enumerate(range(0, len(active), per_chunk)):
             pixels = active[start:start + per_chunk]
-            a, b = tracer.trace(pixels, spp, round_seed(seed, round_index, chunk))
+            if getattr(tracer, "owen_sobol", False):  # one pattern per pixel, continued from round to round
+                a, b = tracer.trace(pixels, spp, seed, first=count[pixels])
+            else:
+                a, b = tracer.trace(pixels, spp, round_seed(seed, round_index, chunk))
             sum_a[pixels] += a
             sum_b[pixels] += b
         count[active] += spp

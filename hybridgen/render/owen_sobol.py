@@ -15,10 +15,10 @@ with its own hash of the sequence's seed and the set. Per set:
 Sets are decorrelated by their own seeds (a full-avalanche hash of the sequence seed and the set index:
 :func:`mix`), so the joint distribution of any two sets is uniform in expectation - unlike Mitsuba 3.9's
 ``ldsampler``, whose dimensions share one XOR scramble and permutation seeds one apart (two rounds of TEA), which
-rendered the window room of tools/color_quality.py 0.75 % too bright (docs/color_quality.md). Only the low
-:data:`INDEX_BITS` bits of the shuffled index are turned into Sobol digits: a pattern has at most
-``2^INDEX_BITS`` samples, and the bits above are a constant per pattern (a digital shift the Owen scramble
-absorbs).
+rendered the window room of tools/color_quality.py 0.69 % too bright (docs/color_quality.md). Only the low
+:data:`INDEX_BITS` bits of the index are turned into Sobol digits (after the shuffle, the bits above are a
+constant per block: a digital shift the Owen scramble absorbs); each further block of ``2^INDEX_BITS`` samples of
+a sequence is a pattern of its own (the seed hashed with the block's number).
 
 The fields are Dr.Jit state (``DRJIT_STRUCT``), so a symbolic loop carries the set counter from one iteration
 to the next.
@@ -28,9 +28,9 @@ from __future__ import annotations
 from typing import Any
 
 INDEX_BITS = 16
-"""Bits of the (shuffled) sample index turned into Sobol digits: at most 65536 samples per pattern."""
+"""Bits of the (shuffled) sample index turned into Sobol digits: blocks of 65536 samples are one pattern each."""
 MAX_SAMPLES = 1 << INDEX_BITS
-"""Samples one pattern (one sequence seed) gives at most."""
+"""Samples of one pattern; a sequence's next samples come from a pattern of their own."""
 
 
 def sobol_direction_numbers() -> list[int]:
@@ -109,16 +109,16 @@ def _to_unit(reversed_digits: Any) -> Any:
 def sample_2d(index: Any, seed: Any) -> tuple[Any, Any]:
     """The shuffled, Owen-scrambled Sobol point number ``index`` of the pattern ``seed`` (UInt32 each): two
     floats in [0, 1)."""
-    shuffled = reverse_bits(reversed_owen(reverse_bits(index), mix(seed ^ 0xBFF95BFE)))
+    seed = mix(seed ^ (index >> INDEX_BITS))  # each block of MAX_SAMPLES samples: a pattern of its own
+    shuffled = reverse_bits(reversed_owen(reverse_bits(index & (MAX_SAMPLES - 1)), mix(seed ^ 0xBFF95BFE)))
     x, y = _sobol_reversed(shuffled)
     return _to_unit(reversed_owen(x, mix(seed ^ 0x2B9C3E1D))), _to_unit(reversed_owen(y, mix(seed ^ 0x68E31DA4)))
 
 
 class OwenSobol:
     """A sampler for hybridgen's Python integrators (``next_1d`` / ``next_2d``, as a Mitsuba sampler is
-    called): sample ``index`` (UInt32, per lane: the sample's number in its pattern, below
-    :data:`MAX_SAMPLES`) of the pattern ``seed`` (UInt32, per lane: one per pixel and launch); each call is
-    the next dimension set (module docstring)."""
+    called): sample ``index`` (UInt32, per lane: the sample's number in its sequence) of the sequence ``seed``
+    (UInt32, per lane: one per pixel and keypoint); each call is the next dimension set (module docstring)."""
 
     DRJIT_STRUCT = {"index": object, "seed": object, "dimension": object}
 

@@ -106,7 +106,24 @@ def test_render_keeps_the_expectation_and_is_deterministic(monkeypatch):
     assert counts.min() >= 80 and np.array_equal(image, adaptive.render_with_counts(pose, seed=3)[0])
 
 
-def test_launch_counts_of_the_owen_sobol_sampler():
-    assert adaptive_sampling.launch_counts(80, "OwenSobol") == [80]
-    assert adaptive_sampling.launch_counts(3 * owen_sobol.MAX_SAMPLES + 5, "OwenSobol") == \
-        [owen_sobol.MAX_SAMPLES] * 3 + [5]
+def test_adaptive_rounds_continue_each_pixels_pattern():
+    """Samples 0..n-1 of a pixel traced in two rounds (first 0 and n/2) are the samples of one n-sample trace."""
+    variant = _jit_variant()
+    from tests.render.test_world_guide import _box
+
+    scene = _box()
+    view = PathTraceView(scene, PathTraceSettings(samples=64), variant=variant)
+    view.set_pose(scene.camera.keypoints[0])
+    tracer = view._tracer
+    pixels = np.arange(0, tracer.width * tracer.height, 7)
+    whole = np.add(*tracer.trace(pixels, 64, seed=5))
+    first = np.add(*tracer.trace(pixels, 32, seed=5, first=np.zeros(len(pixels), np.uint32)))
+    rest = np.add(*tracer.trace(pixels, 32, seed=5, first=np.full(len(pixels), 32, np.uint32)))
+    np.testing.assert_allclose(first + rest, whole, rtol=1e-5, atol=1e-6)
+    other = np.add(*tracer.trace(pixels, 32, seed=5, first=np.full(len(pixels), 64, np.uint32)))
+    assert not np.allclose(other, rest)  # later samples of the sequence are other samples
+    # a sequence past one pattern's MAX_SAMPLES samples goes on in a pattern of its own
+    import mitsuba as mi
+
+    beyond = owen_sobol.sample_2d(mi.UInt32([3, owen_sobol.MAX_SAMPLES + 3]), mi.UInt32([9, 9]))
+    assert np.asarray(beyond[0])[0] != np.asarray(beyond[0])[1]
