@@ -29,7 +29,10 @@ OPENCV_TO_MITSUBA = np.diag([-1.0, -1.0, 1.0, 1.0])
 
 
 SAMPLER = "ldsampler"
-"""Mitsuba's sample generator: its low-discrepancy sampler (a scrambled (0, 2)-sequence per pair of
+"""The sensor's Mitsuba sampler. hybridgen's Python integrator (every default render in a JIT variant) draws
+from :mod:`hybridgen.render.owen_sobol` in its place (unbiased: this sampler's dimensions correlate, see
+:data:`hybridgen.render.adaptive_sampling.OWEN_SOBOL`); Mitsuba's own integrators (``scalar_rgb``, or clamp and
+filter glossy both off) use it. It is Mitsuba's low-discrepancy sampler (a scrambled (0, 2)-sequence per pair of
 dimensions, the sample order shuffled per dimension), stratified like Cycles' Sobol pattern. Because of the
 shuffle, the two halves adaptive sampling compares are random halves of a stratified set, so its error
 estimate is conservative (it sees more noise than the full estimate has) and pixels may get more samples
