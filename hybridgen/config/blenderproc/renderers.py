@@ -53,8 +53,14 @@ def render_pixel_aspect(config: dict[str, Any], note: Note, version: Any) -> lis
     return [("camera.PixelAspect", {"pixel_aspect_x": value})]
 
 
+BLENDERPROC_LOBE_BOUNCES = {"glossy_bounces": 0, "transmission_bounces": 0}
+"""BlenderProc's own defaults of its RgbRenderer (1.0 and 1.12; hybridgen's own default is ``max_bounces`` for
+every lobe): no glossy or transmission bounce, so metals and mirrors reflect only the lights and glass renders
+dark - what a BlenderProc config renders in BlenderProc."""
+
+
 def rgb(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]]]:
-    cfg = dict(config)
+    cfg = {**BLENDERPROC_LOBE_BOUNCES, **config}
     _output_keys(cfg, note, "colors")
     _renderer_common(cfg, note)
     if "render_diffuse_color" in cfg:
