@@ -156,13 +156,13 @@ class PathTraceSettings:
         return {name: value for name, value in self._lobe_bounces().items()
                 if value is not None and value < self.max_bounces}
 
-    def integrator_for(self, variant: str, transparent_shadows: bool = False,
-                       hidden_emission: bool = False) -> dict[str, Any]:
-        """The integrator used in ``variant``: hybridgen's clamped path tracer where it can run (JIT variants)
-        and is needed (clamp on, per-lobe limits, ``transparent_shadows`` for a scene with alpha surfaces:
-        :mod:`hybridgen.render.transparent_shadows`, or ``hidden_emission``:
-        :mod:`hybridgen.render.camera_hidden_emission`), else :meth:`integrator` (``volpath`` in
-        ``scalar_rgb`` with ``transparent_shadows``)."""
+    def integrator_for(self, variant: str, transparent_shadows: bool = False) -> dict[str, Any]:
+        """The integrator used in ``variant``: hybridgen's clamped path tracer wherever it can run (JIT variants;
+        also with clamp and filter glossy off, so every JIT render draws the unbiased samples of
+        :mod:`hybridgen.render.owen_sobol`; it handles per-lobe limits, ``transparent_shadows`` for a scene with
+        alpha surfaces: :mod:`hybridgen.render.transparent_shadows`, and emitters hidden from the camera:
+        :mod:`hybridgen.render.camera_hidden_emission`), else :meth:`integrator` (``volpath`` in ``scalar_rgb``
+        with ``transparent_shadows``)."""
         limits = self.lobe_limits()
         if not is_jit(variant):
             if limits:
@@ -170,9 +170,6 @@ class PathTraceSettings:
                                  f"({self.max_bounces}) needs a JIT Mitsuba variant (llvm_ad_rgb or cuda_ad_rgb): "
                                  f"{variant}'s path tracer has one depth limit for every lobe")
             return {**self.integrator(), "type": "volpath"} if transparent_shadows else self.integrator()
-        if self.clamp_indirect <= 0 and self.filter_glossy <= 0 and not limits and not transparent_shadows \
-                and not hidden_emission:
-            return self.integrator()
         clamped_path.register(variant)
         plain = self.integrator()
         keys = {"diffuse_bounces": "max_diffuse", "glossy_bounces": "max_glossy",
@@ -236,8 +233,7 @@ class PathTraceView:
         self._own_film = integrator is not None  # e.g. AOV integrators: rendered through Mitsuba's film
         hidden = [] if integrator is not None else camera_hidden_emission.hidden_emitter_keys(scene)
         description["integrator"] = integrator or self.settings.integrator_for(
-            self.variant, transparent_shadows=transparent_shadows.scene_has_masks(scene),
-            hidden_emission=bool(hidden))
+            self.variant, transparent_shadows=transparent_shadows.scene_has_masks(scene))
         first = scene.camera.keypoints[0] if scene.camera.keypoints else np.eye(4)
         description["sensor"] = sensor_dict(self.intrinsics, first, self.variant, scene.camera.depth_of_field)
         try:  # serially: see SERIAL_SCENE_LOAD

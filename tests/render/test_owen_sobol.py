@@ -127,3 +127,17 @@ def test_adaptive_rounds_continue_each_pixels_pattern():
 
     beyond = owen_sobol.sample_2d(mi.UInt32([3, owen_sobol.MAX_SAMPLES + 3]), mi.UInt32([9, 9]))
     assert np.asarray(beyond[0])[0] != np.asarray(beyond[0])[1]
+
+
+def test_every_jit_render_draws_owen_sobol_samples_also_without_clamp_and_filter_glossy():
+    """With clamp and filter glossy off the JIT path still runs hybridgen's integrator (Mitsuba's own ``path``
+    would draw from the biased ldsampler)."""
+    variant = _jit_variant()
+    from hybridgen.render import clamped_path
+    from tests.render.test_world_guide import _box
+
+    settings = PathTraceSettings(samples=4, clamp_indirect=0.0, filter_glossy=0.0)
+    assert settings.integrator_for(variant)["type"] == clamped_path.PLUGIN_NAME
+    view = PathTraceView(_box(), settings, variant=variant)
+    assert view.own_integrator and not view.clamped and view._tracer.owen_sobol
+    assert settings.integrator_for("scalar_rgb")["type"] == "path"
