@@ -208,9 +208,9 @@ class PixelTracer:
         keypoint's: adaptive rounds continue it) and traces its samples number ``first`` (per pixel, 0 if not
         given) to ``first + spp - 1``: a pixel's samples of all rounds are one prefix of its sequence, every
         power-of-two part of it stratified. The sensor's Mitsuba sampler may only accept some sample counts
-        (stratified patterns: powers of two for ``ldsampler``), so ``spp`` is split into counts it accepts (:func:`launch_counts`); equal counts are
-        one launch (a pattern per count and pixel), each launch with its own seed derived from ``seed``; each
-        pattern's first half of samples goes to the first sum.
+        (stratified patterns: powers of two for ``ldsampler``), so ``spp`` is split into counts it accepts
+        (:func:`launch_counts`); equal counts are one launch (a pattern per count and pixel), each launch with its
+        own seed derived from ``seed``; each pattern's first half of samples goes to the first sum.
         An odd ``spp`` (fixed-count rendering only) leaves the odd sample in the first sum."""
         if self.owen_sobol:
             return self._launch(pixels, spp, 1, seed, np.zeros(len(pixels), np.uint32) if first is None else first)
@@ -354,7 +354,7 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int) -> tuple
         per_chunk = max(1, MAX_WAVEFRONT // spp)
         for chunk, start in enumerate(range(0, len(active), per_chunk)):
             pixels = active[start:start + per_chunk]
-            if getattr(tracer, "owen_sobol", False):  # one pattern per pixel, continued from round to round
+            if tracer.owen_sobol:  # one pattern per pixel, continued from round to round
                 a, b = tracer.trace(pixels, spp, seed, first=count[pixels])
             else:
                 a, b = tracer.trace(pixels, spp, round_seed(seed, round_index, chunk))

@@ -296,6 +296,9 @@ class FullFrameTracer:
     render per half of the samples) and returns the pixels asked for, so adaptive sampling there decides
     counts but saves no time."""
 
+    owen_sobol = False
+    """Mitsuba's film draws from the sensor's own sampler here (rounds are independent patterns)."""
+
     def __init__(self, view: PathTraceView) -> None:
         self.view = view
         self.width, self.height = view.intrinsics.width, view.intrinsics.height
