@@ -9,8 +9,9 @@ Run: .venv/bin/python tools/bench_writer.py [--scene "50 objects"] [--resolution
    records), then discards the renderer.
 2. Stages: writes them ``--rounds`` times per ``--compression`` (alternating) with ``Hdf5SingleFileWriter`` (file
    created, every keypoint written, finalized) and reports the process CPU per keypoint (all threads) and each
-   stage's thread CPU per keypoint (the writer's functions wrapped with ``time.thread_time``): shuffle and deflate on the compressor pool, chunk
-   hashes, JSON records and the rest of storing on the writer thread. Median over rounds.
+   stage's thread CPU per keypoint (the writer's functions wrapped with ``time.thread_time``): shuffle and
+   deflate on the compressor pool, chunk hashes, JSON records and the rest of storing on the writer thread.
+   Median over rounds.
 3. Codecs: per pass, thread CPU and stored bytes per keypoint of ISA-L deflate levels 0-2 with and without HDF5's
    byte shuffle (what the writer stores today: shuffle for float depth, level 1); of Blosc2 frames as the
    writer's ``compression: blosc2`` makes them (codecs, levels, byte/bit shuffle); and of hdf5plugin's Bitshuffle

@@ -46,11 +46,12 @@ _STOP = object()
 def deflate(data: Any, level: int) -> bytes:
     """A zlib-format stream of ``data`` (what HDF5's gzip filter reads). Levels 1-3 use ISA-L (``isal``, a
     dependency: 4-6x faster than zlib at the same ratio) for inputs of :data:`ISAL_MIN_BYTES` or more, 0 and 4-9
-    and smaller inputs zlib's own. The bytes differ between the two libraries, never between runs: ISA-L calls are serialized by a process-wide lock because
-    concurrent calls occasionally pick other matches - valid streams of the same data but other bytes
-    (measured: 2 of 320 compressions of one 192-byte segmap by 8 threads at once; 0 of 480 under the lock;
-    it made resumed runs differ from direct ones at random). One ISA-L call at a time (~400 MB/s
-    on one core here) still outpaces the label pass; the compressor threads overlap everything else."""
+    and smaller inputs zlib's own. The bytes differ between the two libraries, never between runs: ISA-L calls
+    are serialized by a process-wide lock because concurrent calls occasionally pick other matches - valid
+    streams of the same data but other bytes (measured: 2 of 320 compressions of one 192-byte segmap by 8
+    threads at once; 0 of 480 under the lock; it made resumed runs differ from direct ones at random). One
+    ISA-L call at a time (~400 MB/s on one core here) still outpaces the label pass; the compressor threads
+    overlap everything else."""
     if 1 <= level <= 3 and _isal is not None and memoryview(data).nbytes >= ISAL_MIN_BYTES:
         with _ISAL_LOCK:
             return _isal.compress(data, level)

@@ -113,7 +113,8 @@ def test_our_readers_register_the_filter(files):
         for i in range(3):
             a, b = ref[i], new[i]
             for key in ("depth", "distance", "normals", "instance_segmaps", "category_id_segmaps"):
-                assert a[key].dtype == b[key].dtype and np.array_equal(a[key].view(np.uint8), b[key].view(np.uint8)), key
+                assert a[key].dtype == b[key].dtype, key
+                assert np.array_equal(a[key].view(np.uint8), b[key].view(np.uint8)), key
         from hybridgen.cli import main
         out = pathlib.Path(sys.argv[3])
         for name, source in (("new", sys.argv[2]), ("ref", sys.argv[1])):

@@ -38,7 +38,8 @@ def _box(hole: bool = True) -> hg.Scene:
     h = math.pi / 2
     parts = [("floor", 2, 2, hg.object_pose([0, 0, 0])),
              ("ceiling", 2, 2, hg.object_pose([0, 0, 2], [math.pi, 0, 0])),
-             ("west", 2, 2, hg.object_pose([-1, 0, 1], [0, h, 0])), ("east", 2, 2, hg.object_pose([1, 0, 1], [0, -h, 0])),
+             ("west", 2, 2, hg.object_pose([-1, 0, 1], [0, h, 0])),
+             ("east", 2, 2, hg.object_pose([1, 0, 1], [0, -h, 0])),
              ("south", 2, 2, hg.object_pose([0, -1, 1], [-h, 0, 0]))]
     if hole:
         parts += [("north_left", 0.6, 2, hg.object_pose([-0.7, 1, 1], [h, 0, 0])),

@@ -21,6 +21,6 @@ from .setup_keys import BLENDER_PYTHON_PACKAGES, BLENDER_SETUP_KEYS, FAMILY_READ
 from .translate import KEYS_ONLY_BLENDERPROC, TRANSLATORS, WRITERS, translate_module
 from .writers import finish
 
-__all__ = ["ALIASES", "BLENDER_PYTHON_PACKAGES", "BLENDER_SETUP_KEYS", "FAMILY_READ", "GLOBAL_IGNORED", "KEYS_ONLY_BLENDERPROC",
-           "Note", "TRANSLATORS", "UNAVAILABLE", "WRITERS", "custom_properties", "finish", "samplers_as_blenderproc",
-           "selector", "translate_module", "unavailable_reason"]
+__all__ = ["ALIASES", "BLENDER_PYTHON_PACKAGES", "BLENDER_SETUP_KEYS", "FAMILY_READ", "GLOBAL_IGNORED",
+           "KEYS_ONLY_BLENDERPROC", "Note", "TRANSLATORS", "UNAVAILABLE", "WRITERS", "custom_properties", "finish",
+           "samplers_as_blenderproc", "selector", "translate_module", "unavailable_reason"]
