@@ -53,6 +53,10 @@ class RgbRenderer(Module):
         Param("filter_glossy", "float", 1.0, doc="firefly control, Cycles' blur_glossy (1.0, Cycles' default): "
               "glossy lobes are roughened after rough bounces (a highlight seen via a diffuse bounce is blurred); "
               "0: off. JIT variants", check=_non_negative),
+        Param("caustics_refractive", "bool", True, doc="Cycles' caustics_refractive (true, Cycles' default): "
+              "false drops refraction (glass, spec_trans) at surfaces reached by a diffuse bounce - light through "
+              "glass onto diffuse surfaces, a main source of noise in glass scenes; glass seen from the camera or "
+              "in mirrors is unchanged. JIT variants"),
         Param("filter_width", "float", 1.5, "px", "pixel filter, Cycles' Blackman-Harris filter_width (1.5, Cycles' "
               "default): samples are spread over +-filter_width px around the pixel centre (importance-sampled); "
               "0: one-pixel box. JIT variants (scalar_rgb: box)", check=_non_negative),
@@ -100,7 +104,8 @@ class RgbRenderer(Module):
                                      noise_threshold=threshold, min_samples=cfg["min_samples"],
                                      clamp_indirect=cfg["clamp_indirect"], diffuse_bounces=cfg["diffuse_bounces"],
                                      transmission_bounces=cfg["transmission_bounces"],
-                                     filter_width=cfg["filter_width"], filter_glossy=cfg["filter_glossy"])
+                                     filter_width=cfg["filter_width"], filter_glossy=cfg["filter_glossy"],
+                                     caustics_refractive=cfg["caustics_refractive"])
         plan = settings.plan()
         variant = choose_variant(cfg["variant"])
         sampling = (f"adaptive {plan.min_samples}..{plan.max_samples} spp (noise threshold {plan.noise_threshold})"

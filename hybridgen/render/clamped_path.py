@@ -52,8 +52,8 @@ PLUGIN_NAME = "hybridgen_clamped_path"
 SINGULAR_ROUGHNESS = 2e-10 ** 0.25
 """Principled roughness (Blender's; alpha = roughness^2) at or below which a lobe is singular, as in Cycles:
 ``alpha_x alpha_y <= BSDF_ROUGHNESS_SQ_THRESH = 2e-10``, i.e. roughness <= 0.00376."""
-LOOP_STATE = ("active", "bsdf_ctx", "bsdf_delta_prev", "bsdf_pdf_prev", "depth", "eta", "filter_glossy", "guide",
-              "guided_prev", "hidden", "last_segment", "max_depth", "max_diffuse", "max_glossy", "max_transmission",
+LOOP_STATE = ("active", "bsdf_ctx", "bsdf_delta_prev", "bsdf_pdf_prev", "depth", "diffuse_prev", "eta",
+              "filter_glossy", "guide", "guided_prev", "hidden", "last_segment", "max_depth", "max_diffuse", "max_glossy", "max_transmission",
               "min_ray_pdf", "mis_weight", "n_diffuse", "n_glossy", "n_transmission", "n_transparent", "radiance",
               "ray", "rr_depth", "sampler", "scene", "self", "si_prev", "throughput", "transparent", "world_radiance")
 """The path loop's state (``dr.while_loop`` labels), in the order the body takes and returns it. It is the state
@@ -76,6 +76,18 @@ def is_singular(bsdf: Any, si: Any, active: Any = True) -> Any:
     return principled & no_diffuse & (bsdf.eval_attribute_1("roughness", si, active) <= SINGULAR_ROUGHNESS)
 
 
+def refracts(bsdf: Any, si: Any, wo: Any) -> Any:
+    """Per lane: ``bsdf`` has a glossy or sharp transmission lobe (principled ``spec_trans`` > 0) and the local
+    direction ``wo`` lies on the other side of the surface than ``si.wi``, i.e. light along ``wo`` reaches
+    ``si.wi`` only by refraction."""
+    import mitsuba as mi
+
+    flags = bsdf.flags()
+    refractive = mi.has_flag(flags, mi.BSDFFlags.GlossyTransmission) | \
+        mi.has_flag(flags, mi.BSDFFlags.DeltaTransmission)
+    return refractive & (mi.Frame3f.cos_theta(si.wi) * mi.Frame3f.cos_theta(wo) < 0.0)
+
+
 @lru_cache(maxsize=None)
 def register(variant: str) -> None:
     """Register the integrator plugin for ``variant`` (must be the active, JIT variant)."""
@@ -92,6 +104,8 @@ def register(variant: str) -> None:
             # hybridgen/render/transparent_shadows.py: shadow rays through masks, null passes cost no bounce
             self.transparent_shadows = bool(props.get("transparent_shadows", False))
             self.filter_glossy = float(props.get("filter_glossy", 0.0))  # Cycles' blur_glossy (render/glossy_filter.py)
+            # Cycles' caustics_refractive: False drops refraction at vertices reached by a diffuse bounce
+            self.caustics_refractive = bool(props.get("caustics_refractive", True))
             # hybridgen/render/camera_hidden_emission.py: emitters the camera sees as their BSDF (set after load)
             self.hidden_shapes: list[Any] = []
             # hybridgen/render/world_guide.py: light samples of an enclosed constant world (set per keypoint)
@@ -137,6 +151,8 @@ def register(variant: str) -> None:
             si_prev = dr.zeros(mi.SurfaceInteraction3f)
             bsdf_pdf_prev = mi.Float(1.0)
             bsdf_delta_prev = mi.Bool(True)
+            diffuse_prev = mi.Bool(False)  # this vertex was reached by a diffuse BSDF sample (Cycles' PATH_RAY_DIFFUSE)
+            no_refractive_caustics = not self.caustics_refractive
             max_depth, rr_depth = mi.UInt32(self.max_depth), mi.UInt32(self.rr_depth)
             big = 2 ** 30
             max_diffuse, max_glossy, max_transmission = (mi.UInt32(big if v < 0 else v) for v in self.limits)
@@ -148,8 +164,9 @@ def register(variant: str) -> None:
             world_radiance = guide.radiance if guide is not None else None
             guided_prev = mi.Bool(False)  # the previous vertex took a guided world sample (MIS for world hits)
 
-            def bounce(active: Any, bsdf_ctx: Any, bsdf_delta_prev: Any, bsdf_pdf_prev: Any, depth: Any, eta: Any,
-                       filter_glossy: Any, guide: Any, guided_prev: Any, hidden: Any, last_segment: Any,
+            def bounce(active: Any, bsdf_ctx: Any, bsdf_delta_prev: Any, bsdf_pdf_prev: Any, depth: Any,
+                       diffuse_prev: Any, eta: Any, filter_glossy: Any, guide: Any, guided_prev: Any, hidden: Any,
+                       last_segment: Any,
                        max_depth: Any, max_diffuse: Any, max_glossy: Any, max_transmission: Any, min_ray_pdf: Any,
                        mis_weight: Any, n_diffuse: Any, n_glossy: Any, n_transmission: Any, n_transparent: Any,
                        radiance: Any, ray: Any, rr_depth: Any, sampler: Any, scene: Any, self: Any, si_prev: Any,
@@ -187,6 +204,8 @@ def register(variant: str) -> None:
                 if transparent:
                     em_weight *= transparent_shadows.shadow_transmittance(scene, si, ds_em, active_em)
                 wo = si.to_local(ds_em.d)
+                if no_refractive_caustics:  # no light through a refracting surface reached by a diffuse bounce
+                    active_em &= ~(diffuse_prev & refracts(bsdf, si, wo))
                 bsdf_val, bsdf_pdf = bsdf.eval_pdf(bsdf_ctx, si, wo, active_em)
                 mis_em = dr.select(ds_em.delta, 1.0, mis_weight(ds_em.pdf, bsdf_pdf))
                 lit = dr.select(active_em, throughput * bsdf_val * em_weight * mis_em, 0.0)
@@ -196,6 +215,8 @@ def register(variant: str) -> None:
                     d_world, pdf_world = world_guide.sample(guide, si.p, sampler.next_1d(), sampler.next_2d(),
                                                             active_world)
                     active_world &= ~scene.ray_test(si.spawn_ray(d_world), active_world)
+                    if no_refractive_caustics:
+                        active_world &= ~(diffuse_prev & refracts(bsdf, si, si.to_local(d_world)))
                     val_world, pdf_bsdf_world = bsdf.eval_pdf(bsdf_ctx, si, si.to_local(d_world), active_world)
                     sky = throughput * val_world * world_radiance * \
                         (mis_weight(pdf_world, pdf_bsdf_world) / dr.maximum(pdf_world, 1e-20))
@@ -216,6 +237,8 @@ def register(variant: str) -> None:
                 n_transmission[active_next & transmits] += 1
                 last_segment = ((n_diffuse > max_diffuse) | (n_glossy > max_glossy)
                                 | (n_transmission > max_transmission))
+                if no_refractive_caustics:  # a refraction sampled there ends the path, finding nothing
+                    active_next &= ~(diffuse_prev & transmits)
                 ray = si.spawn_ray(si.to_world(bsdf_sample.wo))
                 throughput *= bsdf_weight
                 eta *= bsdf_sample.eta
@@ -224,6 +247,7 @@ def register(variant: str) -> None:
                 n_transparent[null_pass] += 1
                 last_segment |= n_transparent > transparent_shadows.MAX_TRANSPARENT
                 si_prev = dr.select(null_pass, si_prev, si)
+                diffuse_prev = dr.select(null_pass, diffuse_prev, diffuse)
                 bsdf_pdf_prev = dr.select(null_pass, bsdf_pdf_prev, bsdf_sample.pdf)
                 bsdf_delta_prev = dr.select(null_pass, bsdf_delta_prev,
                                             mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta) | singular)
@@ -240,15 +264,15 @@ def register(variant: str) -> None:
                 throughput[rr_active] *= dr.rcp(rr_prob)
                 rr_continue = sampler.next_1d() < rr_prob
                 active = active_next & (~rr_active | rr_continue) & (throughput_max != 0.0)
-                return (active, bsdf_ctx, bsdf_delta_prev, bsdf_pdf_prev, depth, eta, filter_glossy, guide,
-                        guided_prev, hidden, last_segment, max_depth, max_diffuse, max_glossy, max_transmission,
+                return (active, bsdf_ctx, bsdf_delta_prev, bsdf_pdf_prev, depth, diffuse_prev, eta, filter_glossy,
+                        guide, guided_prev, hidden, last_segment, max_depth, max_diffuse, max_glossy, max_transmission,
                         min_ray_pdf, mis_weight, n_diffuse, n_glossy, n_transmission, n_transparent, radiance, ray,
                         rr_depth, sampler, scene, self, si_prev, throughput, transparent, world_radiance)
 
             assert bounce.__code__.co_varnames[:bounce.__code__.co_argcount] == LOOP_STATE
             state = dr.while_loop(
-                (active, bsdf_ctx, bsdf_delta_prev, bsdf_pdf_prev, depth, eta, filter_glossy, guide, guided_prev,
-                 hidden, last_segment, max_depth, max_diffuse, max_glossy, max_transmission, min_ray_pdf,
+                (active, bsdf_ctx, bsdf_delta_prev, bsdf_pdf_prev, depth, diffuse_prev, eta, filter_glossy, guide,
+                 guided_prev, hidden, last_segment, max_depth, max_diffuse, max_glossy, max_transmission, min_ray_pdf,
                  mis_weight, n_diffuse, n_glossy, n_transmission, n_transparent, radiance, ray, rr_depth, sampler,
                  scene, self, si_prev, throughput, transparent, world_radiance),
                 lambda active, *rest: active, bounce, labels=LOOP_STATE, max_iterations=-1,

@@ -110,6 +110,7 @@ class PathTraceSettings:
     transmission_bounces: int | None = None
     filter_width: float = pixel_filter.DEFAULT_WIDTH
     filter_glossy: float = glossy_filter.DEFAULT_FILTER_GLOSSY
+    caustics_refractive: bool = True
 
     def __post_init__(self) -> None:
         if self.samples is not None and self.samples < 1:
@@ -176,6 +177,7 @@ class PathTraceSettings:
                 "transmission_bounces": "max_transmission"}
         return {"type": clamped_path.PLUGIN_NAME, "max_depth": plain["max_depth"], "rr_depth": plain["rr_depth"],
                 "clamp_indirect": float(self.clamp_indirect), "filter_glossy": float(self.filter_glossy),
+                "caustics_refractive": bool(self.caustics_refractive),
                 **{keys[k]: v for k, v in limits.items()},
                 **({"transparent_shadows": True} if transparent_shadows else {})}
 

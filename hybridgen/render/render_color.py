@@ -63,6 +63,7 @@ class ColorProducer:
                                  else "box, 1 px"),
                 "min_bounces": s.min_bounces, "max_bounces": s.max_bounces, "mitsuba_max_depth": s.max_bounces + 2,
                 **{name: value for name, value in s.lobe_limits().items()},
+                **({"caustics_refractive": False} if self.view.own_integrator and not s.caustics_refractive else {}),
                 "color_encoding": "sRGB transfer of linear radiance clipped to [0, 1]", "denoised": self.denoise}
 
     def records(self) -> dict[str, np.ndarray]:
