@@ -449,6 +449,9 @@ def main() -> None:
                         help="quality mode: also time hybridgen at these noise thresholds (tuning)")
     parser.add_argument("--blenderproc-lobes", action="store_true", help="quality mode: hybridgen with "
                         "BlenderProc's glossy_bounces 0 / transmission_bounces 0, the light paths Cycles renders")
+    parser.add_argument("--lobes", choices=("default", "blenderproc", "no-refractive-caustics"), default=None,
+                        help="quality mode: hybridgen's light paths (tools/default_color_process.py LOBES; "
+                        "--blenderproc-lobes is --lobes blenderproc)")
     parser.add_argument("--scenes", default="", help="quality mode: comma-separated scene names (default all)")
     parser.add_argument("--out", default=str(REPO / "output" / "bench_color_quality"),
                         help="quality mode: folder for side-by-side PNGs and the rows (JSON)")

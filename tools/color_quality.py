@@ -17,7 +17,8 @@ For each scene: hybridgen's defaults (``PathTraceSettings()`` + denoising, as ``
 with no color options: stratified samples, Blackman-Harris 1.5 px pixel filter, adaptive 64..1024 spp at
 noise threshold 0.01 in Cycles' meaning, indirect clamp 10, filter glossy 1.0, principled lobes sampled by
 albedo, a constant world left to BSDF sampling, Cycles' roulette, 3 bounces for every lobe, OIDN; with
-``--blenderproc-lobes`` glossy and transmission bounces 0 as Cycles renders at BlenderProc's defaults),
+``--blenderproc-lobes`` glossy and transmission bounces 0 as Cycles renders at BlenderProc's defaults, with
+``--lobes no-refractive-caustics`` ``caustics_refractive: false``),
 timed as the issue asks: the WHOLE process (tools/default_color_process.py: Python's start, ``import
 hybridgen``, the scene built from its mesh files, Mitsuba, kernels, raster guides, render, denoise, the PNG
 written), wall clock from spawn to exit and CPU from the child's rusage. The first run of each scene gets
@@ -395,15 +396,17 @@ class DefaultRuns:
 # ----------------------------------------------------------------------------------------- scoring
 PHASES = ("startup", "import", "build", "render", "write", "exit")
 """The phases of a timed hybridgen process (:meth:`DefaultRuns.run`)."""
-LOBES_NAME = {False: "default", True: "blenderproc"}
-"""``--blenderproc-lobes`` -> the name of default_color_process.LOBES' entry."""
+def lobes_name(args: Any) -> str:
+    """The name of default_color_process.LOBES' entry the benchmark renders hybridgen with: ``--lobes``, or
+    ``blenderproc`` for ``--blenderproc-lobes``."""
+    return args.lobes if args.lobes else ("blenderproc" if args.blenderproc_lobes else "default")
 
 
 def time_hybridgen(name: str, resolution: str, workdir: Path, args: Any, reference: np.ndarray,
                    row: dict[str, Any]) -> np.ndarray:
     """Fills ``row`` with hybridgen's whole-process numbers (one cold run, ``args.warm_runs`` warm ones:
     medians) and PSNR; returns its frame."""
-    runs = DefaultRuns(name, resolution, workdir, LOBES_NAME[args.blenderproc_lobes], args.threads)
+    runs = DefaultRuns(name, resolution, workdir, lobes_name(args), args.threads)
     try:
         cold_png, png = workdir / f"{name}_hybridgen_cold.png", workdir / f"{name}_hybridgen.png"
         cold = runs.run(cold_png, args.hg_threshold)
@@ -491,7 +494,7 @@ def run_quality(args: Any, bpy_python: Path | None) -> list[dict[str, Any]]:
     out.mkdir(parents=True, exist_ok=True)
     workdir = Path(tempfile.mkdtemp(prefix="bench_color_quality_"))  # private: concurrent runs share --out
     cache = ReferenceCache(cache_root(args.reference_cache))
-    refs = References(cache, args.reference_spp, resolution, LOBES_NAME[args.blenderproc_lobes], bpy_python,
+    refs = References(cache, args.reference_spp, resolution, lobes_name(args), bpy_python,
                       workdir)
     load = os.getloadavg()
     print(f"{resolution}, references {args.reference_spp} spp, {args.threads} threads per engine, reference cache "

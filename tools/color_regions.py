@@ -113,7 +113,7 @@ def main() -> None:
     parser.add_argument("--scenes", default="materials", help="comma-separated scene names of color_quality.py")
     parser.add_argument("--res", default="320x240")
     parser.add_argument("--reference-spp", type=int, default=4096)
-    parser.add_argument("--lobes", choices=("default", "blenderproc"), default="default")
+    parser.add_argument("--lobes", choices=("default", "blenderproc", "no-refractive-caustics"), default="default")
     parser.add_argument("--threshold", type=float, default=None, help="noise threshold (default: hybridgen's)")
     parser.add_argument("--paths", type=int, default=0, help="spp of the light-path variance table (0: skip)")
     parser.add_argument("--reference-cache", default=None, help="folder of the reference cache (or 'off')")

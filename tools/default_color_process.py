@@ -26,9 +26,12 @@ import json  # noqa: E402
 import sys  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-LOBES: dict[str, dict[str, int]] = {"default": {}, "blenderproc": {"glossy_bounces": 0, "transmission_bounces": 0}}
-"""``--lobes``: hybridgen's default per-lobe bounces, or BlenderProc's (glossy and transmission 0: the light
-paths Cycles renders at BlenderProc's defaults)."""
+LOBES: dict[str, dict[str, int | bool]] = {
+    "default": {}, "blenderproc": {"glossy_bounces": 0, "transmission_bounces": 0},
+    "no-refractive-caustics": {"caustics_refractive": False}}
+"""``--lobes``: hybridgen's default light paths; BlenderProc's (glossy and transmission bounces 0: the light
+paths Cycles renders at BlenderProc's defaults); or hybridgen's without refraction after a diffuse bounce
+(``caustics_refractive: false``)."""
 
 
 def main() -> None:
