@@ -334,6 +334,25 @@ class References:
         return self.cache.fetch("cycles", key, render)
 
 
+# ------------------------------------------------------------------------------------------ the host
+def host_cpu() -> dict[str, Any]:
+    """The CPU the timings come from: its model name and widest vector instruction set, and the float32 lanes
+    Dr.Jit's LLVM backend generates for it (16 with AVX-512, 8 with AVX/AVX2, 4 otherwise: its native width).
+    Ratios to Cycles depend on it: hybridgen's path tracer is Dr.Jit-vectorized, Cycles' is not (its Embree is)."""
+    model, flags = "unknown", set()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            key, _, value = line.partition(":")
+            if key.strip() == "model name" and model == "unknown":
+                model = value.strip()
+            elif key.strip() == "flags" and not flags:
+                flags = set(value.split())
+    except OSError:
+        pass
+    isa = "avx512f" if "avx512f" in flags else "avx2" if "avx2" in flags else "avx" if "avx" in flags else "sse"
+    return {"model": model, "isa": isa, "drjit_llvm_lanes": {"avx512f": 16, "avx2": 8, "avx": 8}.get(isa, 4)}
+
+
 # ------------------------------------------------------------------------------ whole-process timing
 @dataclass(frozen=True)
 class Finished:
@@ -447,7 +466,7 @@ def quality_row(name: str, scene: Any, content: str, refs: References, session: 
 
     resolution = refs.resolution
     row: dict[str, Any] = {"scene": name, "resolution": resolution, "reference_spp": refs.spp, "lobes": refs.lobes,
-                           "hg_threshold": args.hg_threshold}
+                           "hg_threshold": args.hg_threshold, "cpu": host_cpu()}
     ref, record = refs.hybridgen(name, scene, content, CLAMP)
     ref_unclamped, _ = refs.hybridgen(name, scene, content, 0.0)
     row["hg_ref_s"], row["hg_ref_cached"] = record["seconds"], record["cached"]
@@ -500,6 +519,8 @@ def run_quality(args: Any, bpy_python: Path | None) -> list[dict[str, Any]]:
     print(f"{resolution}, references {args.reference_spp} spp, {args.threads} threads per engine, reference cache "
           f"{cache.root if cache.root else 'off'}; {os.cpu_count()} cores, load average {load[0]:.2f} "
           f"{load[1]:.2f} {load[2]:.2f} at start", flush=True)
+    cpu = host_cpu()
+    print(f"CPU: {cpu['model']}, {cpu['isa']} (Dr.Jit LLVM {cpu['drjit_llvm_lanes']} lanes)", flush=True)
     rows = []
     try:
         for index, name in enumerate(args.scenes.split(",") if args.scenes else SCENES):
