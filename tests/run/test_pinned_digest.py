@@ -7,8 +7,11 @@ failure says whether the data or only the file layout changed.
 
 Floating-point results depend on the machine (LLVM code for the CPU's vector width and FMA, Mesa's version,
 OIDN's kernels) and HDF5 bytes on the library version, so the digests are pinned together with the
-environment that produced them; on another environment the test skips and says what differs. To re-pin after
-an intended change of output: ``HYBRIDGEN_PIN_DIGESTS=1 pytest tests/run/test_pinned_digest.py``.
+environment that produced them, one entry per environment (e.g. an AVX-512 and an AVX2 host: their LLVM code
+differs, so their colors do); on an environment not pinned the test skips and says what differs. To re-pin after
+an intended change of output, or to pin a new environment: ``HYBRIDGEN_PIN_DIGESTS=1 pytest
+tests/run/test_pinned_digest.py`` (on each environment pinned: an output change needs every entry pinned again,
+or the entries of environments at hand kept and the others removed).
 """
 from __future__ import annotations
 
@@ -162,21 +165,31 @@ def _run_locked(text: str, folder: Path) -> dict[str, str]:
         shutil.rmtree(folder, ignore_errors=True)
 
 
+def _pins() -> list[dict]:
+    """The pinned entries, one ``{"environment": ..., "runs": {name: digests}}`` per environment pinned on (a file
+    of the older one-environment form is read as one entry)."""
+    pinned = json.loads(PINNED.read_text()) if PINNED.exists() else {}
+    return pinned["pins"] if "pins" in pinned else ([pinned] if pinned else [])
+
+
 @pytest.mark.parametrize("name", sorted(RUNS))
 def test_outputs_match_the_pinned_digests(gl_context, name):
     digests = _run(RUNS[name], name)
     env = environment()
-    pinned = json.loads(PINNED.read_text()) if PINNED.exists() else {}
+    pins = _pins()
+    mine = next((entry for entry in pins if entry["environment"] == env), None)
     if os.environ.get("HYBRIDGEN_PIN_DIGESTS") == "1":
-        pinned["environment"] = env
-        pinned.setdefault("runs", {})[name] = digests
-        PINNED.write_text(json.dumps(pinned, indent=1, sort_keys=True) + "\n")
+        if mine is None:
+            mine = {"environment": env, "runs": {}}
+            pins.append(mine)
+        mine["runs"][name] = digests
+        PINNED.write_text(json.dumps({"pins": pins}, indent=1, sort_keys=True) + "\n")
         pytest.skip(f"pinned {len(digests)} digests of {name}")
-    assert name in pinned.get("runs", {}), f"no pinned digests for {name}: run with HYBRIDGEN_PIN_DIGESTS=1"
-    if pinned["environment"] != env:
-        differs = sorted(k for k in env if env[k] != pinned["environment"].get(k))
-        pytest.skip(f"digests were pinned on another environment (differs: {differs})")
-    expected = pinned["runs"][name]
+    if mine is None:
+        differs = [sorted(k for k in env if env[k] != entry["environment"].get(k)) for entry in pins]
+        pytest.skip(f"digests were pinned on other environments (differs: {' / '.join(map(str, differs))})")
+    assert name in mine["runs"], f"no pinned digests for {name} here: run with HYBRIDGEN_PIN_DIGESTS=1"
+    expected = mine["runs"][name]
     assert sorted(digests) == sorted(expected), "the run writes other files than when the digests were pinned"
     changed = sorted(k for k in expected if digests[k] != expected[k])
     assert not changed, f"output changed: {changed}"
