@@ -53,12 +53,13 @@ SINGULAR_ROUGHNESS = 2e-10 ** 0.25
 """Principled roughness (Blender's; alpha = roughness^2) at or below which a lobe is singular, as in Cycles:
 ``alpha_x alpha_y <= BSDF_ROUGHNESS_SQ_THRESH = 2e-10``, i.e. roughness <= 0.00376."""
 LOOP_STATE = ("active", "bsdf_ctx", "bsdf_delta_prev", "bsdf_pdf_prev", "depth", "diffuse_prev", "eta",
-              "filter_glossy", "guide", "guided_prev", "hidden", "last_segment", "max_depth", "max_diffuse", "max_glossy", "max_transmission",
-              "min_ray_pdf", "mis_weight", "n_diffuse", "n_glossy", "n_transmission", "n_transparent", "radiance",
-              "ray", "rr_depth", "sampler", "scene", "self", "si_prev", "throughput", "transparent", "world_radiance")
-"""The path loop's state (``dr.while_loop`` labels), in the order the body takes and returns it. It is the state
-``@dr.syntax`` derived from the former ``while`` loop (every name the loop reads or writes, sorted), so the
-traced kernels - and the Dr.Jit kernel-cache keys - are the ones that loop traced; the explicit loop only saves
+              "filter_glossy", "guide", "guided_prev", "hidden", "last_segment", "max_depth", "max_diffuse",
+              "max_glossy", "max_transmission", "min_ray_pdf", "mis_weight", "n_diffuse", "n_glossy",
+              "n_transmission", "n_transparent", "radiance", "ray", "rr_depth", "sampler", "scene", "self", "si_prev",
+              "throughput", "transparent", "world_radiance")
+"""The path loop's state (``dr.while_loop`` labels), in the order the body takes and returns it: every name the
+loop reads or writes, sorted, as ``@dr.syntax`` derived it from the former ``while`` loop (``diffuse_prev`` came
+later, for ``caustics_refractive``), so the traced kernels were the ones that loop traced; the explicit loop only saves
 re-parsing this file's source in every process (~0.01 s CPU measured; most of the 0.15 s once blamed on
 ``dr.syntax`` was Mitsuba's own AD integrators, see :mod:`hybridgen.render.deferred_ad_integrators`)."""
 

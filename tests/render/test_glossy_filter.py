@@ -8,22 +8,13 @@ import pytest
 
 import hybridgen as hg
 from hybridgen.render import glossy_filter
-from hybridgen.render.mitsuba_variant import choose_variant, is_jit
 from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
 
 
-@pytest.fixture
-def variant():
-    chosen = choose_variant(None)
-    if not is_jit(chosen):
-        pytest.skip("filter glossy lives in hybridgen's path tracer (JIT variants)")
-    return chosen
-
-
-def test_roughness_floor_is_cycles_blur(variant):
+def test_roughness_floor_is_cycles_blur(jit_variant):
     import mitsuba as mi
 
-    mi.set_variant(variant)
+    mi.set_variant(jit_variant)
     pdf = mi.Float([math.inf, 10.0, 1.0, 1 / math.pi, 0.0])
     floor = np.array(glossy_filter.roughness_floor(1.0, pdf))
     alpha = [0.0, 0.0, 0.0, math.sqrt(1 - 1 / math.pi) / 2, 0.5]  # Cycles: sqrt(1 - blur_pdf) / 2 when < 1
@@ -54,21 +45,21 @@ def _glossy_scene() -> hg.Scene:
     return scene
 
 
-def test_direct_light_and_camera_seen_highlights_are_never_blurred(variant):
+def test_direct_light_and_camera_seen_highlights_are_never_blurred(jit_variant):
     """Camera vertices have no rough bounce before them: with direct light only, filter glossy changes no
     pixel (same samples; equal up to float rounding of the two kernels) - the glossy tile's highlight stays
     sharp."""
     scene = _glossy_scene()
     pose = scene.camera.keypoints[0]
-    on = PathTraceView(scene, PathTraceSettings(samples=16, max_bounces=0, filter_glossy=1.0), variant=variant)
-    off = PathTraceView(scene, PathTraceSettings(samples=16, max_bounces=0, filter_glossy=0.0), variant=variant)
+    on = PathTraceView(scene, PathTraceSettings(samples=16, max_bounces=0, filter_glossy=1.0), variant=jit_variant)
+    off = PathTraceView(scene, PathTraceSettings(samples=16, max_bounces=0, filter_glossy=0.0), variant=jit_variant)
     assert on.own_integrator
     a, b = on.render(pose, seed=1), off.render(pose, seed=1)
     assert a.max() > 1.0  # something is lit
     np.testing.assert_allclose(a, b, rtol=1e-5, atol=1e-7)
 
 
-def test_filter_glossy_tames_caustic_fireflies(variant):
+def test_filter_glossy_tames_caustic_fireflies(jit_variant):
     """The floor next to the near-mirror receives the lamp's caustic through floor -> mirror -> lamp paths,
     which a diffuse sample finds rarely and brightly: the floor's mean over a few seeds scatters widely
     without the filter and little with it (unclamped, so only the filter acts)."""
@@ -80,7 +71,7 @@ def test_filter_glossy_tames_caustic_fireflies(variant):
 
     def spread(filter_glossy: float) -> float:
         view = PathTraceView(scene, PathTraceSettings(samples=32, clamp_indirect=0.0, filter_glossy=filter_glossy),
-                             variant=variant)
+                             variant=jit_variant)
         means = [view.render(pose, seed=seed)[floor].mean() for seed in range(4)]
         return float(np.std(means) / np.mean(means))
 

@@ -2,19 +2,9 @@
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 import hybridgen as hg
-from hybridgen.render.mitsuba_variant import choose_variant, is_jit
 from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
-
-
-@pytest.fixture
-def variant():
-    chosen = choose_variant(None)
-    if not is_jit(chosen):
-        pytest.skip("caustics_refractive lives in hybridgen's path tracer (JIT variants)")
-    return chosen
 
 
 def _lamp_in_glass() -> hg.Scene:
@@ -38,26 +28,26 @@ def _lamp_in_glass() -> hg.Scene:
     return scene
 
 
-def _render(scene: hg.Scene, caustics: bool, variant: str, **settings: float) -> np.ndarray:
+def _render(scene: hg.Scene, caustics: bool, jit_variant: str, **settings: float) -> np.ndarray:
     view = PathTraceView(scene, PathTraceSettings(samples=32, caustics_refractive=caustics, clamp_indirect=0.0,
-                                                  **settings), variant=variant)
+                                                  **settings), variant=jit_variant)
     assert view.own_integrator
     return view.render(scene.camera.keypoints[0], seed=3)
 
 
-def test_floor_lit_only_through_glass_goes_dark_without_refractive_caustics(variant):
+def test_floor_lit_only_through_glass_goes_dark_without_refractive_caustics(jit_variant):
     scene = _lamp_in_glass()
     ids = hg.RasterView(scene).render(scene.camera.keypoints[0], ["instance_segmaps"])["instance_segmaps"]
     floor, glass = ids == 1, ids == 2
     assert floor.sum() > 100 and glass.sum() > 20
-    on, off = _render(scene, True, variant), _render(scene, False, variant)
+    on, off = _render(scene, True, jit_variant), _render(scene, False, jit_variant)
     assert on[floor].mean() > 0.01  # the caustic (and the glow around the ball) lights the floor
     assert off[floor].max() == 0.0  # no other light reaches it
     # the camera sees the lamp through the glass either way: no diffuse bounce before the refraction
     assert off[glass].mean() > 0.5 * on[glass].mean() > 0.0
 
 
-def test_scene_without_refracting_surfaces_is_unchanged(variant):
+def test_scene_without_refracting_surfaces_is_unchanged(jit_variant):
     """Only refraction after a diffuse bounce is dropped: a scene of diffuse, glossy and metal surfaces renders
     the same (same samples; equal up to the float rounding of two kernels)."""
     scene = hg.Scene()
@@ -71,14 +61,14 @@ def test_scene_without_refracting_surfaces_is_unchanged(variant):
     scene.world.strength = 0.2
     scene.camera.intrinsics = hg.Intrinsics.from_fov(0.9, 24, 16)
     scene.camera.add_keypoint(hg.look_at([2.0, -1.5, 1.4], [0.0, 0.0, 0.3]))
-    on, off = _render(scene, True, variant), _render(scene, False, variant)
+    on, off = _render(scene, True, jit_variant), _render(scene, False, jit_variant)
     assert on.mean() > 0.05
     np.testing.assert_allclose(on, off, rtol=1e-5, atol=1e-7)
 
 
-def test_refractive_caustics_are_on_by_default_as_in_cycles(variant):
+def test_refractive_caustics_are_on_by_default_as_in_cycles(jit_variant):
     import mitsuba as mi
 
-    mi.set_variant(variant)
-    assert PathTraceSettings().integrator_for(variant)["caustics_refractive"] is True
-    assert PathTraceSettings(caustics_refractive=False).integrator_for(variant)["caustics_refractive"] is False
+    mi.set_variant(jit_variant)
+    assert PathTraceSettings().integrator_for(jit_variant)["caustics_refractive"] is True
+    assert PathTraceSettings(caustics_refractive=False).integrator_for(jit_variant)["caustics_refractive"] is False

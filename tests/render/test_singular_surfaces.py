@@ -7,19 +7,10 @@ import pytest
 
 import hybridgen as hg
 from hybridgen.render import clamped_path
-from hybridgen.render.mitsuba_variant import choose_variant, is_jit
 from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
 from hybridgen.scene.material import Material
 
 LOOK_DOWN = np.array([[1.0, 0, 0, 0], [0, -1, 0, 0], [0, 0, -1, 1.0], [0, 0, 0, 1]])  # at z = 1 looking down
-
-
-@pytest.fixture
-def variant():
-    chosen = choose_variant(None)
-    if not is_jit(chosen):
-        pytest.skip("singular surfaces live in hybridgen's path tracer (JIT variants)")
-    return chosen
 
 
 def test_threshold_is_cycles_roughness_sq_thresh():
@@ -28,14 +19,14 @@ def test_threshold_is_cycles_roughness_sq_thresh():
     assert clamped_path.SINGULAR_ROUGHNESS == pytest.approx(0.0037606, abs=1e-6)
 
 
-def test_singular_lanes_of_hybridgen_bsdfs(variant):
+def test_singular_lanes_of_hybridgen_bsdfs(jit_variant):
     """hybridgen's own BSDFs (twosided principled with the glossy filter's roughness wrapper, glass, diffuse):
     metal and glass singular at roughness 0 and 0.0037, not at 0.004 or 0.2, never a diffuse one nor a principled
     one with a diffuse lobe (sharp plastic, half metal: its diffuse light needs NEE); the glossy filter's floor
     (si.time) lifts a sharp lobe out of it, as Cycles' blur_glossy sets SD_BSDF_HAS_EVAL again."""
     import mitsuba as mi
 
-    mi.set_variant(variant)
+    mi.set_variant(jit_variant)
     from hybridgen.render.mitsuba_materials import bsdf_dict
 
     materials = [Material(metallic=1.0, roughness=0.0), Material(metallic=1.0, roughness=0.0037),
@@ -72,13 +63,13 @@ def _mirror_scene(*, panel: bool, roughness: float = 0.0) -> hg.Scene:
     return scene
 
 
-def test_sharp_mirror_shows_no_point_light_and_the_full_reflected_panel(variant):
+def test_sharp_mirror_shows_no_point_light_and_the_full_reflected_panel(jit_variant):
     """A roughness-0 metal mirror (F0 = base 0.8) under a black world: a point light is not reflected at all
     (Cycles: no NEE on a singular closure, and a point light cannot be hit), and an emitting panel of radiance
     1.5 is reflected at full weight: F x 1.5 with Schlick's F at these near-normal angles (< 9 deg: F - F0 <
     1e-6)."""
     settings = PathTraceSettings(samples=64)
-    dark = PathTraceView(_mirror_scene(panel=False), settings, variant=variant).render(LOOK_DOWN, seed=3)
+    dark = PathTraceView(_mirror_scene(panel=False), settings, variant=jit_variant).render(LOOK_DOWN, seed=3)
     assert float(np.abs(dark).max()) == 0.0
-    panel = PathTraceView(_mirror_scene(panel=True), settings, variant=variant).render(LOOK_DOWN, seed=3)
+    panel = PathTraceView(_mirror_scene(panel=True), settings, variant=jit_variant).render(LOOK_DOWN, seed=3)
     np.testing.assert_allclose(panel.reshape(-1, 3), np.full((48, 3), 0.8 * 1.5), rtol=1e-3)
