@@ -20,7 +20,13 @@ it against an unclamped reference.
 :mod:`hybridgen.render.glossy_filter` (the integrator tracks the path's smallest BSDF-sampling pdf and hands
 each vertex its roughness floor).
 
-Per-lobe bounce limits as Cycles' ``diffuse_bounces`` / ``glossy_bounces`` / ``transmission_bounces``
+``caustics_refractive`` (Cycles' option of that name; default true): false drops refraction at every vertex a
+diffuse BSDF sample led to, as Cycles drops refraction closures on ``PATH_RAY_DIFFUSE`` rays - a light sample
+across a surface with a glossy or sharp transmission lobe (:func:`refracts`) contributes nothing there, and a
+sampled refraction ends the path. Glass seen by the camera or through mirrors is unchanged; light reaching diffuse
+surfaces only through glass is not rendered (a bias, measured in docs/color_quality.md).
+
+Per-lobe bounce limits as Cycles'' ``diffuse_bounces`` / ``glossy_bounces`` / ``transmission_bounces``
 (``max_diffuse`` / ``max_glossy`` / ``max_transmission``; -1 = only ``max_depth`` limits): a path that
 exceeds one still collects the emission its last BSDF sample finds (so MIS with next-event estimation
 stays complete, as at ``max_depth``) and then ends. Glossy counts glossy and specular reflection;
@@ -167,10 +173,10 @@ def register(variant: str) -> None:
 
             def bounce(active: Any, bsdf_ctx: Any, bsdf_delta_prev: Any, bsdf_pdf_prev: Any, depth: Any,
                        diffuse_prev: Any, eta: Any, filter_glossy: Any, guide: Any, guided_prev: Any, hidden: Any,
-                       last_segment: Any,
-                       max_depth: Any, max_diffuse: Any, max_glossy: Any, max_transmission: Any, min_ray_pdf: Any,
-                       mis_weight: Any, n_diffuse: Any, n_glossy: Any, n_transmission: Any, n_transparent: Any,
-                       radiance: Any, ray: Any, rr_depth: Any, sampler: Any, scene: Any, self: Any, si_prev: Any,
+                       last_segment: Any, max_depth: Any, max_diffuse: Any, max_glossy: Any, max_transmission: Any,
+                       min_ray_pdf: Any, mis_weight: Any, n_diffuse: Any, n_glossy: Any, n_transmission: Any,
+                       n_transparent: Any, radiance: Any, ray: Any, rr_depth: Any, sampler: Any, scene: Any, self: Any,
+                       si_prev: Any,
                        throughput: Any, transparent: Any, world_radiance: Any) -> tuple[Any, ...]:
                 """One path vertex. Takes and returns the loop state (:data:`LOOP_STATE`, in that order)."""
                 si = scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=depth == 0, active=active)

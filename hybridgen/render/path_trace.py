@@ -98,6 +98,9 @@ class PathTraceSettings:
 
     ``filter_glossy``: Cycles' ``blur_glossy`` (default 1.0, Cycles' and BlenderProc's; 0 = off), glossy lobes
     roughened after rough bounces (:mod:`hybridgen.render.glossy_filter`); JIT variants only.
+
+    ``caustics_refractive``: Cycles' option (default True, Cycles'); False drops refraction at surfaces a diffuse
+    bounce led to (:mod:`hybridgen.render.clamped_path`); JIT variants only.
     """
 
     samples: int | None = None
