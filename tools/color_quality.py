@@ -455,6 +455,11 @@ def time_cycles(name: str, session: CyclesSession, workdir: Path, row: dict[str,
     png = workdir / f"{name}_cycles.png"
     answer = session.render(1, png, mode="blenderproc")
     row["cycles_s"], row["cycles_cpu_s"] = answer["seconds"], answer["cpu_s"]
+    # Its samples per pixel from the same render again with Cycles' Debug Sample Count pass (untimed: the pass
+    # is not part of BlenderProc's defaults), so the two engines' samples can be compared, not only their times.
+    counts = workdir / f"{name}_cycles_counts.npy"
+    session.render(1, workdir / f"{name}_cycles_counted.png", mode="blenderproc", sample_counts=str(counts))
+    row["cycles_mean_spp"] = float(np.load(counts).mean())
     return _read_png(png)
 
 
@@ -565,8 +570,9 @@ def print_table(rows: list[dict[str, Any]], reference_spp: int) -> None:
           f"{rows[0]['resolution']}. hybridgen: the whole process (median of warm runs; cold = fresh Dr.Jit kernel "
           "and mesh caches; in-proc = render_color alone); Cycles: its render only, at BlenderProc's defaults. "
           "CPU = user + system s of every thread. Ratio = hybridgen / Cycles.\n")
-    print("| scene | hybridgen dB (mean spp) | hg wall s | hg CPU s | hg cold wall s | hg in-proc s | Cycles dB | "
-          "Cycles wall s | Cycles CPU s | wall ratio | CPU ratio | goal (wall / CPU) | clamp bias dB |")
+    print("| scene | hybridgen dB (mean spp) | hg wall s | hg CPU s | hg cold wall s | hg in-proc s | "
+          "Cycles dB (mean spp) | Cycles wall s | Cycles CPU s | wall ratio | CPU ratio | goal (wall / CPU) | "
+          "clamp bias dB |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         wall_ratio = r["hg_s"] / r["cycles_s"] if r.get("cycles_s") else nan
@@ -575,7 +581,8 @@ def print_table(rows: list[dict[str, Any]], reference_spp: int) -> None:
         goal = " / ".join("yes" if clean and ratio <= 0.5 else "no" for ratio in (wall_ratio, cpu_ratio))
         print(f"| {_row_name(r)} | {r['hg_psnr']:.1f} ({r['hg_mean_spp']:.0f}) | {r['hg_s']:.2f} | "
               f"{r['hg_cpu_s']:.2f} | {r['hg_cold_s']:.2f} | {r['hg_inprocess_s']:.2f} | "
-              f"{r.get('cycles_psnr', nan):.1f} | {r.get('cycles_s', nan):.2f} | {r.get('cycles_cpu_s', nan):.2f} | "
+              f"{r.get('cycles_psnr', nan):.1f} ({r.get('cycles_mean_spp', nan):.0f}) | {r.get('cycles_s', nan):.2f} | "
+              f"{r.get('cycles_cpu_s', nan):.2f} | "
               f"{wall_ratio:.2f} | {cpu_ratio:.2f} | {goal} | {r['clamp_bias_psnr']:.1f} |")
     print("\nclamp bias: PSNR of hybridgen's clamped reference against its unclamped one (higher = less bias; inf = "
           "none). Warm-run phases (s) per scene, startup / import / build / render / write / exit:")
