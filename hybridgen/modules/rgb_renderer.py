@@ -40,7 +40,7 @@ class RgbRenderer(Module):
               "(Cycles' meaning)", check=_optional_positive),
         Param("noise_threshold", "float|null", None, doc="adaptive sampling: a pixel gets no more samples once "
               "its noise estimate (Cycles') is below this (Cycles' meaning: 0.01 is BlenderProc's default); null: "
-              "0.005 when samples is null (samples here cost a third to 0.45 of Cycles'), else off; 0: off",
+              "0.005 when samples is null (a sample here costs 0.3-0.45 of Cycles'), else off; 0: off",
               check=_optional_non_negative),
         Param("use_adaptive_sampling", "float|null", None, doc="BlenderProc 1.x's name of noise_threshold",
               check=_optional_non_negative),

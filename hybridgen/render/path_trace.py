@@ -46,8 +46,8 @@ DEFAULT_MAX_SAMPLES = 1024
 """Samples per pixel at most when ``samples`` is not given (BlenderProc 2.8's default maximum)."""
 DEFAULT_NOISE_THRESHOLD = 0.005
 """Adaptive sampling's threshold when neither ``samples`` nor ``noise_threshold`` is given: half of BlenderProc
-2.8's 0.01, because a sample costs about a third of a Cycles sample here (AVX-512; 1.15-1.4x that, relative to
-Cycles, with AVX2, where Dr.Jit's vectors are half as wide: docs/color_quality.md). An explicit ``noise_threshold``
+2.8's 0.01, because a sample costs about a third of a Cycles sample here (AVX-512; 0.45 with AVX2, where Dr.Jit's
+vectors are half as wide: docs/color_quality.md). An explicit ``noise_threshold``
 keeps Cycles' meaning (0.01 stops pixels where BlenderProc's Cycles does). Chosen by measurement on the four
 scenes of tools/color_quality.py (160x120, denoised, PSNR against 8192-spp references; CPU s of sampling,
 guides and denoising in the process, loaded 2-core machine, 2 runs each), thresholds 0.01 / 0.007 / 0.005 /
