@@ -43,6 +43,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from default_color_process import LOBES
 
 REPO = Path(__file__).resolve().parents[1]
 VARIANT = "llvm_ad_rgb"  # hybridgen's automatic choice on a machine without CUDA (checked at run time)
@@ -449,7 +450,7 @@ def main() -> None:
                         help="quality mode: also time hybridgen at these noise thresholds (tuning)")
     parser.add_argument("--blenderproc-lobes", action="store_true", help="quality mode: hybridgen with "
                         "BlenderProc's glossy_bounces 0 / transmission_bounces 0, the light paths Cycles renders")
-    parser.add_argument("--lobes", choices=("default", "blenderproc", "no-refractive-caustics"), default=None,
+    parser.add_argument("--lobes", choices=sorted(LOBES), default=None,
                         help="quality mode: hybridgen's light paths (tools/default_color_process.py LOBES; "
                         "--blenderproc-lobes is --lobes blenderproc)")
     parser.add_argument("--scenes", default="", help="quality mode: comma-separated scene names (default all)")

@@ -49,6 +49,7 @@ import sys
 import tempfile
 import time
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -335,6 +336,7 @@ class References:
 
 
 # ------------------------------------------------------------------------------------------ the host
+@lru_cache(maxsize=None)
 def host_cpu() -> dict[str, Any]:
     """The CPU the timings come from: its model name and widest vector instruction set, and the float32 lanes
     Dr.Jit's LLVM backend generates for it (16 with AVX-512, 8 with AVX/AVX2, 4 otherwise: its native width).
@@ -415,6 +417,8 @@ class DefaultRuns:
 # ----------------------------------------------------------------------------------------- scoring
 PHASES = ("startup", "import", "build", "render", "write", "exit")
 """The phases of a timed hybridgen process (:meth:`DefaultRuns.run`)."""
+
+
 def lobes_name(args: Any) -> str:
     """The name of default_color_process.LOBES' entry the benchmark renders hybridgen with: ``--lobes``, or
     ``blenderproc`` for ``--blenderproc-lobes``."""

@@ -109,11 +109,13 @@ def path_variances(scene: Any, base: dict[str, Any], ids: np.ndarray, spp: int) 
 
 
 def main() -> None:
+    from default_color_process import LOBES
+
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenes", default="materials", help="comma-separated scene names of color_quality.py")
     parser.add_argument("--res", default="320x240")
     parser.add_argument("--reference-spp", type=int, default=4096)
-    parser.add_argument("--lobes", choices=("default", "blenderproc", "no-refractive-caustics"), default="default")
+    parser.add_argument("--lobes", choices=sorted(LOBES), default="default")
     parser.add_argument("--threshold", type=float, default=None, help="noise threshold (default: hybridgen's)")
     parser.add_argument("--paths", type=int, default=0, help="spp of the light-path variance table (0: skip)")
     parser.add_argument("--reference-cache", default=None, help="folder of the reference cache (or 'off')")
@@ -122,7 +124,6 @@ def main() -> None:
     import color_quality as cq
     import reference_noise as rn
     from bench_color import export_for_cycles
-    from default_color_process import LOBES
     from reference_cache import ReferenceCache, cache_root, scene_digest
 
     from hybridgen.render.path_trace import PathTraceSettings
