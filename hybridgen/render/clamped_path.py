@@ -222,9 +222,10 @@ def register(variant: str) -> None:
                     d_world, pdf_world = world_guide.sample(guide, si.p, sampler.next_1d(), sampler.next_2d(),
                                                             active_world)
                     active_world &= ~scene.ray_test(si.spawn_ray(d_world), active_world)
+                    wo_world = si.to_local(d_world)
                     if no_refractive_caustics:
-                        active_world &= ~(diffuse_prev & refracts(bsdf, si, si.to_local(d_world)))
-                    val_world, pdf_bsdf_world = bsdf.eval_pdf(bsdf_ctx, si, si.to_local(d_world), active_world)
+                        active_world &= ~(diffuse_prev & refracts(bsdf, si, wo_world))
+                    val_world, pdf_bsdf_world = bsdf.eval_pdf(bsdf_ctx, si, wo_world, active_world)
                     sky = throughput * val_world * world_radiance * \
                         (mis_weight(pdf_world, pdf_bsdf_world) / dr.maximum(pdf_world, 1e-20))
                     radiance += self._clamped(dr.select(active_world, sky, 0.0), depth >= 1)

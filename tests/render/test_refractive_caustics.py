@@ -28,9 +28,9 @@ def _lamp_in_glass() -> hg.Scene:
     return scene
 
 
-def _render(scene: hg.Scene, caustics: bool, jit_variant: str, **settings: float) -> np.ndarray:
-    view = PathTraceView(scene, PathTraceSettings(samples=32, caustics_refractive=caustics, clamp_indirect=0.0,
-                                                  **settings), variant=jit_variant)
+def _render(scene: hg.Scene, caustics: bool, jit_variant: str) -> np.ndarray:
+    view = PathTraceView(scene, PathTraceSettings(samples=32, caustics_refractive=caustics, clamp_indirect=0.0),
+                         variant=jit_variant)
     assert view.own_integrator
     return view.render(scene.camera.keypoints[0], seed=3)
 
