@@ -41,6 +41,12 @@ spot of enormous radiance that even a 2048-spp reference does not resolve. Measu
 tools/color_quality.py (160x120, defaults, denoised, PSNR against a 2048-spp reference of the same
 estimator): with BlenderProc's glossy/transmission bounces 0 the spot sat on the black glass and held 81 % of
 the error (42.5 dB; 49.7 dB without its 6x6 px); now 50.5 dB. With 3 bounces per lobe 47.0 -> 48.3 dB.
+The per-lane test (:func:`is_singular`: two attribute queries and three attribute evaluations, each a dispatch to
+the BSDF) runs only in scenes with a material that can be singular (:func:`may_be_singular`, set after loading as
+:attr:`singular_surfaces`); elsewhere no lane is singular and the kernel skips it - same values, and 4 % less time
+for a default frame of the tabletop of tools/color_quality.py (320x240, 5 alternating pairs in one process:
+render_color 3.70 -> 3.54 s wall, 7.27 -> 6.95 s CPU, the same bytes; the test cost ~80 of ~800 ns per sample on
+the pixels that reach 1024 spp, the objects).
 
 Depth is counted as Mitsuba's ``max_depth`` (path segments; ``max_depth = 2`` is direct light only). The
 plugin is written in Python and traced once into the JIT kernel, so it costs what the built-in integrator
@@ -52,6 +58,7 @@ from __future__ import annotations
 from functools import lru_cache
 from typing import Any
 
+from ..scene.material import Material
 from . import glossy_filter, transparent_shadows, world_guide
 
 PLUGIN_NAME = "hybridgen_clamped_path"
@@ -81,6 +88,17 @@ def is_singular(bsdf: Any, si: Any, active: Any = True) -> Any:
     no_diffuse = (bsdf.eval_attribute_1("metallic", si, active) >= 1.0) | \
         (bsdf.eval_attribute_1("spec_trans", si, active) >= 1.0)
     return principled & no_diffuse & (bsdf.eval_attribute_1("roughness", si, active) <= SINGULAR_ROUGHNESS)
+
+
+def may_be_singular(material: Material) -> bool:
+    """Whether any point of a surface with ``material`` can be singular (:func:`is_singular`: no diffuse lobe,
+    roughness at most :data:`SINGULAR_ROUGHNESS`): fully metallic or transmissive somewhere (a value of 1 or a
+    metallic map) and that smooth somewhere (a roughness at or below the threshold, or a roughness map). False
+    guarantees that :func:`is_singular` is false on every lane the material's BSDF is hit; True may be
+    conservative."""
+    metal_or_glass = material.metallic >= 1.0 or material.metallic_texture is not None or material.transmission >= 1.0
+    smooth = material.roughness <= SINGULAR_ROUGHNESS or material.roughness_texture is not None
+    return metal_or_glass and smooth
 
 
 def refracts(bsdf: Any, si: Any, wo: Any) -> Any:
@@ -117,6 +135,8 @@ def register(variant: str) -> None:
             self.hidden_shapes: list[Any] = []
             # hybridgen/render/world_guide.py: light samples of an enclosed constant world (set per keypoint)
             self.world_guide: Any = None  # world_guide.JitGuide
+            # whether any material of the scene may_be_singular (set after load): False skips the per-lane test
+            self.singular_surfaces = True
 
         def _camera_hidden(self, si: Any) -> Any:
             """True where ``si`` lies on one of :attr:`hidden_shapes`."""
@@ -202,7 +222,7 @@ def register(variant: str) -> None:
                     active_next &= ~(hidden & (depth > 0))
 
                 # Singular surfaces (roughness <= SINGULAR_ROUGHNESS after the glossy filter's floor): no NEE.
-                singular = is_singular(bsdf, si, active)
+                singular = is_singular(bsdf, si, active) if self.singular_surfaces else mi.Bool(False)
 
                 # Next-event estimation: one emitter sample, MIS-weighted against BSDF sampling.
                 active_em = active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth) & ~singular
