@@ -51,7 +51,7 @@ import time
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 from default_color_process import LOBES
@@ -426,14 +426,22 @@ def lobes_name(args: Any) -> str:
 
 
 def time_hybridgen(name: str, resolution: str, workdir: Path, args: Any, reference: np.ndarray,
-                   row: dict[str, Any]) -> np.ndarray:
+                   row: dict[str, Any], partner: Callable[[], None] | None = None) -> np.ndarray:
     """Fills ``row`` with hybridgen's whole-process numbers (one cold run, ``args.warm_runs`` warm ones:
-    medians) and PSNR; returns its frame."""
+    medians, and each warm run's times) and PSNR; returns its frame. ``partner`` (Cycles' timed render) runs once
+    beside each warm run - after it in even pairs, before it in odd ones - so each pair of timings sees the same
+    state of the shared machine and a drift in its speed cancels in the pair's ratio."""
     runs = DefaultRuns(name, resolution, workdir, lobes_name(args), args.threads)
     try:
         cold_png, png = workdir / f"{name}_hybridgen_cold.png", workdir / f"{name}_hybridgen.png"
         cold = runs.run(cold_png, args.hg_threshold)
-        warm = [runs.run(png, args.hg_threshold) for _ in range(max(1, args.warm_runs))]
+        warm = []
+        for pair in range(max(1, args.warm_runs)):
+            if partner is not None and pair % 2 == 1:
+                partner()
+            warm.append(runs.run(png, args.hg_threshold))
+            if partner is not None and pair % 2 == 0:
+                partner()
         for threshold in args.try_thresholds:  # tuning: other thresholds, same reference, warm
             other_png = workdir / f"{name}_hybridgen_{threshold}.png"
             other = runs.run(other_png, threshold)
@@ -447,29 +455,50 @@ def time_hybridgen(name: str, resolution: str, workdir: Path, args: Any, referen
                hg_s=statistics.median(run["wall"] for run in warm),
                hg_cpu_s=statistics.median(run["cpu"] for run in warm), hg_cold_s=cold["wall"],
                hg_cold_cpu_s=cold["cpu"], hg_inprocess_s=typical["render"],
+               hg_warm_s=[run["wall"] for run in warm], hg_warm_cpu_s=[run["cpu"] for run in warm],
                hg_phases={key: round(typical[key], 3) for key in PHASES},
                hg_cold_phases={key: round(cold[key], 3) for key in PHASES},
                hg_same_bytes_cold_warm=bool(np.array_equal(_read_png(cold_png), image)))
     return image
 
 
-def time_cycles(name: str, session: CyclesSession, workdir: Path, row: dict[str, Any]) -> np.ndarray:
-    """Fills ``row`` with Cycles' render time at BlenderProc's defaults (``bpy.ops.render.render`` alone);
-    returns its frame."""
-    png = workdir / f"{name}_cycles.png"
-    answer = session.render(1, png, mode="blenderproc")
-    row["cycles_s"], row["cycles_cpu_s"] = answer["seconds"], answer["cpu_s"]
-    # Its samples per pixel from the same render again with Cycles' Debug Sample Count pass (untimed: the pass
-    # is not part of BlenderProc's defaults), so the two engines' samples can be compared, not only their times.
-    counts = workdir / f"{name}_cycles_counts.npy"
-    session.render(1, workdir / f"{name}_cycles_counted.png", mode="blenderproc", sample_counts=str(counts))
-    row["cycles_mean_spp"] = float(np.load(counts).mean())
-    return _read_png(png)
+class CyclesTimes:
+    """Cycles' timed renders at BlenderProc's defaults (``bpy.ops.render.render`` alone), one per call, each
+    into the same PNG (the same seed: the same frame)."""
+
+    def __init__(self, name: str, session: CyclesSession, workdir: Path) -> None:
+        self.name, self.session, self.png = name, session, workdir / f"{name}_cycles.png"
+        self.answers: list[dict[str, Any]] = []
+
+    def __call__(self) -> None:
+        self.answers.append(self.session.render(1, self.png, mode="blenderproc"))
+
+    def finish(self, workdir: Path, row: dict[str, Any]) -> np.ndarray:
+        """Fills ``row`` with the renders' median times, each render's times and the per-pair ratios to
+        hybridgen's warm runs (``row['hg_warm_s']``, in the same order: :func:`time_hybridgen`) with their
+        medians, which the table reports; returns Cycles' frame."""
+        if not self.answers:
+            self()
+        walls, cpus = [a["seconds"] for a in self.answers], [a["cpu_s"] for a in self.answers]
+        row.update(cycles_s=statistics.median(walls), cycles_cpu_s=statistics.median(cpus), cycles_runs_s=walls,
+                   cycles_runs_cpu_s=cpus)
+        if len(row.get("hg_warm_s", [])) == len(walls):
+            walls_ratio = [hg / cy for hg, cy in zip(row["hg_warm_s"], walls)]
+            cpus_ratio = [hg / cy for hg, cy in zip(row["hg_warm_cpu_s"], cpus)]
+            row.update(pair_wall_ratios=walls_ratio, pair_cpu_ratios=cpus_ratio,
+                       wall_ratio=statistics.median(walls_ratio), cpu_ratio=statistics.median(cpus_ratio))
+        # Its samples per pixel from the same render again with Cycles' Debug Sample Count pass (untimed: the pass
+        # is not part of BlenderProc's defaults), so the two engines' samples can be compared, not only their times.
+        counts = workdir / f"{self.name}_cycles_counts.npy"
+        self.session.render(1, workdir / f"{self.name}_cycles_counted.png", mode="blenderproc",
+                            sample_counts=str(counts))
+        row["cycles_mean_spp"] = float(np.load(counts).mean())
+        return _read_png(self.png)
 
 
 def quality_row(name: str, scene: Any, content: str, refs: References, session: CyclesSession | None,
-                args: Any, workdir: Path, out: Path, hybridgen_first: bool) -> dict[str, Any]:
-    """One scene's row: both engines' defaults timed (in the order ``hybridgen_first`` says) and scored
+                args: Any, workdir: Path, out: Path) -> dict[str, Any]:
+    """One scene's row: both engines' defaults timed in interleaved pairs (:func:`time_hybridgen`) and scored
     against their references; the side-by-side PNG (hybridgen | its reference | Cycles | its reference)."""
     from PIL import Image
 
@@ -479,18 +508,15 @@ def quality_row(name: str, scene: Any, content: str, refs: References, session: 
     ref, record = refs.hybridgen(name, scene, content, CLAMP)
     ref_unclamped, _ = refs.hybridgen(name, scene, content, 0.0)
     row["hg_ref_s"], row["hg_ref_cached"] = record["seconds"], record["cached"]
-    parts = [lambda: time_hybridgen(name, resolution, workdir, args, ref, row)]
-    if session is not None:
-        parts.append(lambda: time_cycles(name, session, workdir, row))
-    images = [part() for part in (parts if hybridgen_first else parts[::-1])]
-    image = images[0 if hybridgen_first else -1]
+    cycles_times = CyclesTimes(name, session, workdir) if session is not None else None
+    image = time_hybridgen(name, resolution, workdir, args, ref, row, cycles_times)
     row["hg_psnr_vs_unclamped_ref"] = psnr(image, ref_unclamped)
     row["clamp_bias_psnr"] = psnr(ref, ref_unclamped)
     row["clamp_bias_mean"] = float(ref.astype(float).mean() - ref_unclamped.astype(float).mean())
     panels = [image, ref]
-    if session is not None:
-        cycles = images[1 if hybridgen_first else 0]
-        cycles_ref, record = refs.cycles(name, content, session)
+    if cycles_times is not None:
+        cycles = cycles_times.finish(workdir, row)
+        cycles_ref, record = refs.cycles(name, content, cycles_times.session)
         row["cycles_psnr"] = psnr(cycles, cycles_ref)
         row["cycles_ref_s"], row["cycles_ref_cached"] = record["seconds"], record["cached"]
         panels += [cycles, cycles_ref]
@@ -532,7 +558,7 @@ def run_quality(args: Any, bpy_python: Path | None) -> list[dict[str, Any]]:
     print(f"CPU: {cpu['model']}, {cpu['isa']} (Dr.Jit LLVM {cpu['drjit_llvm_lanes']} lanes)", flush=True)
     rows = []
     try:
-        for index, name in enumerate(args.scenes.split(",") if args.scenes else SCENES):
+        for name in args.scenes.split(",") if args.scenes else SCENES:
             scene = build(name, width, height, workdir)
             npz = workdir / f"{name}.npz"
             export_for_cycles(scene, npz, 1024, 3, 0, threads=args.threads)
@@ -542,7 +568,7 @@ def run_quality(args: Any, bpy_python: Path | None) -> list[dict[str, Any]]:
                 if args.precompute:
                     precompute(name, scene, content, refs, session, args.precompute)
                     continue
-                row = quality_row(name, scene, content, refs, session, args, workdir, out, index % 2 == 0)
+                row = quality_row(name, scene, content, refs, session, args, workdir, out)
             finally:
                 if session is not None:
                     session.close()
@@ -572,15 +598,17 @@ def print_table(rows: list[dict[str, Any]], reference_spp: int) -> None:
     nan = float("nan")
     print(f"\nPSNR (dB, 8-bit sRGB) against each engine's own {reference_spp}-spp reference at "
           f"{rows[0]['resolution']}. hybridgen: the whole process (median of warm runs; cold = fresh Dr.Jit kernel "
-          "and mesh caches; in-proc = render_color alone); Cycles: its render only, at BlenderProc's defaults. "
-          "CPU = user + system s of every thread. Ratio = hybridgen / Cycles.\n")
+          "and mesh caches; in-proc = render_color alone); Cycles: its render only, at BlenderProc's defaults (median of as "
+          "many renders, each paired with a warm run). CPU = user + system s of every thread. Ratio = hybridgen / "
+          "Cycles, the median of the pairs' ratios.\n")
     print("| scene | hybridgen dB (mean spp) | hg wall s | hg CPU s | hg cold wall s | hg in-proc s | "
           "Cycles dB (mean spp) | Cycles wall s | Cycles CPU s | wall ratio | CPU ratio | goal (wall / CPU) | "
           "clamp bias dB |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
-        wall_ratio = r["hg_s"] / r["cycles_s"] if r.get("cycles_s") else nan
-        cpu_ratio = r["hg_cpu_s"] / r["cycles_cpu_s"] if r.get("cycles_cpu_s") else nan
+        # the median of the interleaved pairs' ratios; rows of older JSON files: the ratio of the medians
+        wall_ratio = r.get("wall_ratio", r["hg_s"] / r["cycles_s"] if r.get("cycles_s") else nan)
+        cpu_ratio = r.get("cpu_ratio", r["hg_cpu_s"] / r["cycles_cpu_s"] if r.get("cycles_cpu_s") else nan)
         clean = r["hg_psnr"] >= r.get("cycles_psnr", nan)
         goal = " / ".join("yes" if clean and ratio <= 0.5 else "no" for ratio in (wall_ratio, cpu_ratio))
         print(f"| {_row_name(r)} | {r['hg_psnr']:.1f} ({r['hg_mean_spp']:.0f}) | {r['hg_s']:.2f} | "
