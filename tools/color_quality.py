@@ -35,7 +35,9 @@ tools/reference_cache.py when their key matches (``--reference-cache PATH|off``)
 | its reference | Cycles | its reference) and the rows as JSON go to ``--out``.
 
 The machine is shared: times are wall-clock under whatever load there is (the load average is printed at
-start and end; CPU seconds are steadier); hybridgen and Cycles alternate scene by scene (ABBA).
+start and end; CPU seconds are steadier). Cycles' timed render runs once beside each warm hybridgen run (after it
+in even pairs, before it in odd ones: ABBA), and the table's ratios are the medians of the pairs' ratios, so a
+drift in the machine's speed over minutes cancels.
 """
 from __future__ import annotations
 
@@ -214,8 +216,6 @@ def sky_hdri(path: Path, width: int = 256) -> Path:
 
 
 def hdri_tabletop(width: int, height: int, workdir: Path) -> Any:
-    import hybridgen as hg
-
     scene = tabletop(width, height)
     scene.lights.clear()
     scene.world.hdri_path = str(sky_hdri(workdir / "sky.exr"))
@@ -598,9 +598,9 @@ def print_table(rows: list[dict[str, Any]], reference_spp: int) -> None:
     nan = float("nan")
     print(f"\nPSNR (dB, 8-bit sRGB) against each engine's own {reference_spp}-spp reference at "
           f"{rows[0]['resolution']}. hybridgen: the whole process (median of warm runs; cold = fresh Dr.Jit kernel "
-          "and mesh caches; in-proc = render_color alone); Cycles: its render only, at BlenderProc's defaults (median of as "
-          "many renders, each paired with a warm run). CPU = user + system s of every thread. Ratio = hybridgen / "
-          "Cycles, the median of the pairs' ratios.\n")
+          "and mesh caches; in-proc = render_color alone); Cycles: its render only, at BlenderProc's defaults "
+          "(median of as many renders, each paired with a warm run). CPU = user + system s of every thread. Ratio = "
+          "hybridgen / Cycles, the median of the pairs' ratios.\n")
     print("| scene | hybridgen dB (mean spp) | hg wall s | hg CPU s | hg cold wall s | hg in-proc s | "
           "Cycles dB (mean spp) | Cycles wall s | Cycles CPU s | wall ratio | CPU ratio | goal (wall / CPU) | "
           "clamp bias dB |")
