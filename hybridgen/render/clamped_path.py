@@ -58,6 +58,8 @@ from __future__ import annotations
 from functools import lru_cache
 from typing import Any
 
+import numpy as np
+
 from ..scene.material import Material
 from . import glossy_filter, transparent_shadows, world_guide
 
@@ -95,10 +97,13 @@ def may_be_singular(material: Material) -> bool:
     roughness at most :data:`SINGULAR_ROUGHNESS`): fully metallic or transmissive somewhere (a value of 1 or a
     metallic map) and that smooth somewhere (a roughness at or below the threshold, or a roughness map). False
     guarantees that :func:`is_singular` is false on every lane the material's BSDF is hit; True may be
-    conservative."""
-    metal_or_glass = material.metallic >= 1.0 or material.metallic_texture is not None or material.transmission >= 1.0
-    smooth = material.roughness <= SINGULAR_ROUGHNESS or material.roughness_texture is not None
-    return metal_or_glass and smooth
+    conservative. Values are compared as the BSDF holds and the kernel compares them, in float32 (1 - 1e-9 is 1
+    there)."""
+    f32 = np.float32
+    metal_or_glass = f32(material.metallic) >= 1 or material.metallic_texture is not None or \
+        f32(material.transmission) >= 1
+    smooth = f32(material.roughness) <= f32(SINGULAR_ROUGHNESS) or material.roughness_texture is not None
+    return bool(metal_or_glass and smooth)
 
 
 def refracts(bsdf: Any, si: Any, wo: Any) -> Any:

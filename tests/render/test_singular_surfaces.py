@@ -76,13 +76,18 @@ def test_sharp_mirror_shows_no_point_light_and_the_full_reflected_panel(jit_vari
 
 
 def _grid_of_materials() -> list[Material]:
-    """Constant materials around the singular threshold, and maps of roughness and metallic with texels on both
-    sides of it (a 4 x 4 checker of 0 and 1, each square 4 x 4 texels, so bilinear lookups inside a square are
-    exactly 0 or 1)."""
+    """Constant materials around the singular threshold (also values that float32 rounds onto or off it), and maps
+    of roughness and metallic with texels on both sides of it (a 4 x 4 checker of 0 and 1, each square 4 x 4
+    texels, so bilinear lookups inside a square are exactly 0 or 1)."""
     checker = np.kron(np.indices((4, 4)).sum(axis=0) % 2, np.ones((4, 4), int)).astype(np.uint8) * 255
     out = [Material(metallic=metallic, transmission=transmission, roughness=roughness, specular=specular, ior=1.5)
            for metallic in (0.0, 0.5, 1.0) for transmission in (0.0, 1.0) for roughness in (0.0, 0.0037, 0.004, 0.2)
            for specular in (0.0, 0.5)]
+    threshold = clamped_path.SINGULAR_ROUGHNESS  # values that round across the boundaries in float32
+    out += [Material(metallic=1 - 1e-9, roughness=0.0), Material(transmission=1 - 1e-9, roughness=0.0, ior=1.5),
+            Material(metallic=1.0, roughness=float(np.nextafter(threshold, 1.0))),
+            Material(metallic=1.0, roughness=threshold * (1 + 1e-9)), Material(metallic=1 - 1e-6, roughness=0.0),
+            Material(metallic=1.0, roughness=threshold * (1 + 1e-5))]
     return out + [Material(metallic=1.0, roughness_texture=checker), Material(metallic=0.0, roughness_texture=checker),
                   Material(metallic_texture=checker, roughness=0.0), Material(metallic_texture=checker, roughness=0.2),
                   Material(metallic_texture=checker, roughness_texture=checker[::-1])]
