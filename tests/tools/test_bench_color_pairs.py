@@ -2,7 +2,6 @@
 reported ratios are the medians of the pairs' ratios, each pair's hybridgen run divided by its own Cycles render."""
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
