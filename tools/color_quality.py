@@ -474,19 +474,16 @@ class CyclesTimes:
         self.answers.append(self.session.render(1, self.png, mode="blenderproc"))
 
     def finish(self, workdir: Path, row: dict[str, Any]) -> np.ndarray:
-        """Fills ``row`` with the renders' median times, each render's times and the per-pair ratios to
-        hybridgen's warm runs (``row['hg_warm_s']``, in the same order: :func:`time_hybridgen`) with their
-        medians, which the table reports; returns Cycles' frame."""
-        if not self.answers:
-            self()
+        """After :func:`time_hybridgen` ran one render per warm run: fills ``row`` with the renders' median times,
+        each render's times and the per-pair ratios to hybridgen's warm runs (``row['hg_warm_s']``, in the same
+        order) with their medians, which the table reports; returns Cycles' frame."""
         walls, cpus = [a["seconds"] for a in self.answers], [a["cpu_s"] for a in self.answers]
+        assert len(walls) == len(row["hg_warm_s"]), "one Cycles render per warm hybridgen run"
+        walls_ratio = [hg / cy for hg, cy in zip(row["hg_warm_s"], walls)]
+        cpus_ratio = [hg / cy for hg, cy in zip(row["hg_warm_cpu_s"], cpus)]
         row.update(cycles_s=statistics.median(walls), cycles_cpu_s=statistics.median(cpus), cycles_runs_s=walls,
-                   cycles_runs_cpu_s=cpus)
-        if len(row.get("hg_warm_s", [])) == len(walls):
-            walls_ratio = [hg / cy for hg, cy in zip(row["hg_warm_s"], walls)]
-            cpus_ratio = [hg / cy for hg, cy in zip(row["hg_warm_cpu_s"], cpus)]
-            row.update(pair_wall_ratios=walls_ratio, pair_cpu_ratios=cpus_ratio,
-                       wall_ratio=statistics.median(walls_ratio), cpu_ratio=statistics.median(cpus_ratio))
+                   cycles_runs_cpu_s=cpus, pair_wall_ratios=walls_ratio, pair_cpu_ratios=cpus_ratio,
+                   wall_ratio=statistics.median(walls_ratio), cpu_ratio=statistics.median(cpus_ratio))
         # Its samples per pixel from the same render again with Cycles' Debug Sample Count pass (untimed: the pass
         # is not part of BlenderProc's defaults), so the two engines' samples can be compared, not only their times.
         counts = workdir / f"{self.name}_cycles_counts.npy"

@@ -106,16 +106,21 @@ def may_be_singular(material: Material) -> bool:
     return bool(metal_or_glass and smooth)
 
 
+def transmission(flags: Any) -> Any:
+    """Per lane: Mitsuba BSDF ``flags`` (of a BSDF, or of a sample's lobe) include a glossy or sharp transmission
+    lobe - a refraction, which Cycles' transmission bounces count."""
+    import mitsuba as mi
+
+    return mi.has_flag(flags, mi.BSDFFlags.GlossyTransmission) | mi.has_flag(flags, mi.BSDFFlags.DeltaTransmission)
+
+
 def refracts(bsdf: Any, si: Any, wo: Any) -> Any:
     """Per lane: ``bsdf`` has a glossy or sharp transmission lobe (principled ``spec_trans`` > 0) and the local
     direction ``wo`` lies on the other side of the surface than ``si.wi``, i.e. light along ``wo`` reaches
     ``si.wi`` only by refraction."""
     import mitsuba as mi
 
-    flags = bsdf.flags()
-    refractive = mi.has_flag(flags, mi.BSDFFlags.GlossyTransmission) | \
-        mi.has_flag(flags, mi.BSDFFlags.DeltaTransmission)
-    return refractive & (mi.Frame3f.cos_theta(si.wi) * mi.Frame3f.cos_theta(wo) < 0.0)
+    return transmission(bsdf.flags()) & (mi.Frame3f.cos_theta(si.wi) * mi.Frame3f.cos_theta(wo) < 0.0)
 
 
 @lru_cache(maxsize=None)
@@ -260,8 +265,7 @@ def register(variant: str) -> None:
                 bsdf_sample, bsdf_weight = bsdf.sample(bsdf_ctx, si, sampler.next_1d(), sampler.next_2d(),
                                                        active_next)
                 sampled = bsdf_sample.sampled_type
-                transmits = mi.has_flag(sampled, mi.BSDFFlags.GlossyTransmission) | \
-                    mi.has_flag(sampled, mi.BSDFFlags.DeltaTransmission)
+                transmits = transmission(sampled)
                 glossy = mi.has_flag(sampled, mi.BSDFFlags.GlossyReflection) | \
                     mi.has_flag(sampled, mi.BSDFFlags.DeltaReflection)
                 diffuse = mi.has_flag(sampled, mi.BSDFFlags.Diffuse)

@@ -253,11 +253,12 @@ class PathTraceView:
         self._tracer: PixelTracer | FullFrameTracer = (
             PixelTracer(self.mi_scene, self.sensor, self.mi_scene.integrator(), self.settings.filter_width)
             if is_jit(self.variant) else FullFrameTracer(self))
-        if self.own_integrator:  # the per-lane singular-surface test only where a material can be singular
-            self.mi_scene.integrator().singular_surfaces = any(
-                clamped_path.may_be_singular(obj.material) for obj in scene.objects)
-        if hidden and self.own_integrator:
-            self.mi_scene.integrator().hidden_shapes = camera_hidden_emission.hidden_shapes(description, hidden)
+        if self.own_integrator:
+            integrator = self.mi_scene.integrator()
+            # the per-lane singular-surface test only where a material can be singular
+            integrator.singular_surfaces = any(clamped_path.may_be_singular(obj.material) for obj in scene.objects)
+            if hidden:
+                integrator.hidden_shapes = camera_hidden_emission.hidden_shapes(description, hidden)
         elif hidden:
             from ..config.notices import notice
 
