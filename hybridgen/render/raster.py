@@ -40,6 +40,12 @@ DEFAULT_ATTACHMENTS = [("normal_depth", 4, "f4"), ("instance", 1, "u4")]
 SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swr", "software")
 
 
+def software_renderer(ctx: Any) -> bool:
+    """True when ``ctx`` rasterizes on the CPU (Mesa llvmpipe and kin), False on a GPU driver."""
+    renderer = str(ctx.info.get("GL_RENDERER", "")).lower()
+    return any(name in renderer for name in SOFTWARE_RENDERERS)
+
+
 @dataclass
 class GpuObject:
     """GL resources of one scene object (vertex positions and indices are shared with other passes)."""
@@ -90,9 +96,7 @@ class RasterView:
         self.depth_background = float(depth_background)
         self.cull_clusters = cull_clusters  # leave out triangle clusters that make no fragment (exact)
         self.ctx = ctx if ctx is not None else shared_context(device_index)
-        renderer = str(self.ctx.info.get("GL_RENDERER", "")).lower()
-        software = any(name in renderer for name in SOFTWARE_RENDERERS)
-        self.readback = readback or ("direct" if software else "pbo")
+        self.readback = readback or ("direct" if software_renderer(self.ctx) else "pbo")
         if self.readback not in READBACKS:
             raise InputError(f"readback must be one of {READBACKS}, got {readback!r}")
         self._gl = gl_calls() if gil_free else None  # draws and reads that release the GIL (gl_calls.py)

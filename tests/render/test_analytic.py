@@ -6,6 +6,8 @@ import pytest
 import trimesh
 
 import hybridgen as hg
+from hybridgen.render.gl_context import shared_context
+from hybridgen.render.raster import software_renderer
 from hybridgen.scene.primitives import make_primitive
 from tests.conftest import camera_at
 
@@ -194,5 +196,32 @@ def test_egl_device_choice(monkeypatch):
     assert egl_device_index() == 3 and egl_device_index(1) == 1
     monkeypatch.delenv("HYBRIDGEN_EGL_DEVICE")
     monkeypatch.setenv("CUDA_VISIBLE_DEVICES", "0")
-    assert egl_device_for_cuda(0) is None  # llvmpipe has no CUDA device: falls back to EGL device 0
-    assert egl_device_index() == 0
+    matched = egl_device_for_cuda(0)  # the EGL device of CUDA device 0 (NVIDIA's EGL), None without one
+    if software_renderer(shared_context()):
+        assert matched is None  # llvmpipe has no CUDA device: falls back to EGL device 0
+    assert egl_device_index() == (0 if matched is None else matched)
+
+
+def test_context_asks_for_the_gl_version_it_needs(monkeypatch):
+    """The EGL context is asked for OpenGL 4.3: NVIDIA's EGL gives exactly the version asked for (3.3, moderngl's
+    default, on an H100 with driver 580), where Mesa gives its highest; an older context is refused by name."""
+    import moderngl
+
+    from hybridgen.render.gl_context import MIN_GL_VERSION, create_context
+
+    asked: list[dict[str, object]] = []
+
+    class OldContext:
+        version_code = 330
+
+        def release(self) -> None:
+            pass
+
+    def standalone(**kwargs: object) -> object:
+        asked.append(kwargs)
+        return OldContext()
+
+    monkeypatch.setattr(moderngl, "create_standalone_context", standalone)
+    with pytest.raises(hg.SystemSetupError, match="OpenGL 3.3 found, hybridgen needs 4.3"):
+        create_context(0)
+    assert asked == [{"backend": "egl", "device_index": 0, "require": MIN_GL_VERSION}] and MIN_GL_VERSION == 430
