@@ -26,6 +26,28 @@ in vec3 v_cam_normal;
 in vec2 v_uv;
 #endif
 
+#ifdef EXACT_DEPTH
+// Hardware rasterizers interpolate from vertex positions snapped to their sub-pixel grid; this intersects the
+// pixel centre's ray with the triangle's plane instead (render/face_planes.py).
+layout(std430, binding = 0) readonly buffer FacePlanes { vec4 face_planes[]; };  // (n, w) local: n . x = w
+uniform mat4 u_modelview;       // local -> camera (the vertex stage's)
+uniform mat3 u_normal_to_cam;   // its linear part's inverse-transpose
+uniform vec4 u_pixel_to_ray;    // (1/fx, 1/fy, -cx/fx, -cy/fy)
+flat in uint v_triangle_base;
+
+float fragment_z() {
+    vec4 plane = face_planes[v_triangle_base + uint(gl_PrimitiveID)];
+    vec3 n = u_normal_to_cam * plane.xyz;
+    precise float w = plane.w + dot(n, u_modelview[3].xyz);
+    vec2 pixel = gl_FragCoord.xy - 0.5;  // the pixel centre (u, v): no y flip (render/projection.py)
+    vec3 ray = vec3(pixel * u_pixel_to_ray.xy + u_pixel_to_ray.zw, 1.0);
+    precise float slope = dot(n, ray);
+    return slope != 0.0 ? w / slope : v_z;
+}
+#else
+float fragment_z() { return v_z; }
+#endif
+
 #ifdef PACKED_TARGETS
 layout(location = 0) out float out_depth;
 #ifdef OCTAHEDRAL_NORMALS
@@ -77,7 +99,7 @@ void main() {
     vec3 normal = u_cam_to_output * n;
 #endif
 #ifdef PACKED_TARGETS
-    out_depth = v_z;
+    out_depth = fragment_z();
 #ifdef OCTAHEDRAL_NORMALS
     out_normal_code = octahedral_code(normal);
 #endif
@@ -85,7 +107,7 @@ void main() {
     out_category = u_category_id;
 #endif
 #else
-    out_normal_depth = vec4(normal, v_z);
+    out_normal_depth = vec4(normal, fragment_z());
 #endif
     out_instance = u_instance_id;
 }

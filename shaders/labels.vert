@@ -14,6 +14,10 @@ in vec3 in_normal;
 #ifdef ALPHA_CUTOUT
 in vec2 in_uv;
 #endif
+#ifdef EXACT_DEPTH  // hardware rasterizers (render/face_planes.py): z from the triangle's plane
+in uint in_triangle_base;       // per instance: the draw's first triangle (its command's base instance)
+flat out uint v_triangle_base;
+#endif
 
 out float v_z;                  // camera z (m)
 out vec3 v_cam_normal;
@@ -27,6 +31,9 @@ void main() {
     v_cam_normal = u_normal_to_cam * in_normal;
 #ifdef ALPHA_CUTOUT
     v_uv = in_uv;
+#endif
+#ifdef EXACT_DEPTH
+    v_triangle_base = in_triangle_base;
 #endif
     gl_Position = u_projection * p;
 }

@@ -31,6 +31,7 @@ from .readback import RasterOutput
 from .projection import near_plane_corner_distance, projection_from_K
 from .shader_source import shader_source
 from .cluster_cache import mesh_clusters
+from .face_planes import face_planes, pixel_to_ray
 from .triangle_clusters import TriangleClusters, draw_commands, visible_clusters
 
 NORMAL_SPACES = ("camera", "world")
@@ -63,6 +64,7 @@ class GpuObject:
     packed_vaos: dict[Any, Any] = dataclasses.field(default_factory=dict)  # (LabelTargets, cutout) -> vao
     clusters: TriangleClusters | None = None  # large meshes: culled per keypoint (render/triangle_clusters.py)
     indirect: Any = None  # the draw-command buffer of the kept clusters
+    planes: Any = None  # storage buffer of the triangles' planes (exact depth: render/face_planes.py)
 
 
 class RasterView:
@@ -78,6 +80,11 @@ class RasterView:
     k - 1 is processed, and collecting only maps them. Default: "direct" on software renderers (there a PBO
     adds a copy and makes the draw finish before ``submit`` returns), "pbo" on GPUs. Same values either way.
 
+    ``exact_depth``: the label shader computes z-depth by intersecting each pixel centre's ray with its
+    triangle's plane (render/face_planes.py) instead of interpolating it. Default: on for GPUs, whose
+    rasterizers interpolate from snapped vertex positions (off by up to ~1.5e-4 of the depth at grazing angles);
+    off for software renderers, where interpolation is exact to float32 and the extra reads cost throughput.
+
     ``gil_free``: issue the draws and the direct readback through :mod:`hybridgen.render.gl_calls` (the same
     GL calls without holding the GIL, so compressor threads and other raster threads run meanwhile); False:
     through moderngl.
@@ -88,7 +95,7 @@ class RasterView:
 
     def __init__(self, scene: Scene, *, normals_space: str = "camera", depth_background: float = float("inf"),
                  device_index: int | None = None, ctx: Any = None, cull_clusters: bool = True,
-                 readback: str | None = None, gil_free: bool = True) -> None:
+                 readback: str | None = None, gil_free: bool = True, exact_depth: bool | None = None) -> None:
         if normals_space not in NORMAL_SPACES:
             raise InputError(f"normals_space must be one of {NORMAL_SPACES}, got {normals_space!r}")
         self.scene = scene
@@ -99,6 +106,7 @@ class RasterView:
         self.readback = readback or ("direct" if software_renderer(self.ctx) else "pbo")
         if self.readback not in READBACKS:
             raise InputError(f"readback must be one of {READBACKS}, got {readback!r}")
+        self.exact_depth = not software_renderer(self.ctx) if exact_depth is None else bool(exact_depth)
         self._gl = gl_calls() if gil_free else None  # draws and reads that release the GIL (gl_calls.py)
         self.program = self._label_program(cutout=False)
         self._cutout_program: Any = None  # built with the first object that cuts out (render/alpha_cutout.py)
@@ -125,6 +133,8 @@ class RasterView:
         vertex, fragment = shader_source("labels.vert"), shader_source("labels.frag")
         if cutout:
             vertex, fragment = (text.replace("\n", "\n#define ALPHA_CUTOUT\n", 1) for text in (vertex, fragment))
+        if self.exact_depth:
+            vertex, fragment = (text.replace("\n", "\n#define EXACT_DEPTH\n", 1) for text in (vertex, fragment))
         if targets is not None:
             fragment = fragment.replace("\n", f"\n{targets.defines()}\n", 1)
         return compile_program(self.ctx, vertex_shader=vertex, fragment_shader=fragment)
@@ -181,6 +191,11 @@ class RasterView:
         indices = ctx.buffer(faces.astype(np.uint32).tobytes())
         cutout = upload_cutout(ctx, obj, vertex_order)
         content = [(positions, "3f", "in_position"), (normal_buffer, "3f", "in_normal")]
+        planes = None
+        if self.exact_depth:  # each triangle's plane, and 0, 1, 2, ... read at the draw's base instance
+            planes = ctx.buffer(face_planes(obj.vertices, obj.faces).tobytes())
+            bases = ctx.buffer(np.arange(len(obj.faces), dtype=np.uint32).tobytes())
+            content.append((bases, "1u/i", "in_triangle_base"))
         program = self.program
         if cutout is not None:
             if self._cutout_program is None:
@@ -190,6 +205,8 @@ class RasterView:
                 content.append((cutout.uv_buffer, "2f", "in_uv"))
         vao = ctx.vertex_array(program, content, index_buffer=indices, index_element_size=4)
         extra = cutout.resources() if cutout is not None else []
+        if planes is not None:
+            extra += [planes, content[2][0]]
         # the clusters of obj's triangles (those of a flat mesh's corner vertices are the same), built once
         clusters, indirect = (mesh_clusters(obj.vertices, obj.faces) if self.cull_clusters else None), None
         if clusters is not None:
@@ -198,7 +215,7 @@ class RasterView:
         # a cut-out volume shows its inside through its holes: never culled
         return GpuObject(obj.instance_id, vao, content, positions, indices, [positions, normal_buffer, indices, *extra],
                          vertex_order, obj.is_closed and cutout is None, obj.bounds_local, cutout,
-                         clusters=clusters if indirect is not None else None, indirect=indirect)
+                         clusters=clusters if indirect is not None else None, indirect=indirect, planes=planes)
 
     def _create_framebuffer(self, shape: Shape) -> tuple[Any, list[Any]]:
         """A framebuffer of ``shape`` (width, height, targets) and, for PBO readback, a pixel-pack buffer per
@@ -307,7 +324,8 @@ class RasterView:
         draws = [(*self._draw_program(draw[0], targets), *draw)
                  for draw in self._object_uniforms(cam2world, world2cam, near_reach, hidden)]
         frame_uniforms = {"u_projection": projection.tobytes(),
-                          "u_cam_to_output": to_output.T.astype(np.float32).tobytes()}
+                          "u_cam_to_output": to_output.T.astype(np.float32).tobytes(),
+                          "u_pixel_to_ray": pixel_to_ray(intr.K).tobytes()}
         programs = {id(draw[0]): draw[0] for draw in draws}  # the few distinct programs of this keypoint
         members = {key: set(program) for key, program in programs.items()}  # their uniform names, once each
         for key, program in programs.items():
@@ -331,6 +349,8 @@ class RasterView:
                 prog["u_category_id"].value = int(self._class_lut[gpu.instance_id])
             if gpu.cutout is not None:
                 set_cutout_uniforms(prog, gpu.cutout)
+            if gpu.planes is not None:
+                gpu.planes.bind_to_storage_buffer(0)
             # The projection mirrors handedness (and so may the object's transform): front_face is set so
             # that gl_FrontFacing means "the side the normal points to faces the camera".
             self.ctx.front_face = front_face

@@ -130,7 +130,9 @@ def visible_clusters(clusters: TriangleClusters, modelview: np.ndarray, K: np.nd
 
 def draw_commands(clusters: TriangleClusters, keep: np.ndarray) -> np.ndarray:
     """(R, 5) uint32 ``DrawElementsIndirectCommand`` rows (count, instances, first index, base vertex, base
-    instance) drawing the kept clusters, consecutive ones merged into one run, in the original order."""
+    instance) drawing the kept clusters, consecutive ones merged into one run, in the original order. The base
+    instance is the run's first triangle: the exact-depth label shader adds it to ``gl_PrimitiveID``, which
+    restarts at 0 in every command of a multi-draw (render/face_planes.py)."""
     if not keep.any():
         return np.zeros((0, 5), dtype=np.uint32)
     edges = np.diff(np.concatenate([[0], keep.astype(np.int8), [0]]))
@@ -141,4 +143,5 @@ def draw_commands(clusters: TriangleClusters, keep: np.ndarray) -> np.ndarray:
     out[:, 0] = 3 * (last - first)
     out[:, 1] = 1
     out[:, 2] = 3 * first
+    out[:, 4] = first
     return out

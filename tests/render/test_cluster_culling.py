@@ -86,8 +86,9 @@ def test_clusters_keep_the_triangle_order():
     keep[[0, 1, 3, clusters.size - 1]] = True
     commands = draw_commands(clusters, keep)
     last = clusters.first[-1] + clusters.count[-1]
-    np.testing.assert_array_equal(commands, [[3 * 2 * CLUSTER_TRIANGLES, 1, 0, 0, 0],
-                                             [3 * CLUSTER_TRIANGLES, 1, 3 * 3 * CLUSTER_TRIANGLES, 0, 0],
-                                             [3 * (last - clusters.first[-1]), 1, 3 * clusters.first[-1], 0, 0]])
+    np.testing.assert_array_equal(commands, [
+        [3 * 2 * CLUSTER_TRIANGLES, 1, 0, 0, 0],
+        [3 * CLUSTER_TRIANGLES, 1, 3 * 3 * CLUSTER_TRIANGLES, 0, 3 * CLUSTER_TRIANGLES],
+        [3 * (last - clusters.first[-1]), 1, 3 * clusters.first[-1], 0, clusters.first[-1]]])
     assert draw_commands(clusters, np.zeros(clusters.size, bool)).shape == (0, 5)
     assert build_clusters(vertices, faces[:MIN_TRIANGLES - 1]) is None  # small meshes are drawn whole
