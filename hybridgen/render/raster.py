@@ -191,7 +191,7 @@ class RasterView:
         indices = ctx.buffer(faces.astype(np.uint32).tobytes())
         cutout = upload_cutout(ctx, obj, vertex_order)
         content = [(positions, "3f", "in_position"), (normal_buffer, "3f", "in_normal")]
-        planes = None
+        planes = bases = None
         if self.exact_depth:  # each triangle's plane, and 0, 1, 2, ... read at the draw's base instance
             planes = ctx.buffer(face_planes(obj.vertices, obj.faces).tobytes())
             bases = ctx.buffer(np.arange(len(obj.faces), dtype=np.uint32).tobytes())
@@ -206,7 +206,7 @@ class RasterView:
         vao = ctx.vertex_array(program, content, index_buffer=indices, index_element_size=4)
         extra = cutout.resources() if cutout is not None else []
         if planes is not None:
-            extra += [planes, content[2][0]]
+            extra += [planes, bases]
         # the clusters of obj's triangles (those of a flat mesh's corner vertices are the same), built once
         clusters, indirect = (mesh_clusters(obj.vertices, obj.faces) if self.cull_clusters else None), None
         if clusters is not None:
