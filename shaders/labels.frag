@@ -33,6 +33,7 @@ layout(std430, binding = 0) readonly buffer FacePlanes { vec4 face_planes[]; }; 
 uniform mat4 u_modelview;       // local -> camera (the vertex stage's)
 uniform mat3 u_normal_to_cam;   // its linear part's inverse-transpose
 uniform vec4 u_pixel_to_ray;    // (1/fx, 1/fy, -cx/fx, -cy/fy)
+// EXACT_DEPTH_AGREEMENT is defined by the host with EXACT_DEPTH (render/face_planes.py: AGREEMENT)
 flat in uint v_triangle_base;
 
 float fragment_z() {
@@ -42,7 +43,12 @@ float fragment_z() {
     vec2 pixel = gl_FragCoord.xy - 0.5;  // the pixel centre (u, v): no y flip (render/projection.py)
     vec3 ray = vec3(pixel * u_pixel_to_ray.xy + u_pixel_to_ray.zw, 1.0);
     precise float slope = dot(n, ray);
-    return slope != 0.0 ? w / slope : v_z;
+    if (slope == 0.0) return v_z;
+    precise float z = w / slope;
+    // Coverage comes from snapped positions: a pixel centre given to a triangle seen edge-on can lie past the
+    // plane's horizon, where the division extrapolates. Keep the plane's z only beside the interpolated one
+    // (a GPU's interpolation error measured up to 3e-4 of the depth).
+    return (z > 0.0 && abs(z - v_z) <= EXACT_DEPTH_AGREEMENT * v_z) ? z : v_z;
 }
 #else
 float fragment_z() { return v_z; }

@@ -31,7 +31,7 @@ from .readback import RasterOutput
 from .projection import near_plane_corner_distance, projection_from_K
 from .shader_source import shader_source
 from .cluster_cache import mesh_clusters
-from .face_planes import face_planes, pixel_to_ray
+from .face_planes import AGREEMENT, mesh_face_planes, pixel_to_ray
 from .triangle_clusters import TriangleClusters, draw_commands, visible_clusters
 
 NORMAL_SPACES = ("camera", "world")
@@ -111,6 +111,9 @@ class RasterView:
         self.program = self._label_program(cutout=False)
         self._cutout_program: Any = None  # built with the first object that cuts out (render/alpha_cutout.py)
         self._packed_programs: dict[tuple[LabelTargets, bool], Any] = {}  # label_targets.py variants
+        # exact depth: 0, 1, 2, ... read per draw at its base instance (its first triangle), one for all objects
+        self._triangle_bases = self.ctx.buffer(np.arange(max([len(obj.faces) for obj in scene.objects] + [1]),
+                                                         dtype=np.uint32).tobytes()) if self.exact_depth else None
         self.gpu_objects = self._upload_all(scene.objects)
         try:  # instance id -> category_id, for the category_id_segmaps pass (0 where an object has none)
             self._class_lut = self.category_lut()
@@ -134,7 +137,8 @@ class RasterView:
         if cutout:
             vertex, fragment = (text.replace("\n", "\n#define ALPHA_CUTOUT\n", 1) for text in (vertex, fragment))
         if self.exact_depth:
-            vertex, fragment = (text.replace("\n", "\n#define EXACT_DEPTH\n", 1) for text in (vertex, fragment))
+            defines = f"\n#define EXACT_DEPTH\n#define EXACT_DEPTH_AGREEMENT {AGREEMENT!r}\n"
+            vertex, fragment = (text.replace("\n", defines, 1) for text in (vertex, fragment))
         if targets is not None:
             fragment = fragment.replace("\n", f"\n{targets.defines()}\n", 1)
         return compile_program(self.ctx, vertex_shader=vertex, fragment_shader=fragment)
@@ -191,11 +195,10 @@ class RasterView:
         indices = ctx.buffer(faces.astype(np.uint32).tobytes())
         cutout = upload_cutout(ctx, obj, vertex_order)
         content = [(positions, "3f", "in_position"), (normal_buffer, "3f", "in_normal")]
-        planes = bases = None
-        if self.exact_depth:  # each triangle's plane, and 0, 1, 2, ... read at the draw's base instance
-            planes = ctx.buffer(face_planes(obj.vertices, obj.faces).tobytes())
-            bases = ctx.buffer(np.arange(len(obj.faces), dtype=np.uint32).tobytes())
-            content.append((bases, "1u/i", "in_triangle_base"))
+        planes = None
+        if self._triangle_bases is not None:  # each triangle's plane, indexed from the draw's first triangle
+            planes = ctx.buffer(mesh_face_planes(obj.vertices, obj.faces).tobytes())
+            content.append((self._triangle_bases, "1u/i", "in_triangle_base"))
         program = self.program
         if cutout is not None:
             if self._cutout_program is None:
@@ -206,7 +209,7 @@ class RasterView:
         vao = ctx.vertex_array(program, content, index_buffer=indices, index_element_size=4)
         extra = cutout.resources() if cutout is not None else []
         if planes is not None:
-            extra += [planes, bases]
+            extra.append(planes)
         # the clusters of obj's triangles (those of a flat mesh's corner vertices are the same), built once
         clusters, indirect = (mesh_clusters(obj.vertices, obj.faces) if self.cull_clusters else None), None
         if clusters is not None:
@@ -489,6 +492,9 @@ class RasterView:
             for buf in gpu.buffers:
                 buf.release()
         self.gpu_objects = []
+        if self._triangle_bases is not None:
+            self._triangle_bases.release()
+            self._triangle_bases = None
         for slot in list(self._fences):
             self._drop_fence(slot)
         self._submitted.clear()
