@@ -103,10 +103,11 @@ class RasterView:
         self.depth_background = float(depth_background)
         self.cull_clusters = cull_clusters  # leave out triangle clusters that make no fragment (exact)
         self.ctx = ctx if ctx is not None else shared_context(device_index)
-        self.readback = readback or ("direct" if software_renderer(self.ctx) else "pbo")
+        software = software_renderer(self.ctx)
+        self.readback = readback or ("direct" if software else "pbo")
         if self.readback not in READBACKS:
             raise InputError(f"readback must be one of {READBACKS}, got {readback!r}")
-        self.exact_depth = not software_renderer(self.ctx) if exact_depth is None else bool(exact_depth)
+        self.exact_depth = not software if exact_depth is None else bool(exact_depth)
         self._gl = gl_calls() if gil_free else None  # draws and reads that release the GIL (gl_calls.py)
         self.program = self._label_program(cutout=False)
         self._cutout_program: Any = None  # built with the first object that cuts out (render/alpha_cutout.py)
