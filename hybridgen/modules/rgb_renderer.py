@@ -35,9 +35,9 @@ class RgbRenderer(Module):
     path_traces = True
 
     params = (
-        Param("samples", "int|null", None, "spp", "null: adaptive sampling up to 1024 spp (BlenderProc 2.8's "
-              "default); N: a plain N-spp estimate in every pixel, or at most N when noise_threshold is given "
-              "(Cycles' meaning)", check=_optional_positive),
+        Param("samples", "int|null", None, "spp", "null: adaptive sampling up to 768 spp (hybridgen's default), "
+              "or up to 1024 (BlenderProc 2.8's) when noise_threshold is given; N: a plain N-spp estimate in every "
+              "pixel, or at most N when noise_threshold is given (Cycles' meaning)", check=_optional_positive),
         Param("noise_threshold", "float|null", None, doc="adaptive sampling: a pixel gets no more samples once "
               "its noise estimate (Cycles') is below this (Cycles' meaning: 0.01 is BlenderProc's default); null: "
               "0.005 when samples is null (a sample here costs 0.3-0.45 of Cycles'), else off; 0: off",

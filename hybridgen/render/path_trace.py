@@ -42,8 +42,22 @@ noise of the tabletop scene of tools/color_quality.py at 16 / 64 / 256 spp from 
 CPU time per sample. Sample counts are traced as whole 4^k-point patterns
 (:func:`hybridgen.render.adaptive_sampling.launch_counts`)."""
 
-DEFAULT_MAX_SAMPLES = 1024
-"""Samples per pixel at most when ``samples`` is not given (BlenderProc 2.8's default maximum)."""
+DEFAULT_MAX_SAMPLES = 768
+"""Samples per pixel at most when neither ``samples`` nor ``noise_threshold`` is given (with
+:data:`DEFAULT_NOISE_THRESHOLD`): hybridgen's own default, three quarters of BlenderProc's. The pixels that reach
+the maximum are the hard ones (object edges and contact regions, glossy and refracting paths), where a sample costs
+3-4x an average one (docs/color_quality.md, session 9), and Open Image Denoise removes most of what their last
+samples would: measured on the four scenes of tools/color_quality.py (320x240, in one process per scene, denoised,
+PSNR against the benchmark's 4096-spp references; CPU s of ``render_color``, variants alternating, AVX2 host,
+issue #14 session 11) at threshold 0.005, maximum 1024 / 768 / 640 / 512: tabletop 54.31 / 54.10 / 53.95 / 53.70 dB
+at 9.64 / 7.66 / 7.47 / 7.57 s (the last from another run: 10.28 s for 1024 there); window room 49.09 / 48.98 /
+48.90 / 48.77 dB at 93.1 / 62.1 s for the first two (the maximum binds in most of its pixels); HDRI tabletop
+52.80 / 52.53 / 52.31 / 52.00 dB at 29.9 / 25.5 / 20.9 / 18.6 s; materials 51.64 / 51.12 / 50.78 / 50.51 dB at
+32.8 / 24.3 / 21.7 / 20.8 s. 768 keeps every scene but materials as clean as Cycles at BlenderProc's defaults
+(53.2, 48.9, 52.1 dB) for 15-33 % less CPU than 1024."""
+CYCLES_MAX_SAMPLES = 1024
+"""Samples per pixel at most when ``noise_threshold`` is given without ``samples``: BlenderProc 2.8's default
+maximum, so a BlenderProc config's threshold stops pixels where its Cycles would."""
 DEFAULT_NOISE_THRESHOLD = 0.005
 """Adaptive sampling's threshold when neither ``samples`` nor ``noise_threshold`` is given: half of BlenderProc
 2.8's 0.01, because a sample costs about a third of a Cycles sample here (AVX-512; 0.45 with AVX2, where Dr.Jit's
@@ -83,7 +97,8 @@ class PathTraceSettings:
     Sampling (see :mod:`hybridgen.render.adaptive_sampling`): with ``samples`` not given, every pixel is
     sampled adaptively from ``min_samples`` (0, the default: Cycles' automatic minimum for the threshold, 80 at
     0.005, 64 at 0.01) until its noise estimate is below ``noise_threshold`` (default
-    :data:`DEFAULT_NOISE_THRESHOLD`, 0.005; Cycles' meaning when given) or it has :data:`DEFAULT_MAX_SAMPLES`.
+    :data:`DEFAULT_NOISE_THRESHOLD`, 0.005; Cycles' meaning when given) or it has :data:`DEFAULT_MAX_SAMPLES`
+    (768; :data:`CYCLES_MAX_SAMPLES`, BlenderProc's 1024, when ``noise_threshold`` is given).
     An explicit ``samples: N`` is a plain N-spp estimate in every pixel, unless ``noise_threshold`` is given
     too: then N is the maximum (Cycles' meaning of samples with adaptive sampling on).
 
@@ -135,9 +150,9 @@ class PathTraceSettings:
     def plan(self) -> SamplingPlan:
         """The per-pixel sample plan these settings stand for (rule in the class docstring)."""
         if self.samples is None:
-            threshold = DEFAULT_NOISE_THRESHOLD if self.noise_threshold is None else self.noise_threshold
-            return SamplingPlan(DEFAULT_MAX_SAMPLES, min(self._min_samples(threshold), DEFAULT_MAX_SAMPLES),
-                                threshold)
+            threshold, most = (DEFAULT_NOISE_THRESHOLD, DEFAULT_MAX_SAMPLES) if self.noise_threshold is None \
+                else (self.noise_threshold, CYCLES_MAX_SAMPLES)
+            return SamplingPlan(most, min(self._min_samples(threshold), most), threshold)
         threshold = self.noise_threshold or 0.0
         return SamplingPlan(self.samples, min(self._min_samples(threshold), self.samples) if threshold
                             else self.samples, threshold)

@@ -91,7 +91,11 @@ def test_sampling_plan_rounds_double_up_to_the_maximum():
 def test_explicit_samples_are_a_plain_fixed_count_and_defaults_are_adaptive(variant):
     assert not PathTraceSettings(samples=8).plan().adaptive
     default = PathTraceSettings().plan()
-    assert default.adaptive and default.max_samples == 1024 and default.noise_threshold == 0.005
+    assert default.adaptive and default.max_samples == 768 and default.noise_threshold == 0.005
+    assert default.rounds() == [80, 80, 160, 320, 128]
+    # a threshold given alone keeps BlenderProc's maximum (Cycles' meaning); samples alone stays a fixed count
+    assert PathTraceSettings(noise_threshold=0.01).plan() == SamplingPlan(1024, 64, 0.01)
+    assert PathTraceSettings(noise_threshold=0.005).plan().max_samples == 1024
     assert PathTraceSettings(samples=64, noise_threshold=0.05, min_samples=16).plan() == SamplingPlan(64, 16, 0.05)
     # min_samples 0 (the default) is Cycles' automatic minimum: ceil(16 / threshold^0.3), at least 4, even
     assert default.min_samples == 80 and PathTraceSettings(noise_threshold=0.01).plan().min_samples == 64
