@@ -46,15 +46,13 @@ DEFAULT_MAX_SAMPLES = 768
 """Samples per pixel at most when neither ``samples`` nor ``noise_threshold`` is given (with
 :data:`DEFAULT_NOISE_THRESHOLD`): hybridgen's own default, three quarters of BlenderProc's. The pixels that reach
 the maximum are the hard ones (object edges and contact regions, glossy and refracting paths), where a sample costs
-3-4x an average one (docs/color_quality.md, session 9), and Open Image Denoise removes most of what their last
-samples would: measured on the four scenes of tools/color_quality.py (320x240, in one process per scene, denoised,
-PSNR against the benchmark's 4096-spp references; CPU s of ``render_color``, variants alternating, AVX2 host,
-issue #14 session 11) at threshold 0.005, maximum 1024 / 768 / 640 / 512: tabletop 54.31 / 54.10 / 53.95 / 53.70 dB
-at 9.64 / 7.66 / 7.47 / 7.57 s (the last from another run: 10.28 s for 1024 there); window room 49.09 / 48.98 /
-48.90 / 48.77 dB at 93.1 / 62.1 s for the first two (the maximum binds in most of its pixels); HDRI tabletop
-52.80 / 52.53 / 52.31 / 52.00 dB at 29.9 / 25.5 / 20.9 / 18.6 s; materials 51.64 / 51.12 / 50.78 / 50.51 dB at
-32.8 / 24.3 / 21.7 / 20.8 s. 768 keeps every scene but materials as clean as Cycles at BlenderProc's defaults
-(53.2, 48.9, 52.1 dB) for 15-33 % less CPU than 1024."""
+3-4x an average one, and Open Image Denoise removes most of what their last samples would. Measured on the four
+scenes of tools/color_quality.py (320x240, denoised, PSNR against the benchmark's 4096-spp references, CPU s of
+``render_color`` with the maxima in turn in one process per scene, AVX2 host; docs/color_quality.md, session 11),
+maximum 1024 -> 768 at threshold 0.005: tabletop 54.31 -> 54.10 dB, 9.64 -> 7.66 s; window room 49.09 -> 48.98 dB,
+93.1 -> 62.1 s (the maximum binds in most of its pixels); HDRI tabletop 52.80 -> 52.53 dB, 29.9 -> 25.5 s;
+materials 51.64 -> 51.12 dB, 32.8 -> 24.3 s. Every scene but materials stays as clean as Cycles at BlenderProc's
+defaults (53.2, 48.9, 52.1 dB); 640 and 512 are not (window room 48.90 and 48.77 dB)."""
 CYCLES_MAX_SAMPLES = 1024
 """Samples per pixel at most when ``noise_threshold`` is given without ``samples``: BlenderProc 2.8's default
 maximum, so a BlenderProc config's threshold stops pixels where its Cycles would."""
