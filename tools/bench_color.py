@@ -446,6 +446,8 @@ def main() -> None:
     parser.add_argument("--reference-spp", type=int, default=4096, help="quality mode: reference spp")
     parser.add_argument("--hg-threshold", type=float, default=None, help="quality mode: hybridgen's noise "
                         "threshold (default: its default)")
+    parser.add_argument("--hg-max-samples", type=int, default=None, help="quality mode: hybridgen's maximum "
+                        "samples per pixel, adaptive at its threshold (default: its default)")
     parser.add_argument("--try-thresholds", type=lambda v: [float(x) for x in v.split(",")], default=[],
                         help="quality mode: also time hybridgen at these noise thresholds (tuning)")
     parser.add_argument("--blenderproc-lobes", action="store_true", help="quality mode: hybridgen with "

@@ -395,13 +395,15 @@ class DefaultRuns:
                     "HYBRIDGEN_CACHE_DIR": str(self.caches / "hybridgen"), "HYBRIDGEN_THREADS": str(threads)}
         self.env.pop("PYTHONDONTWRITEBYTECODE", None)
 
-    def run(self, png: Path, threshold: float | None = None) -> dict[str, Any]:
-        """One process: wall and CPU seconds, mean spp, and its phases (s): ``startup`` (spawn to the script's
+    def run(self, png: Path, threshold: float | None = None, max_samples: int | None = None) -> dict[str, Any]:
+        """One process (hybridgen's defaults but for a noise ``threshold`` and a ``max_samples`` when given):
+        wall and CPU seconds, mean spp, and its phases (s): ``startup`` (spawn to the script's
         first line), ``import`` (hybridgen), ``build`` (the scene), ``render`` (render_color: scene translation,
         kernels, raster guides, render, denoise - the in-process time), ``write`` (the PNG), ``exit``."""
         command = [sys.executable, str(REPO / "tools" / "default_color_process.py"), self.name, self.resolution,
                    str(png), str(self.workdir), "--lobes", self.lobes]
         command += ["--threshold", str(threshold)] if threshold is not None else []
+        command += ["--max-samples", str(max_samples)] if max_samples is not None else []
         spawned = time.time()
         finished = run_timed(command, self.env)
         r = finished.report
@@ -434,17 +436,17 @@ def time_hybridgen(name: str, resolution: str, workdir: Path, args: Any, referen
     runs = DefaultRuns(name, resolution, workdir, lobes_name(args), args.threads)
     try:
         cold_png, png = workdir / f"{name}_hybridgen_cold.png", workdir / f"{name}_hybridgen.png"
-        cold = runs.run(cold_png, args.hg_threshold)
+        cold = runs.run(cold_png, args.hg_threshold, args.hg_max_samples)
         warm = []
         for pair in range(max(1, args.warm_runs)):
             if partner is not None and pair % 2 == 1:
                 partner()
-            warm.append(runs.run(png, args.hg_threshold))
+            warm.append(runs.run(png, args.hg_threshold, args.hg_max_samples))
             if partner is not None and pair % 2 == 0:
                 partner()
         for threshold in args.try_thresholds:  # tuning: other thresholds, same reference, warm
             other_png = workdir / f"{name}_hybridgen_{threshold}.png"
-            other = runs.run(other_png, threshold)
+            other = runs.run(other_png, threshold, args.hg_max_samples)
             row[f"hg_{threshold}"] = {"psnr": psnr(_read_png(other_png), reference), "s": other["wall"],
                                       "spp": other["mean_spp"], "cpu_s": other["cpu"]}
     finally:
@@ -501,7 +503,8 @@ def quality_row(name: str, scene: Any, content: str, refs: References, session: 
 
     resolution = refs.resolution
     row: dict[str, Any] = {"scene": name, "resolution": resolution, "reference_spp": refs.spp, "lobes": refs.lobes,
-                           "hg_threshold": args.hg_threshold, "cpu": host_cpu()}
+                           "hg_threshold": args.hg_threshold, "hg_max_samples": args.hg_max_samples,
+                           "cpu": host_cpu()}
     ref, record = refs.hybridgen(name, scene, content, CLAMP)
     ref_unclamped, _ = refs.hybridgen(name, scene, content, 0.0)
     row["hg_ref_s"], row["hg_ref_cached"] = record["seconds"], record["cached"]
@@ -585,6 +588,7 @@ def _row_name(row: dict[str, Any]) -> str:
     JSON files have no such keys)."""
     notes = [f"{row['lobes']} lobes"] if row.get("lobes", "default") != "default" else []
     notes += [f"threshold {row['hg_threshold']:g}"] if row.get("hg_threshold") is not None else []
+    notes += [f"at most {row['hg_max_samples']} spp"] if row.get("hg_max_samples") is not None else []
     return row["scene"] + (f" ({', '.join(notes)})" if notes else "")
 
 

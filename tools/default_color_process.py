@@ -25,6 +25,7 @@ import argparse  # noqa: E402
 import json  # noqa: E402
 import sys  # noqa: E402
 from pathlib import Path  # noqa: E402
+from typing import Any  # noqa: E402
 
 LOBES: dict[str, dict[str, int | bool]] = {
     "default": {}, "blenderproc": {"glossy_bounces": 0, "transmission_bounces": 0},
@@ -42,6 +43,8 @@ def main() -> None:
     parser.add_argument("workdir", type=Path, help="folder for generated scene inputs (the HDRI)")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--threshold", type=float, default=None, help="noise threshold (default: hybridgen's)")
+    parser.add_argument("--max-samples", type=int, default=None,
+                        help="most samples per pixel, adaptive at the threshold (default: hybridgen's)")
     parser.add_argument("--lobes", choices=sorted(LOBES), default="default")
     parser.add_argument("--exit", choices=("command", "interpreter"), default="command",
                         help="end as the hybridgen command does (default) or through Python's normal shutdown")
@@ -58,7 +61,13 @@ def main() -> None:
     scene = color_quality.build(args.scene, width, height, args.workdir)
     marks["built"] = time.time()
     sink = hg.MemorySink()
-    hg.render_color(scene, [sink], hg.PathTraceSettings(noise_threshold=args.threshold, **LOBES[args.lobes]),
+    sampling: dict[str, Any] = {"noise_threshold": args.threshold}
+    if args.max_samples is not None:  # samples with a threshold is a maximum (without one, a fixed count)
+        from hybridgen.render.path_trace import DEFAULT_NOISE_THRESHOLD
+
+        sampling = {"samples": args.max_samples,
+                    "noise_threshold": DEFAULT_NOISE_THRESHOLD if args.threshold is None else args.threshold}
+    hg.render_color(scene, [sink], hg.PathTraceSettings(**sampling, **LOBES[args.lobes]),
                     seed=args.seed, denoise=True, sample_counts=True)
     marks["rendered"] = time.time()
     from PIL import Image

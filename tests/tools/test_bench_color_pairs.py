@@ -45,13 +45,15 @@ class FakeSession:
 def test_pairs_alternate_and_ratios_are_medians_of_pairs(color_quality: Any, tmp_path: Path,
                                                          monkeypatch: pytest.MonkeyPatch) -> None:
     log: list[str] = []
+    settings: list[tuple[float | None, int | None]] = []  # (threshold, max_samples) of every hybridgen process
     hg_times = iter([(9.0, 9.0), (4.0, 8.0), (5.0, 9.0), (3.0, 7.0)])  # cold, then three warm runs
 
     class FakeRuns:
         def __init__(self, *args: Any) -> None:
             pass
 
-        def run(self, png: Path, threshold: float | None = None) -> dict[str, Any]:
+        def run(self, png: Path, threshold: float | None = None, max_samples: int | None = None) -> dict[str, Any]:
+            settings.append((threshold, max_samples))
             wall, cpu = next(hg_times)
             log.append("cold" if "cold" in png.name else "hybridgen")
             _png(png, 5)
@@ -61,14 +63,15 @@ def test_pairs_alternate_and_ratios_are_medians_of_pairs(color_quality: Any, tmp
             pass
 
     monkeypatch.setattr(color_quality, "DefaultRuns", FakeRuns)
-    args = SimpleNamespace(warm_runs=3, hg_threshold=None, try_thresholds=[], threads=2, lobes=None,
-                           blenderproc_lobes=False)
+    args = SimpleNamespace(warm_runs=3, hg_threshold=None, hg_max_samples=512, try_thresholds=[], threads=2,
+                           lobes=None, blenderproc_lobes=False)
     cycles = color_quality.CyclesTimes("s", FakeSession([(8.0, 16.0), (10.0, 20.0), (6.0, 12.0)], log), tmp_path)
     row: dict[str, Any] = {}
     image = color_quality.time_hybridgen("s", "3x2", tmp_path, args, np.full((2, 3, 3), 5, np.uint8), row, cycles)
     frame = cycles.finish(tmp_path, row)
 
     assert log == ["cold", "hybridgen", "cycles", "cycles", "hybridgen", "hybridgen", "cycles", "cycles counts"]
+    assert settings == [(None, 512)] * 4  # --hg-max-samples reaches every timed process
     assert row["pair_wall_ratios"] == pytest.approx([4 / 8, 5 / 10, 3 / 6])
     assert row["pair_cpu_ratios"] == pytest.approx([8 / 16, 9 / 20, 7 / 12])
     assert row["wall_ratio"] == pytest.approx(0.5) and row["cpu_ratio"] == pytest.approx(0.5)
