@@ -48,6 +48,14 @@ for a default frame of the tabletop of tools/color_quality.py (320x240, 5 altern
 render_color 3.70 -> 3.54 s wall, 7.27 -> 6.95 s CPU, the same bytes; the test cost ~80 of ~800 ns per sample on
 the pixels that reach 1024 spp, the objects).
 
+Shadow rays are traced only where the light sample can contribute: the emitter is sampled without Mitsuba's
+visibility test, the BSDF evaluated, and the shadow ray (the segment Mitsuba's own test would trace) cast only on
+lanes where both the BSDF value and the emitter's weight are non-zero - not from the side of an opaque surface
+that faces away from the light, nor where the light sample missed. The values are the same bytes as with
+Mitsuba's test (the tabletop and materials scenes of tools/color_quality.py, 160x120, 32 spp); default frames of
+the tabletop take 5-10 % less time (320x240, 9 alternating pairs in one process: medians 3.72 -> 3.33 s and 3.85
+-> 3.64 s wall in two runs), fixed 64-spp renders of the materials and HDRI tabletop scenes ~1 % less.
+
 Depth is counted as Mitsuba's ``max_depth`` (path segments; ``max_depth = 2`` is direct light only). The
 plugin is written in Python and traced once into the JIT kernel, so it costs what the built-in integrator
 costs in the ``llvm``/``cuda`` variants; in ``scalar_rgb`` it would run Python per sample, so the color
@@ -236,14 +244,19 @@ def register(variant: str) -> None:
 
                 # Next-event estimation: one emitter sample, MIS-weighted against BSDF sampling.
                 active_em = active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth) & ~singular
-                ds_em, em_weight = scene.sample_emitter_direction(si, sampler.next_2d(), not transparent, active_em)
+                ds_em, em_weight = scene.sample_emitter_direction(si, sampler.next_2d(), False, active_em)
                 active_em &= ds_em.pdf != 0.0
-                if transparent:
-                    em_weight *= transparent_shadows.shadow_transmittance(scene, si, ds_em, active_em)
                 wo = si.to_local(ds_em.d)
                 if no_refractive_caustics:  # no light through a refracting surface reached by a diffuse bounce
                     active_em &= ~(diffuse_prev & refracts(bsdf, si, wo))
                 bsdf_val, bsdf_pdf = bsdf.eval_pdf(bsdf_ctx, si, wo, active_em)
+                # The shadow ray only where the light sample can contribute (module docstring: same values)
+                shadowed = active_em & (dr.max(mi.unpolarized_spectrum(bsdf_val)) > 0) & \
+                    (dr.max(mi.unpolarized_spectrum(em_weight)) > 0)
+                if transparent:
+                    em_weight *= transparent_shadows.shadow_transmittance(scene, si, ds_em, shadowed)
+                else:
+                    em_weight = dr.select(scene.ray_test(si.spawn_ray_to(ds_em.p), shadowed), 0.0, em_weight)
                 mis_em = dr.select(ds_em.delta, 1.0, mis_weight(ds_em.pdf, bsdf_pdf))
                 lit = dr.select(active_em, throughput * bsdf_val * em_weight * mis_em, 0.0)
                 radiance += self._clamped(lit, depth >= 1)

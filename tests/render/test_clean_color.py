@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
-from hybridgen.render.adaptive_sampling import SamplingPlan, automatic_min_samples, pixel_error
+from hybridgen.render.adaptive_sampling import SamplingPlan, automatic_min_samples, dilate, pixel_error
 from hybridgen.render.mitsuba_variant import choose_variant, is_jit
 from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
 from hybridgen.render.render_color import ColorProducer
@@ -183,6 +183,48 @@ def test_clamping_never_changes_direct_light_but_clamps_indirect(variant):
     b = PathTraceView(scene, PathTraceSettings(samples=64, clamp_indirect=0.0), variant=variant).render(pose, seed=3)
     assert a.mean() < 0.995 * b.mean()
     assert (a <= b * (1 + 1e-5) + 1e-6).all()
+
+
+def test_shadow_rays_darken_exactly_the_shadow_of_an_occluder(variant):
+    """Direct light only (next-event estimation alone): a square plate between a point lamp and the floor.
+    Floor pixels whose point the plate hides from the lamp are black; every other floor pixel has the value it
+    has without the plate. (The integrator traces a shadow ray only where the light sample can contribute; a
+    skipped ray where it could, or a test against the wrong segment, lets light through or darkens lit floor.)"""
+    if not is_jit(variant):
+        pytest.skip("the clamped integrator needs a JIT variant")
+    lamp, plate_centre, half = np.array([1.0, 0.0, 2.0]), np.array([0.5, 0.0, 1.0]), 0.2
+
+    def scene_with(plate: bool) -> hg.Scene:
+        scene = _lamp_over_floor(wall=False)
+        scene.lights[0].local2world = hg.object_pose(lamp.tolist())
+        if plate:
+            scene.add(hg.make_primitive("plane", 2 * half, name="plate", category_id=2, color=(0.5, 0.5, 0.5),
+                                        local2world=hg.object_pose(plate_centre.tolist())))
+        scene.camera.intrinsics = hg.Intrinsics.from_fov(0.9, 40, 40)
+        scene.camera.keypoints[0] = hg.look_at([-1.0, -0.2, 3.0], [0.0, 0.0, 0.0])
+        return scene
+
+    settings = PathTraceSettings(samples=16, max_bounces=0, filter_width=0.0)
+    scenes = scene_with(True), scene_with(False)
+    pose = scenes[0].camera.keypoints[0]
+    shadowed_img, open_img = (PathTraceView(s, settings, variant=variant).render(pose, seed=5) for s in scenes)
+    # floor point of every pixel centre (OpenCV camera axes), and whether the plate blocks it from the lamp
+    rays = scenes[0].camera.intrinsics.pixel_rays() @ pose[:3, :3].T
+    floor = pose[:3, 3] + rays * (-pose[2, 3] / rays[..., 2:3])
+    t = (plate_centre[2] - floor[..., 2]) / (lamp[2] - floor[..., 2])  # where the segment crosses the plate's z
+    cross = floor + t[..., None] * (lamp - floor)
+    blocked = (np.abs(cross[..., :2] - plate_centre[:2]) < half).all(axis=-1)
+    plate_seen = (np.abs((pose[:3, 3] + rays * ((plate_centre[2] - pose[2, 3]) / rays[..., 2:3]))[..., :2]
+                         - plate_centre[:2]) < half).all(axis=-1)
+    margin = dilate(dilate(blocked)) & ~erode(erode(blocked)) | dilate(dilate(plate_seen))  # sub-pixel edges
+    umbra, lit = blocked & ~margin, ~blocked & ~margin
+    assert umbra.sum() > 20 and lit.sum() > 200
+    assert (shadowed_img[umbra] == 0).all() and (open_img[umbra] > 0.1).all()
+    np.testing.assert_array_equal(shadowed_img[lit], open_img[lit])
+
+
+def erode(mask: np.ndarray) -> np.ndarray:
+    return ~dilate(~mask)
 
 
 def test_emitters_are_sampled_in_proportion_to_their_power(variant, monkeypatch):
