@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from functools import partial
 from typing import Any, Iterable
 
 import numpy as np
@@ -406,10 +407,11 @@ class RasterView:
             else:
                 fbo.read_into(arrays[name], attachment=attachment, components=components, dtype=kind)
         if targets is not None:
-            return RasterOutput(None, arrays["instance"], self._rays(intr), self._class_lut, self.depth_background,
-                                depth_image=arrays["depth"], normal_codes=arrays.get("normal_codes"),
-                                category=arrays.get("category"), encoded=dict(targets.encoded))
-        return RasterOutput(arrays["normal_depth"], arrays["instance"], self._rays(intr), self._class_lut,
+            return RasterOutput(None, arrays["instance"], partial(self._rays, intr), self._class_lut,
+                                self.depth_background, depth_image=arrays["depth"],
+                                normal_codes=arrays.get("normal_codes"), category=arrays.get("category"),
+                                encoded=dict(targets.encoded))
+        return RasterOutput(arrays["normal_depth"], arrays["instance"], partial(self._rays, intr), self._class_lut,
                             self.depth_background)
 
     def render_ids(self, cam2world: np.ndarray, intrinsics: Intrinsics | None = None,
