@@ -251,12 +251,13 @@ def register(variant: str) -> None:
                     active_em &= ~(diffuse_prev & refracts(bsdf, si, wo))
                 bsdf_val, bsdf_pdf = bsdf.eval_pdf(bsdf_ctx, si, wo, active_em)
                 # The shadow ray only where the light sample can contribute (module docstring: same values)
-                shadowed = active_em & (dr.max(mi.unpolarized_spectrum(bsdf_val)) > 0) & \
+                needs_shadow_ray = active_em & (dr.max(mi.unpolarized_spectrum(bsdf_val)) > 0) & \
                     (dr.max(mi.unpolarized_spectrum(em_weight)) > 0)
                 if transparent:
-                    em_weight *= transparent_shadows.shadow_transmittance(scene, si, ds_em, shadowed)
+                    em_weight *= transparent_shadows.shadow_transmittance(scene, si, ds_em, needs_shadow_ray)
                 else:
-                    em_weight = dr.select(scene.ray_test(si.spawn_ray_to(ds_em.p), shadowed), 0.0, em_weight)
+                    blocked = scene.ray_test(si.spawn_ray_to(ds_em.p), needs_shadow_ray)
+                    em_weight = dr.select(blocked, 0.0, em_weight)
                 mis_em = dr.select(ds_em.delta, 1.0, mis_weight(ds_em.pdf, bsdf_pdf))
                 lit = dr.select(active_em, throughput * bsdf_val * em_weight * mis_em, 0.0)
                 radiance += self._clamped(lit, depth >= 1)

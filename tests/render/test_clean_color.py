@@ -208,14 +208,15 @@ def test_shadow_rays_darken_exactly_the_shadow_of_an_occluder(variant):
     scenes = scene_with(True), scene_with(False)
     pose = scenes[0].camera.keypoints[0]
     shadowed_img, open_img = (PathTraceView(s, settings, variant=variant).render(pose, seed=5) for s in scenes)
-    # floor point of every pixel centre (OpenCV camera axes), and whether the plate blocks it from the lamp
-    rays = scenes[0].camera.intrinsics.pixel_rays() @ pose[:3, :3].T
-    floor = pose[:3, 3] + rays * (-pose[2, 3] / rays[..., 2:3])
-    t = (plate_centre[2] - floor[..., 2]) / (lamp[2] - floor[..., 2])  # where the segment crosses the plate's z
-    cross = floor + t[..., None] * (lamp - floor)
-    blocked = (np.abs(cross[..., :2] - plate_centre[:2]) < half).all(axis=-1)
-    plate_seen = (np.abs((pose[:3, 3] + rays * ((plate_centre[2] - pose[2, 3]) / rays[..., 2:3]))[..., :2]
-                         - plate_centre[:2]) < half).all(axis=-1)
+    rays = scenes[0].camera.intrinsics.pixel_rays() @ pose[:3, :3].T  # through every pixel centre (world axes)
+
+    def on_plate(points: np.ndarray) -> np.ndarray:  # points at the plate's height: inside its square?
+        return (np.abs(points[..., :2] - plate_centre[:2]) < half).all(axis=-1)
+
+    floor = pose[:3, 3] + rays * (-pose[2, 3] / rays[..., 2:3])  # each pixel's floor point (z = 0)
+    t = (plate_centre[2] - floor[..., 2]) / (lamp[2] - floor[..., 2])  # where its segment to the lamp crosses
+    blocked = on_plate(floor + t[..., None] * (lamp - floor))
+    plate_seen = on_plate(pose[:3, 3] + rays * ((plate_centre[2] - pose[2, 3]) / rays[..., 2:3]))
     margin = dilate(dilate(blocked)) & ~erode(erode(blocked)) | dilate(dilate(plate_seen))  # sub-pixel edges
     umbra, lit = blocked & ~margin, ~blocked & ~margin
     assert umbra.sum() > 20 and lit.sum() > 200
