@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
 from .pixel_filter import DEFAULT_WIDTH, filter_supersampled
 from .scene_raster import SceneRaster
@@ -41,22 +42,27 @@ class DenoiseGuides:
 
     def __init__(self, scene: Scene, factor: int = DEFAULT_FACTOR, raster: SceneRaster | None = None,
                  filter_width: float = DEFAULT_WIDTH, follow_specular: bool | None = None) -> None:
-        intr = scene.camera.intrinsics
-        self.factor, self.width, self.height = int(factor), intr.width, intr.height
+        self.factor = int(factor)
         self.filter_width = float(filter_width)  # the color's pixel filter (0: box), render/pixel_filter.py
-        self.fine = intr.resized(intr.width * self.factor, intr.height * self.factor)
         self._own = raster is None
         self.raster = raster or SceneRaster(scene)
         self.follow_specular = FOLLOW_SPECULAR if follow_specular is None else bool(follow_specular)
         self._tracer: tuple[Any, SpecularGuideTracer] | None = None  # (the Mitsuba scene it traces, tracer)
         self.traced_subpixels = 0  # of the last render (sub-pixels whose features come from behind glass/mirrors)
 
+    @property
+    def fine(self) -> Intrinsics:
+        """The supersampled camera of the current keypoint (the scene camera's intrinsics: they may change
+        between keypoints)."""
+        intr = self.raster.scene.camera.intrinsics
+        return intr.resized(intr.width * self.factor, intr.height * self.factor)
+
     def _box(self, image: np.ndarray) -> np.ndarray:
         f = self.factor
         image = np.nan_to_num(image, nan=0.0, posinf=0.0, neginf=0.0)
         if self.filter_width > 0:
             return filter_supersampled(image, f, self.filter_width)
-        blocks = image.reshape(self.height, f, self.width, f, -1)
+        blocks = image.reshape(image.shape[0] // f, f, image.shape[1] // f, f, -1)
         return np.ascontiguousarray(blocks.mean(axis=(1, 3), dtype=np.float32))
 
     def render(self, cam2world: np.ndarray, path_view: Any = None) -> tuple[np.ndarray, np.ndarray]:
@@ -64,14 +70,15 @@ class DenoiseGuides:
         :class:`~hybridgen.render.path_trace.PathTraceView`, JIT variants) and ``follow_specular`` they follow
         sharp specular surfaces (:mod:`hybridgen.render.specular_guides`)."""
         tracer = self._tracer_for(path_view)
-        albedo = self.raster.albedo.render(cam2world, intrinsics=self.fine)
+        fine = self.fine
+        albedo = self.raster.albedo.render(cam2world, intrinsics=fine)
         passes = self.raster.view.render(cam2world, ["normals"] + (["instance_segmaps"] if tracer else []),
-                                         intrinsics=self.fine, normals_space="camera")
+                                         intrinsics=fine, normals_space="camera")
         normals = passes["normals"]
         self.traced_subpixels = 0
         if tracer is not None:
             normals = np.array(normals, dtype=np.float32)
-            self.traced_subpixels = tracer.apply(cam2world, self.fine, np.asarray(passes["instance_segmaps"]),
+            self.traced_subpixels = tracer.apply(cam2world, fine, np.asarray(passes["instance_segmaps"]),
                                                  albedo, normals)
         return self._box(albedo), self._box(normals)
 

@@ -9,7 +9,9 @@ from ..io.frame_sink import FrameSink, PassLayout
 from ..scene.scene import Scene
 from .denoise import denoise as oidn_denoise
 from .denoise import require_oidn
+from . import denoise_guides
 from .denoise_guides import DenoiseGuides
+from .guide_worker import GuideWorker
 from .scene_raster import SceneRaster
 from .keypoint_loop import ProgressFactory, Producer, StereoProducer, run_keypoints
 from .label_request import LabelRequest
@@ -41,11 +43,24 @@ class ColorProducer:
         self.scene, self.settings, self.seed, self.hdr, self.denoise = scene, settings, int(seed), hdr, denoise
         self.keep_raw, self.sample_counts = keep_raw and denoise, sample_counts
         self._guides: DenoiseGuides | None = None
-        if denoise:
-            require_oidn()
-        self.view = view or PathTraceView(scene, settings, variant=variant)
-        if denoise:  # raster: the labels' view, shared; guides filtered like the color's pixels
+        self._worker: GuideWorker | None = None
+        if denoise and raster is None and not denoise_guides.FOLLOW_SPECULAR:
+            # guides of their own: drawn on a thread of their own, its GL context made while Mitsuba starts
+            self._worker = GuideWorker(scene)
+        try:
+            if denoise:
+                require_oidn()
+            self.view = view or PathTraceView(scene, settings, variant=variant)
+        except BaseException:
+            self.close()
+            raise
+        if denoise and self._worker is None:  # raster: the labels' view, shared; guides filtered like the pixels
             self._guides = DenoiseGuides(scene, raster=raster, filter_width=self.view.filter_width)
+
+    @property
+    def guides(self) -> DenoiseGuides | None:
+        """The denoiser's guide renderer (on the worker thread: once it has drawn a keypoint), or None."""
+        return self._worker.guides if self._worker is not None else self._guides
 
     def layouts(self) -> list[PassLayout]:
         intr = self.scene.camera.intrinsics
@@ -70,13 +85,17 @@ class ColorProducer:
         return {}
 
     def produce(self, index: int, cam2world: np.ndarray, eye: int = 0) -> dict[str, Any]:
+        worker = self._worker  # guides drawn on their own thread while the samples are traced
+        drawing = worker.submit(cam2world, self.view.filter_width) if worker is not None else None
         linear, counts = self.view.render_with_counts(cam2world, keypoint_seed(self.seed, index, eye))
         values: dict[str, Any] = {}
         if self.keep_raw:
             values["colors_raw"] = to_srgb8(linear)
         if self.sample_counts:
             values["sample_counts"] = counts
-        if self._guides is not None:
+        if worker is not None and drawing is not None:
+            linear = oidn_denoise(linear, *worker.result(drawing))
+        elif self._guides is not None:
             linear = oidn_denoise(linear, *self._guides.render(cam2world, self.view))
         values["colors"] = to_srgb8(linear)
         if self.hdr:
@@ -89,10 +108,13 @@ class ColorProducer:
         self.view = PathTraceView(self.scene, self.settings, variant=self.view.variant)
 
     def close(self) -> None:
-        """Release the denoising guides' GL resources (the Mitsuba scene goes with this producer)."""
+        """Release the denoising guides' GL resources and thread (the Mitsuba scene goes with this producer)."""
         if self._guides is not None:
             self._guides.release()
             self._guides = None
+        if self._worker is not None:
+            worker, self._worker = self._worker, None
+            worker.release()
 
 
 def render_color(scene: Scene, sinks: Iterable[FrameSink], settings: PathTraceSettings | None = None, *,
@@ -104,10 +126,9 @@ def render_color(scene: Scene, sinks: Iterable[FrameSink], settings: PathTraceSe
     ``keep_raw`` and ``sample_counts`` as in :class:`ColorProducer`."""
     sinks = list(sinks)
     producers: list[Producer] = []
-    raster = None  # one raster view for labels and denoising guides
-    if labels is not None or denoise:
-        raster = SceneRaster(scene, normals_space=labels.normals_space if labels else "camera",
-                             depth_background=labels.depth_background if labels else float("inf"))
+    raster = None  # one raster view for labels and denoising guides (guides alone: ColorProducer's own thread)
+    if labels is not None:
+        raster = SceneRaster(scene, normals_space=labels.normals_space, depth_background=labels.depth_background)
     try:
         if labels is not None:
             producers.append(LabelProducer(scene, labels.with_sinks(sinks), default_category_id=default_category_id,

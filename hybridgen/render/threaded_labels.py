@@ -22,25 +22,21 @@ since one thread already overlaps its binning with llvmpipe's rasterizer threads
 from __future__ import annotations
 
 import os
-import queue
-import threading
 from concurrent.futures import Future
-from typing import TYPE_CHECKING, Any, Callable
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InputError, SystemSetupError
+from ..errors import InputError
 from ..io.frame_sink import PassLayout
 from ..scene.scene import Scene
-from .gl_context import create_context
+from .gl_worker import DEFAULT_TIMEOUT_S, GLWorker
 from .label_request import LabelRequest
 from .raster import RasterView
 
 if TYPE_CHECKING:  # render_labels builds this class (imported lazily there): no import cycle
     from .render_labels import LabelProducer
 
-DEFAULT_TIMEOUT_S = 600.0
-"""Longest wait for one keypoint (or for a worker's context and upload) before giving up, seconds."""
 AUTO_THREADS_TRIANGLES = 1_000_000
 """Scenes of at least this many triangles get 2 raster threads under ``render_threads: auto``."""
 AUTO_THREADS_KEYPOINTS = 32
@@ -68,48 +64,6 @@ def auto_render_threads(triangles: int, keypoints: int, cores: int | None = None
     return 2 if big and cores >= 2 else 1
 
 
-class _Worker:
-    """One thread owning a GL context, a raster view of the scene and a :class:`LabelProducer` on it."""
-
-    def __init__(self, build: Callable[[Any], "LabelProducer"], name: str) -> None:
-        self.jobs: queue.Queue[tuple[Callable[["LabelProducer"], Any], Future] | None] = queue.Queue()
-        self.ready: Future = Future()
-        self.thread = threading.Thread(target=self._run, args=(build,), name=name, daemon=True)
-        self.thread.start()
-
-    def _run(self, build: Callable[[Any], "LabelProducer"]) -> None:
-        ctx = producer = None
-        try:
-            ctx = create_context()
-            producer = build(ctx)
-            self.ready.set_result(producer)
-        except BaseException as exc:  # noqa: BLE001 - handed to the thread that waits for it
-            self.ready.set_exception(exc)
-        try:
-            while producer is not None:
-                job = self.jobs.get()
-                if job is None:
-                    break
-                work, result = job
-                if not result.set_running_or_notify_cancel():
-                    continue
-                try:
-                    result.set_result(work(producer))
-                except BaseException as exc:  # noqa: BLE001
-                    result.set_exception(exc)
-        finally:
-            if producer is not None:
-                producer.close()
-                producer.view.release()
-            if ctx is not None:
-                ctx.release()
-
-    def submit(self, work: Callable[["LabelProducer"], Any]) -> Future:
-        result: Future = Future()
-        self.jobs.put((work, result))
-        return result
-
-
 class ThreadedLabelProducer:
     """The producer ``producer_class`` (:class:`~hybridgen.render.render_labels.LabelProducer`: same passes,
     same values, same order) on ``threads`` raster threads, each with its own context and upload of ``scene``.
@@ -131,20 +85,18 @@ class ThreadedLabelProducer:
                 view.release()
                 raise
 
-        self.workers = [_Worker(build, f"hybridgen-raster-{i}") for i in range(threads)]
-        self._pending: dict[tuple[int, int, bytes], Future] = {}
+        def release(producer: "LabelProducer") -> None:
+            producer.close()
+            producer.view.release()
+
+        self.workers = [GLWorker(build, release, f"hybridgen-raster-{i}", self.timeout) for i in range(threads)]
+        self._pending: dict[tuple[int, int, bytes], tuple[GLWorker, Future]] = {}
         self._turn = 0
         try:
-            self.producers = [self._wait(worker.ready, "its GL context and upload") for worker in self.workers]
+            self.producers = [worker.wait(worker.ready, "its GL context and upload") for worker in self.workers]
         except BaseException:
             self.close()
             raise
-
-    def _wait(self, result: Future, what: str) -> Any:
-        try:
-            return result.result(timeout=self.timeout)
-        except TimeoutError as exc:
-            raise SystemSetupError(f"a raster thread gave no answer for {what} within {self.timeout:g} s") from exc
 
     # the run-wide answers are the same on every worker: the first one gives them (no GL calls)
     def layouts(self) -> list[PassLayout]:
@@ -170,20 +122,20 @@ class ThreadedLabelProducer:
         if key not in self._pending:
             self._pending[key] = self._dispatch(index, cam2world, eye)
 
-    def _dispatch(self, index: int, cam2world: np.ndarray, eye: int) -> Future:
+    def _dispatch(self, index: int, cam2world: np.ndarray, eye: int) -> tuple[GLWorker, Future]:
         worker = self.workers[self._turn % len(self.workers)]
         self._turn += 1
         pose = np.array(cam2world, dtype=np.float64)
-        return worker.submit(lambda producer: producer.produce(index, pose, eye))
+        return worker, worker.submit(lambda producer: producer.produce(index, pose, eye))
 
     def produce(self, index: int, cam2world: np.ndarray, eye: int = 0) -> dict[str, Any]:
         key = (index, eye, np.asarray(cam2world).tobytes())
-        result = self._pending.pop(key, None) or self._dispatch(index, cam2world, eye)
-        return self._wait(result, f"keypoint {index}")
+        worker, result = self._pending.pop(key, None) or self._dispatch(index, cam2world, eye)
+        return worker.wait(result, f"keypoint {index}")
 
     def close(self) -> None:
         """Stop the workers (each releases its view and context) and wait for them."""
-        for result in self._pending.values():
+        for _, result in self._pending.values():
             result.cancel()
         self._pending.clear()
         for worker in self.workers:

@@ -186,8 +186,8 @@ def test_color_producer_denoises_with_the_guides_of_its_own_path_trace_view(gl_c
     try:
         producer.produce(0, scene.camera.keypoints[0])
         intr = scene.camera.intrinsics
-        assert producer._guides is not None
-        assert producer._guides.traced_subpixels == (intr.width * intr.height * 9 if follow else 0)
+        assert producer.guides is not None
+        assert producer.guides.traced_subpixels == (intr.width * intr.height * 9 if follow else 0)
     finally:
         producer.close()
 

@@ -1,0 +1,105 @@
+"""The denoiser's guides on a thread of their own (render/guide_worker.py, render/gl_worker.py): the same values as
+drawn on the caller's thread, the same denoised bytes as a run that shares the labels' raster view, errors raised
+where the guides are waited for, and guides that follow intrinsics changing between keypoints."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import hybridgen as hg
+from hybridgen.io.memory_sink import MemorySink
+from hybridgen.render import guide_worker
+from hybridgen.render.denoise_guides import DenoiseGuides
+from hybridgen.render.guide_worker import GuideWorker
+from hybridgen.render.path_trace import PathTraceSettings
+from hybridgen.render.render_color import ColorProducer, render_color
+from hybridgen.scene.object_keyframes import apply_keypoint
+from tests.render.test_color import ALIGNMENT_CAMERAS, _objects_scene
+
+
+def _scene() -> hg.Scene:
+    scene = _objects_scene(*ALIGNMENT_CAMERAS["off_centre"])
+    scene.lights.append(hg.Light("sun", "SUN", energy=2.0, local2world=hg.object_pose([0, 0, 5], [0.4, 0.2, 0])))
+    return scene
+
+
+def test_guides_drawn_on_their_thread_equal_those_drawn_here(gl_context):
+    scene = _scene()
+    here = DenoiseGuides(scene, filter_width=1.5)
+    worker = GuideWorker(scene)
+    try:
+        for pose in scene.camera.keypoints:
+            albedo, normals = worker.result(worker.submit(pose, 1.5))
+            expected_albedo, expected_normals = here.render(pose)
+            assert albedo.shape == (72, 96, 3) and albedo.max() > 0.1  # real guides: objects and floor
+            np.testing.assert_array_equal(albedo, expected_albedo)
+            np.testing.assert_array_equal(normals, expected_normals)
+        box = worker.result(worker.submit(scene.camera.keypoints[0], 0.0))  # a new filter width: a new renderer
+        expected_box = DenoiseGuides(scene, filter_width=0.0).render(scene.camera.keypoints[0])
+        np.testing.assert_array_equal(box[1], expected_box[1])
+    finally:
+        worker.release()
+        here.release()
+    assert worker.guides is not None and worker.guides.filter_width == 0.0
+
+
+def test_color_alone_and_with_labels_denoise_to_the_same_bytes(gl_context, jit_variant):
+    """Alone, the color producer draws its guides on its own thread; with labels, on the labels' raster view."""
+    scene = _scene()
+    settings = PathTraceSettings(samples=4, max_bounces=2)
+    alone, with_labels = MemorySink(), MemorySink()
+    render_color(scene, [alone], settings, seed=5, variant=jit_variant, denoise=True, keep_raw=True)
+    render_color(scene, [with_labels], settings, seed=5, variant=jit_variant, denoise=True, keep_raw=True,
+                 labels=hg.LabelRequest(depth=True))
+    for a, b in zip(alone.frames, with_labels.frames):
+        np.testing.assert_array_equal(a["colors_raw"], b["colors_raw"])
+        assert not np.array_equal(a["colors"], a["colors_raw"])  # denoised
+        np.testing.assert_array_equal(a["colors"], b["colors"])
+    assert "depth" in with_labels.frames[0]
+
+
+def test_an_error_on_the_guide_thread_is_raised_where_the_guides_are_waited_for(gl_context, jit_variant,
+                                                                              monkeypatch):
+    def broken(*args, **kwargs):
+        raise RuntimeError("no raster view today")
+
+    monkeypatch.setattr(guide_worker, "RasterView", broken)
+    scene = _scene()
+    producer = ColorProducer(scene, PathTraceSettings(samples=2, max_bounces=1), variant=jit_variant, denoise=True)
+    assert producer._worker is not None
+    thread = producer._worker._worker.thread
+    try:
+        with pytest.raises(RuntimeError, match="no raster view today"):
+            producer.produce(0, scene.camera.keypoints[0])
+    finally:
+        producer.close()
+    assert producer._worker is None and not thread.is_alive()
+
+
+def test_guides_follow_intrinsics_that_change_between_keypoints(gl_context):
+    """Keypoint 1 has intrinsics of its own (a longer focal length): its guides are those of a camera with
+    them, not the first keypoint's."""
+    K, width, height = ALIGNMENT_CAMERAS["off_centre"]
+    zoomed = np.array(K, dtype=float)
+    zoomed[0, 0] *= 1.6
+    zoomed[1, 1] *= 1.6
+    scene = _scene()
+    scene.camera.intrinsics_per_keypoint = [hg.Intrinsics(K, width, height, clip_start=0.01),
+                                            hg.Intrinsics(zoomed, width, height, clip_start=0.01)]
+    pose = scene.camera.keypoints[1]
+    fixed = _scene()
+    fixed.camera.intrinsics = hg.Intrinsics(zoomed, width, height, clip_start=0.01)
+    expected = DenoiseGuides(fixed).render(pose)
+    guides = DenoiseGuides(scene)
+    worker = GuideWorker(scene)
+    try:
+        apply_keypoint(scene, 0)
+        first = guides.render(pose)
+        apply_keypoint(scene, 1)
+        for albedo, normals in (guides.render(pose), worker.result(worker.submit(pose, 1.5))):
+            np.testing.assert_array_equal(albedo, expected[0])
+            np.testing.assert_array_equal(normals, expected[1])
+        assert not np.array_equal(first[1], expected[1])
+    finally:
+        worker.release()
+        guides.release()
