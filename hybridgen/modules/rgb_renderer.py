@@ -45,7 +45,8 @@ class RgbRenderer(Module):
         Param("use_adaptive_sampling", "float|null", None, doc="BlenderProc 1.x's name of noise_threshold",
               check=_optional_non_negative),
         Param("min_samples", "int", 0, "spp", "samples every pixel gets before adaptive sampling judges it "
-              "(Cycles' Min Samples); 0: Cycles' automatic value, 80 at noise threshold 0.005, 64 at 0.01",
+              "(Cycles' Min Samples); 0: 64 (BlenderProc's) without noise_threshold, else Cycles' automatic value "
+              "for it (64 at 0.01, 80 at 0.005)",
               check=_non_negative),
         Param("clamp_indirect", "float", 10.0, doc="firefly control, Cycles' sample_clamp_indirect: indirect "
               "light of one sample is scaled down to at most this linear radiance (direct light never); 0: off",

@@ -53,6 +53,15 @@ maximum 1024 -> 768 at threshold 0.005: tabletop 54.31 -> 54.10 dB, 9.64 -> 7.66
 93.1 -> 62.1 s (the maximum binds in most of its pixels); HDRI tabletop 52.80 -> 52.53 dB, 29.9 -> 25.5 s;
 materials 51.64 -> 51.12 dB, 32.8 -> 24.3 s. Every scene but materials stays as clean as Cycles at BlenderProc's
 defaults (53.2, 48.9, 52.1 dB); 640 and 512 are not (window room 48.90 and 48.77 dB)."""
+DEFAULT_MIN_SAMPLES = 64
+"""Samples per pixel at least when neither ``samples`` nor ``noise_threshold`` is given (and ``min_samples`` is 0):
+BlenderProc's, Cycles' automatic minimum at its threshold 0.01, rather than the 80 Cycles' rule gives for
+hybridgen's 0.005. The adaptive rounds then check at 64, 128, 256 and 512 spp (80, 160, 320, 640 before), so
+pixels stop nearer the count they need. Measured as :data:`DEFAULT_MAX_SAMPLES` (session 12, 2 seeds): 80 -> 64
+gave tabletop 54.10 -> 53.98 dB at 131 -> 116 spp, window room 48.99 -> 48.98 dB at 661 -> 657 spp, HDRI
+tabletop 52.49 -> 52.40 dB at 451 -> 365 spp, materials 51.20 -> 51.11 dB at 304 -> 267 spp; the tabletop's
+whole process 5.21 -> 4.79 s wall (median of 8 alternating pairs). 48 (checks at 96, 192, 384) gave the HDRI
+tabletop 459 spp."""
 CYCLES_MAX_SAMPLES = 1024
 """Samples per pixel at most when ``noise_threshold`` is given without ``samples``: BlenderProc 2.8's default
 maximum, so a BlenderProc config's threshold stops pixels where its Cycles would."""
@@ -93,10 +102,11 @@ class PathTraceSettings:
     ``path``, one depth limit for all lobes) rejects a value below ``max_bounces`` rather than ignoring it.
 
     Sampling (see :mod:`hybridgen.render.adaptive_sampling`): with ``samples`` not given, every pixel is
-    sampled adaptively from ``min_samples`` (0, the default: Cycles' automatic minimum for the threshold, 80 at
-    0.005, 64 at 0.01) until its noise estimate is below ``noise_threshold`` (default
-    :data:`DEFAULT_NOISE_THRESHOLD`, 0.005; Cycles' meaning when given) or it has :data:`DEFAULT_MAX_SAMPLES`
-    (768; :data:`CYCLES_MAX_SAMPLES`, BlenderProc's 1024, when ``noise_threshold`` is given).
+    sampled adaptively from ``min_samples`` (0, the default: :data:`DEFAULT_MIN_SAMPLES`, 64, without
+    ``noise_threshold``; Cycles' automatic minimum for a given threshold, 64 at 0.01, 80 at 0.005) until its
+    noise estimate is below ``noise_threshold`` (default :data:`DEFAULT_NOISE_THRESHOLD`, 0.005; Cycles'
+    meaning when given) or it has :data:`DEFAULT_MAX_SAMPLES` (768; :data:`CYCLES_MAX_SAMPLES`, BlenderProc's
+    1024, when ``noise_threshold`` is given).
     An explicit ``samples: N`` is a plain N-spp estimate in every pixel, unless ``noise_threshold`` is given
     too: then N is the maximum (Cycles' meaning of samples with adaptive sampling on).
 
@@ -148,9 +158,11 @@ class PathTraceSettings:
     def plan(self) -> SamplingPlan:
         """The per-pixel sample plan these settings stand for (rule in the class docstring)."""
         if self.samples is None:
-            threshold, most = (DEFAULT_NOISE_THRESHOLD, DEFAULT_MAX_SAMPLES) if self.noise_threshold is None \
-                else (self.noise_threshold, CYCLES_MAX_SAMPLES)
-            return SamplingPlan(most, min(self._min_samples(threshold), most), threshold)
+            if self.noise_threshold is None:  # hybridgen's defaults
+                least = self.min_samples or DEFAULT_MIN_SAMPLES
+                return SamplingPlan(DEFAULT_MAX_SAMPLES, min(least, DEFAULT_MAX_SAMPLES), DEFAULT_NOISE_THRESHOLD)
+            least = self._min_samples(self.noise_threshold)
+            return SamplingPlan(CYCLES_MAX_SAMPLES, min(least, CYCLES_MAX_SAMPLES), self.noise_threshold)
         threshold = self.noise_threshold or 0.0
         return SamplingPlan(self.samples, min(self._min_samples(threshold), self.samples) if threshold
                             else self.samples, threshold)

@@ -92,13 +92,16 @@ def test_explicit_samples_are_a_plain_fixed_count_and_defaults_are_adaptive(vari
     assert not PathTraceSettings(samples=8).plan().adaptive
     default = PathTraceSettings().plan()
     assert default.adaptive and default.max_samples == 768 and default.noise_threshold == 0.005
-    assert default.rounds() == [80, 80, 160, 320, 128]
+    assert default.rounds() == [64, 64, 128, 256, 256]  # at least BlenderProc's minimum, at most 768
+    assert PathTraceSettings(min_samples=32).plan() == SamplingPlan(768, 32, 0.005)
     # a threshold given alone keeps BlenderProc's maximum (Cycles' meaning); samples alone stays a fixed count
     assert PathTraceSettings(noise_threshold=0.01).plan() == SamplingPlan(1024, 64, 0.01)
     assert PathTraceSettings(noise_threshold=0.005).plan().max_samples == 1024
     assert PathTraceSettings(samples=64, noise_threshold=0.05, min_samples=16).plan() == SamplingPlan(64, 16, 0.05)
-    # min_samples 0 (the default) is Cycles' automatic minimum: ceil(16 / threshold^0.3), at least 4, even
-    assert default.min_samples == 80 and PathTraceSettings(noise_threshold=0.01).plan().min_samples == 64
+    # min_samples 0 (the default) with a threshold given is Cycles' automatic minimum: ceil(16 / threshold^0.3), at
+    # least 4, even; without one, BlenderProc's (Cycles' at its threshold 0.01), not Cycles' 80 at 0.005
+    assert PathTraceSettings(noise_threshold=0.01).plan().min_samples == 64
+    assert PathTraceSettings(noise_threshold=0.005).plan().min_samples == 80
     assert PathTraceSettings(samples=64, noise_threshold=0.05).plan() == SamplingPlan(64, 40, 0.05)
     assert [automatic_min_samples(t) for t in (0.1, 0.01, 0.001)] == [32, 64, 128]  # Cycles' comment's values
     assert automatic_min_samples(10.0) == 10 and automatic_min_samples(1e6) == 4  # 9 rounded up to even; floor 4

@@ -101,7 +101,7 @@ def test_render_keeps_the_expectation_and_is_deterministic(monkeypatch):
     np.testing.assert_allclose(np.mean([first.mean(axis=(0, 1)), second.mean(axis=(0, 1))], axis=0), expected,
                                rtol=0.01)
     # adaptive rounds of any size (80: not a power of two) trace one pattern per pixel and stay deterministic
-    adaptive = PathTraceView(scene, PathTraceSettings(), variant=variant)
+    adaptive = PathTraceView(scene, PathTraceSettings(min_samples=80), variant=variant)
     image, counts = adaptive.render_with_counts(pose, seed=3)
     assert counts.min() >= 80 and np.array_equal(image, adaptive.render_with_counts(pose, seed=3)[0])
 
