@@ -60,3 +60,15 @@ def denoise(linear: np.ndarray, albedo: np.ndarray, normals: np.ndarray) -> np.n
 
     out = oidn.denoise(padded(linear), padded(albedo), padded(normals), hdr=True, clean_aux=True)
     return np.asarray(out, dtype=np.float32)[BORDER_PAD:-BORDER_PAD, BORDER_PAD:-BORDER_PAD].copy()
+
+
+WARM_UP_SIZE = 8
+"""Pixels per side of the image :func:`warm_up` denoises."""
+
+
+def warm_up() -> None:
+    """Creates Open Image Denoise's device and its filter for :func:`denoise`'s inputs (color, albedo and normals,
+    HDR, clean guides) by denoising a tiny black image: ~0.05 s of one-time setup that a thread can do while the
+    first image is rendered (the denoiser serializes its calls and is safe to call from any thread)."""
+    zeros = np.zeros((WARM_UP_SIZE, WARM_UP_SIZE, 3), np.float32)
+    require_oidn().denoise(zeros, zeros, zeros, hdr=True, clean_aux=True)

@@ -26,6 +26,7 @@ from concurrent.futures import Future
 import numpy as np
 
 from ..scene.scene import Scene
+from . import denoise
 from .denoise_guides import DenoiseGuides
 from .gl_worker import DEFAULT_TIMEOUT_S, GLWorker
 from .raster import RasterView
@@ -67,6 +68,12 @@ class GuideWorker:
             return self._guides.render(pose)
 
         return self._worker.submit(draw)
+
+    def prepare_denoiser(self) -> Future:
+        """Queues :func:`hybridgen.render.denoise.warm_up` on the worker (before any keypoint's guides), so the
+        denoiser's one-time setup overlaps the caller's; a failure there shows again where the denoiser runs."""
+        assert self._worker is not None, "prepare_denoiser after release"
+        return self._worker.submit(lambda raster: denoise.warm_up())
 
     def result(self, drawing: Future) -> tuple[np.ndarray, np.ndarray]:
         """The guides of a :meth:`submit` (the worker's exception raised again, a SystemSetupError if it hangs)."""

@@ -50,6 +50,8 @@ class ColorProducer:
         try:
             if denoise:
                 require_oidn()
+                if self._worker is not None:
+                    self._worker.prepare_denoiser()
             self.view = view or PathTraceView(scene, settings, variant=variant)
         except BaseException:
             self.close()

@@ -103,3 +103,27 @@ def test_guides_follow_intrinsics_that_change_between_keypoints(gl_context):
     finally:
         worker.release()
         guides.release()
+
+
+def test_the_denoiser_is_prepared_on_the_guide_thread(gl_context, monkeypatch):
+    """Open Image Denoise's one-time setup (render/denoise.py warm_up) runs on the guide thread, so it overlaps
+    Mitsuba's start; the denoised bytes do not depend on it (tests above: same bytes alone and with labels)."""
+    pytest.importorskip("pyoidn")
+    import threading
+
+    from hybridgen.render import denoise
+
+    names: list[str] = []
+    real = denoise.warm_up
+
+    def recorded() -> None:
+        names.append(threading.current_thread().name)
+        real()
+
+    monkeypatch.setattr(denoise, "warm_up", recorded)
+    worker = GuideWorker(_scene())
+    try:
+        assert worker.prepare_denoiser().result(timeout=60) is None
+    finally:
+        worker.release()
+    assert names == ["hybridgen-guides"]
