@@ -81,8 +81,11 @@ CYCLES_THRESHOLD_SCALE = 5.0
 ``Integrator::get_adaptive_sampling``; see the module docstring for the measurement)."""
 LAUNCH_STREAM = 1 << 20
 """Round index (never reached by adaptive rounds) whose seeds the second and later launches of one trace use."""
-MAX_WAVEFRONT = 1 << 22
-"""Samples per kernel launch at most (bounds the per-sample output arrays to ~50 MB)."""
+MAX_WAVEFRONT = 1 << 23
+"""Samples per kernel launch at most (bounds the per-sample output arrays to ~100 MB). 2^23 rather than 2^22: the
+default first round at 320x240 (64 spp, 4.9 M samples) is one launch instead of two. Tabletop of
+tools/color_quality.py, whole warm processes, alternating pairs, the same bytes: medians 5.17 -> 4.95 s wall over 8
+pairs, 4.83 -> 4.78 s over 10 (session 12; session 11 found 4 M and 8 M within noise with the 80-spp rounds)."""
 MAX_PATTERN = 1024
 """Most samples one low-discrepancy pattern gives a pixel (4^5 points); more are traced as several patterns."""
 
