@@ -35,7 +35,9 @@ def test_guides_drawn_on_their_thread_equal_those_drawn_here(gl_context):
             np.testing.assert_array_equal(albedo, expected_albedo)
             np.testing.assert_array_equal(normals, expected_normals)
         box = worker.result(worker.submit(scene.camera.keypoints[0], 0.0))  # a new filter width: a new renderer
-        expected_box = DenoiseGuides(scene, filter_width=0.0).render(scene.camera.keypoints[0])
+        box_here = DenoiseGuides(scene, filter_width=0.0)
+        expected_box = box_here.render(scene.camera.keypoints[0])
+        box_here.release()
         np.testing.assert_array_equal(box[1], expected_box[1])
     finally:
         worker.release()
@@ -89,7 +91,9 @@ def test_guides_follow_intrinsics_that_change_between_keypoints(gl_context):
     pose = scene.camera.keypoints[1]
     fixed = _scene()
     fixed.camera.intrinsics = hg.Intrinsics(zoomed, width, height, clip_start=0.01)
-    expected = DenoiseGuides(fixed).render(pose)
+    fixed_guides = DenoiseGuides(fixed)
+    expected = fixed_guides.render(pose)
+    fixed_guides.release()
     guides = DenoiseGuides(scene)
     worker = GuideWorker(scene)
     try:
