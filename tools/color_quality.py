@@ -14,7 +14,7 @@ Run: .venv/bin/python tools/bench_color.py --quality   (the issue's settings: 32
      nice -n 10 .venv/bin/python tools/bench_color.py --quality --precompute cycles   (only fill the cache)
 
 For each scene: hybridgen's defaults (``PathTraceSettings()`` + denoising, as ``renderer.RgbRenderer``
-with no color options: stratified samples, Blackman-Harris 1.5 px pixel filter, adaptive 80..768 spp at
+with no color options: stratified samples, Blackman-Harris 1.5 px pixel filter, adaptive 64..768 spp at
 noise threshold 0.005 in Cycles' meaning, indirect clamp 10, filter glossy 1.0, principled lobes sampled by
 albedo, a constant world left to BSDF sampling, Cycles' roulette, 3 bounces for every lobe, OIDN; with
 ``--blenderproc-lobes`` glossy and transmission bounces 0 as Cycles renders at BlenderProc's defaults, with
