@@ -159,10 +159,12 @@ class PathTraceSettings:
         """The per-pixel sample plan these settings stand for (rule in the class docstring)."""
         if self.samples is None:
             if self.noise_threshold is None:  # hybridgen's defaults
+                threshold, most = DEFAULT_NOISE_THRESHOLD, DEFAULT_MAX_SAMPLES
                 least = self.min_samples or DEFAULT_MIN_SAMPLES
-                return SamplingPlan(DEFAULT_MAX_SAMPLES, min(least, DEFAULT_MAX_SAMPLES), DEFAULT_NOISE_THRESHOLD)
-            least = self._min_samples(self.noise_threshold)
-            return SamplingPlan(CYCLES_MAX_SAMPLES, min(least, CYCLES_MAX_SAMPLES), self.noise_threshold)
+            else:  # BlenderProc's maximum, Cycles' automatic minimum for the given threshold
+                threshold, most = self.noise_threshold, CYCLES_MAX_SAMPLES
+                least = self._min_samples(threshold)
+            return SamplingPlan(most, min(least, most), threshold)
         threshold = self.noise_threshold or 0.0
         return SamplingPlan(self.samples, min(self._min_samples(threshold), self.samples) if threshold
                             else self.samples, threshold)
