@@ -10,10 +10,11 @@ what defines it changes, so each is rendered once and found again by a key that 
   ``render.path_trace`` and ``render.tonemap`` with their imports, followed statically), so a change to the
   renderer re-renders it and a change elsewhere (raster labels, writers) does not.
 
-Code is hashed as its syntax tree without docstrings (:func:`code_digest`): comments and docstrings can change
-without invalidating anything. An entry is ``<kind>-<scene>-<W>x<H>-<spp>spp-<digest>.png`` (8-bit sRGB, the
-image PSNR is computed on) with a ``.json`` beside it holding the key and how it was made. Entries are written
-under a temporary name and renamed, so concurrent benchmark runs never read half a file.
+Code is hashed as its syntax tree without docstrings (:func:`code_digest`, attribute docstrings under constants
+included): comments and docstrings can change without invalidating anything. An entry is
+``<kind>-<scene>-<W>x<H>-<spp>spp-<digest>.png`` (8-bit sRGB, the image PSNR is computed on) with a ``.json`` beside it
+holding the key and how it was made. Entries are written under a temporary name and renamed, so concurrent benchmark
+runs never read half a file.
 
 Where: ``$HYBRIDGEN_BENCH_CACHE`` or ``~/.cache/hybridgen/bench_color``; ``off`` (or ``--reference-cache off``)
 disables the cache (everything is rendered again).
@@ -49,14 +50,22 @@ def _sha(text: str | bytes) -> str:
     return hashlib.sha256(text.encode() if isinstance(text, str) else text).hexdigest()
 
 
+def _is_bare_string(statement: ast.stmt) -> bool:
+    """Whether ``statement`` is a string on its own: a docstring, or an attribute docstring after an assignment."""
+    return (isinstance(statement, ast.Expr) and isinstance(statement.value, ast.Constant)
+            and isinstance(statement.value.value, str))
+
+
 def code_digest(path: Path) -> str:
-    """SHA-256 of a Python file's syntax tree with every docstring removed (comments are not in the tree)."""
+    """SHA-256 of a Python file's syntax tree without its bare strings - the docstrings of modules, classes and
+    functions and those written under constants and attributes (comments are not in the tree)."""
     tree = ast.parse(path.read_text())
     for node in ast.walk(tree):
-        body = getattr(node, "body", None)
-        if (isinstance(body, list) and body and isinstance(body[0], ast.Expr)
-                and isinstance(body[0].value, ast.Constant) and isinstance(body[0].value.value, str)):
-            node.body = body[1:] or [ast.Pass()]  # type: ignore[attr-defined]
+        for field in ("body", "orelse", "finalbody"):
+            block = getattr(node, field, None)
+            if isinstance(block, list) and any(isinstance(s, ast.stmt) and _is_bare_string(s) for s in block):
+                kept = [s for s in block if not _is_bare_string(s)]
+                setattr(node, field, kept or [ast.Pass()])
     return _sha(ast.dump(tree))
 
 

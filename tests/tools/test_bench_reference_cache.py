@@ -32,6 +32,24 @@ def test_code_digest_ignores_docstrings_and_comments_not_code(tmp_path: Path) ->
     assert digests["code"] != digests["same"]
 
 
+def test_code_digest_ignores_attribute_docstrings_not_constants(tmp_path: Path) -> None:
+    """A string under a constant documents it (Sphinx's attribute docstrings, as hybridgen writes them); editing
+    it must not re-render references, while the constant's value must."""
+    variants = {
+        "base": 'LIMIT = 4\n"""At most four."""\n\nclass C:\n    size: int = 2\n    """Pixels."""\n',
+        "reworded": 'LIMIT = 4\n"""No more than four, measured."""\n\nclass C:\n    size: int = 2\n    """Pixels wide."""\n',
+        "bare": "LIMIT = 4\n\nclass C:\n    size: int = 2\n",
+        "value": 'LIMIT = 5\n"""At most four."""\n\nclass C:\n    size: int = 2\n    """Pixels."""\n',
+        "field": 'LIMIT = 4\n"""At most four."""\n\nclass C:\n    size: int = 3\n    """Pixels."""\n',
+    }
+    digests = {}
+    for name, text in variants.items():
+        (tmp_path / f"{name}.py").write_text(text)
+        digests[name] = code_digest(tmp_path / f"{name}.py")
+    assert digests["base"] == digests["reworded"] == digests["bare"]
+    assert len({digests["base"], digests["value"], digests["field"]}) == 3
+
+
 def test_module_closure_follows_relative_lazy_and_parent_imports(tmp_path: Path) -> None:
     package = tmp_path / "pkg"
     (package / "sub").mkdir(parents=True)
