@@ -103,6 +103,9 @@ class SamplingPlan:
             raise InputError(f"samples must be >= 1, got {self.max_samples}")
         if self.noise_threshold < 0:
             raise InputError(f"noise_threshold must be >= 0, got {self.noise_threshold}")
+        if self.adaptive and self.max_samples < 2:
+            raise InputError(f"adaptive sampling (noise_threshold {self.noise_threshold}) compares two halves of a "
+                             f"pixel's samples: samples must be >= 2, got {self.max_samples}")
         if self.adaptive and not 2 <= self.min_samples <= self.max_samples:
             raise InputError(f"min_samples must be in 2..samples ({self.max_samples}), got {self.min_samples}")
 
@@ -162,6 +165,10 @@ def round_seed(seed: int, round_index: int, chunk: int) -> int:
 
 class PixelTracer:
     """Traces chosen pixels of the loaded Mitsuba scene (JIT variants only)."""
+
+    whole_frames = False
+    """Traces only the pixels asked for, so :func:`render_adaptive` splits large rounds into launches of at most
+    :data:`MAX_WAVEFRONT` samples."""
 
     def __init__(self, mi_scene: Any, sensor: Any, integrator: Any,
                  filter_width: float = pixel_filter.DEFAULT_WIDTH) -> None:
@@ -354,7 +361,8 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int) -> tuple
             active = active[keep[active]]
             if len(active) == 0:
                 break
-        per_chunk = max(1, MAX_WAVEFRONT // spp)
+        # a whole-frame tracer (scalar_rgb's) renders every pixel per call: one call per round
+        per_chunk = len(active) if tracer.whole_frames else max(1, MAX_WAVEFRONT // spp)
         for chunk, start in enumerate(range(0, len(active), per_chunk)):
             pixels = active[start:start + per_chunk]
             if tracer.owen_sobol:  # one pattern per pixel, continued from round to round

@@ -10,8 +10,14 @@ BlenderProc's defaults: 32.1 / 38.6 dB))
 with one addition, ``clamp_indirect`` (linear radiance, W sr^-1 m^-2; 0 = off), which has the meaning of
 Cycles' ``sample_clamp_indirect``: every *indirect* contribution of a sample - light that reached the
 camera after at least one bounce, i.e. next-event estimation at the second or later path vertex and
-emission found at the third or later - is scaled down so that its largest RGB component is at most the
-clamp. Direct light (emitters seen by the camera, and light reflected once towards it) is never changed.
+emission found at the third or later - is scaled down so that the sum of its RGB components is at most three
+times the clamp (Cycles' ``film_clamp_light``: its scene sync multiplies the clamp by 3 and the kernel compares
+the sum of the absolute components, so grey light is clamped at the clamp per channel and saturated light is
+left up to three times brighter in its channel). Direct light (emitters seen by the camera, and light
+reflected once towards it) is never changed. Every contribution, direct or not, clamped or not, first has
+its non-finite components set to 0, as Cycles' ``ensure_finite`` does there: a NaN or infinite sample would
+otherwise make its pixel's error estimate NaN, which adaptive sampling reads as converged, and the denoiser
+would spread it over its neighbours.
 Clamping removes the rare, very bright samples (fireflies: caustics of glossy objects seen via a diffuse
 surface) at the price of a small downward bias of bright indirect light; ``tools/bench_color.py`` measures
 it against an unclamped reference.
@@ -72,6 +78,10 @@ from ..scene.material import Material
 from . import glossy_filter, transparent_shadows, world_guide
 
 PLUGIN_NAME = "hybridgen_clamped_path"
+CYCLES_CLAMP_SCALE = 3.0
+"""The clamp is compared with the sum of a contribution's RGB components after multiplying it by this (Cycles'
+``Integrator::device_update``: ``sample_clamp_indirect * 3.0f``), so a grey contribution is clamped per channel
+at ``clamp_indirect`` itself."""
 SINGULAR_ROUGHNESS = 2e-10 ** 0.25
 """Principled roughness (Blender's; alpha = roughness^2) at or below which a lobe is singular, as in Cycles:
 ``alpha_x alpha_y <= BSDF_ROUGHNESS_SQ_THRESH = 2e-10``, i.e. roughness <= 0.00376."""
@@ -171,11 +181,14 @@ def register(variant: str) -> None:
             return dr.select(dr.isfinite(w), w, 0.0)
 
         def _clamped(self, contribution: Any, indirect: Any) -> Any:
+            """``contribution`` (linear RGB) with non-finite components set to 0 and, where ``indirect``, scaled
+            to at most ``3 x clamp_indirect`` in the sum of its components (Cycles' ``film_clamp_light``)."""
+            contribution = dr.select(dr.isfinite(contribution), contribution, 0.0)
             if self.clamp_indirect <= 0:
                 return contribution
-            largest = dr.max(contribution)
-            scale = dr.select(indirect & (largest > self.clamp_indirect), self.clamp_indirect / largest, 1.0)
-            return contribution * scale
+            limit = CYCLES_CLAMP_SCALE * self.clamp_indirect
+            total = dr.sum(dr.abs(contribution))
+            return contribution * dr.select(indirect & (total > limit), limit / total, 1.0)
 
         def sample(self, scene: Any, sampler: Any, ray: Any, medium: Any = None, active: Any = True) -> Any:
             """Radiance of one path per lane. The bounce loop is an explicit ``dr.while_loop`` (traced once into

@@ -3,8 +3,10 @@
 A sharp highlight seen through a diffuse bounce (floor -> glossy mug -> lamp) is a caustic path: a diffuse
 BSDF sample rarely finds the narrow lobe, and when it does the sample is very bright. Cycles regularizes
 such paths by default (``blur_glossy`` 1.0, which BlenderProc keeps): it tracks the smallest BSDF-sampling
-pdf of the path so far, ``min_ray_pdf``, and at every later vertex with ``blur_pdf = blur_glossy x
-min_ray_pdf < 1`` raises each microfacet lobe's alpha to at least ``sqrt(1 - blur_pdf) / 2``. After a
+pdf of the path so far, ``min_ray_pdf``, and at every later vertex with ``blur_pdf = min_ray_pdf /
+blur_glossy < 1`` raises each microfacet lobe's alpha to at least ``sqrt(1 - blur_pdf) / 2`` (Cycles' scene sync
+stores ``1 / blur_glossy`` as the kernel's ``filter_glossy`` and the kernel multiplies ``min_ray_pdf`` by it: a
+larger ``blur_glossy`` blurs more). After a
 diffuse bounce (pdf cos / pi <= 0.32) that is alpha >= 0.41 (roughness >= 0.64); camera rays and paths that
 only followed sharp lobes are untouched. It is a bias (indirectly seen highlights are blurred) traded for
 much less noise; ``filter_glossy: 0`` turns it off.
@@ -34,10 +36,11 @@ DEFAULT_FILTER_GLOSSY = 1.0
 
 def roughness_floor(filter_glossy: float, min_ray_pdf: Any) -> Any:
     """Principled roughness floor (Dr.Jit Float) of a vertex whose path's smallest BSDF-sampling pdf so far is
-    ``min_ray_pdf`` (sr^-1; +inf for camera vertices): sqrt of Cycles' alpha floor ``sqrt(1 - blur_pdf) / 2``."""
+    ``min_ray_pdf`` (sr^-1; +inf for camera vertices): sqrt of Cycles' alpha floor ``sqrt(1 - blur_pdf) / 2`` with
+    ``blur_pdf = min_ray_pdf / filter_glossy`` (``filter_glossy`` > 0: Cycles' ``blur_glossy``)."""
     import drjit as dr
 
-    blur_pdf = filter_glossy * min_ray_pdf
+    blur_pdf = min_ray_pdf / filter_glossy
     return dr.select(blur_pdf < 1.0, dr.sqrt(dr.sqrt(dr.maximum(1.0 - blur_pdf, 0.0)) * 0.5), 0.0)
 
 

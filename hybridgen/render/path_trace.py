@@ -20,7 +20,7 @@ from ..scene.scene import Scene
 from ..scene.depth_of_field import DepthOfField
 from . import (camera_hidden_emission, clamped_path, glossy_filter, pinhole_sensor, pixel_filter, thin_lens_sensor,
                transparent_shadows)
-from .adaptive_sampling import PixelTracer, SamplingPlan, automatic_min_samples, render_adaptive
+from .adaptive_sampling import PixelTracer, SamplingPlan, automatic_min_samples, launch_counts, render_adaptive
 from .mitsuba_scene import scene_dict
 from .mitsuba_variant import activate, choose_variant, is_jit
 
@@ -108,7 +108,8 @@ class PathTraceSettings:
     meaning when given) or it has :data:`DEFAULT_MAX_SAMPLES` (768; :data:`CYCLES_MAX_SAMPLES`, BlenderProc's
     1024, when ``noise_threshold`` is given).
     An explicit ``samples: N`` is a plain N-spp estimate in every pixel, unless ``noise_threshold`` is given
-    too: then N is the maximum (Cycles' meaning of samples with adaptive sampling on).
+    too: then N is the maximum (Cycles' meaning of samples with adaptive sampling on). ``noise_threshold`` 0 turns
+    adaptive sampling off: every pixel gets ``samples``, or BlenderProc's 1024 when ``samples`` is not given.
 
     ``clamp_indirect`` (linear radiance; 0 = off) is the firefly control of
     :mod:`hybridgen.render.clamped_path`, Cycles' ``sample_clamp_indirect`` (default 10, Cycles' default):
@@ -147,6 +148,8 @@ class PathTraceSettings:
         for name, value in self._lobe_bounces().items():
             if value is not None and value < 0:
                 raise InputError(f"{name} must be >= 0, got {value}")
+        if self.noise_threshold is not None and not (math.isfinite(self.noise_threshold) and self.noise_threshold >= 0):
+            raise InputError(f"noise_threshold must be >= 0 (0 = adaptive sampling off), got {self.noise_threshold}")
         if not (math.isfinite(self.clamp_indirect) and self.clamp_indirect >= 0):
             raise InputError(f"clamp_indirect must be >= 0 (0 = off), got {self.clamp_indirect}")
         if not (math.isfinite(self.filter_glossy) and self.filter_glossy >= 0):
@@ -161,6 +164,8 @@ class PathTraceSettings:
             if self.noise_threshold is None:  # hybridgen's defaults
                 threshold, most = DEFAULT_NOISE_THRESHOLD, DEFAULT_MAX_SAMPLES
                 least = self.min_samples or DEFAULT_MIN_SAMPLES
+            elif self.noise_threshold == 0:  # adaptivity off: BlenderProc's sample count in every pixel
+                return SamplingPlan(CYCLES_MAX_SAMPLES, CYCLES_MAX_SAMPLES, 0.0)
             else:  # BlenderProc's maximum, Cycles' automatic minimum for the given threshold
                 threshold, most = self.noise_threshold, CYCLES_MAX_SAMPLES
                 least = self._min_samples(threshold)
@@ -329,12 +334,18 @@ class PathTraceView:
 
 class FullFrameTracer:
     """The :class:`~hybridgen.render.adaptive_sampling.PixelTracer` interface for ``scalar_rgb``, where a
-    per-sample Python loop would be slow: each call renders the whole frame through Mitsuba's film (one
-    render per half of the samples) and returns the pixels asked for, so adaptive sampling there decides
-    counts but saves no time."""
+    per-sample Python loop would be slow: each call renders the whole frame through Mitsuba's film and returns
+    the pixels asked for, so adaptive sampling there decides counts but saves no time.
+
+    Each half of the samples is rendered as counts the sensor's sampler takes whole (Mitsuba's low-discrepancy
+    sampler rounds a count up to a power of 4: :func:`~hybridgen.render.adaptive_sampling.launch_counts`), so the
+    samples traced are the samples counted."""
 
     owen_sobol = False
     """Mitsuba's film draws from the sensor's own sampler here (rounds are independent patterns)."""
+    whole_frames = True
+    """Every call renders every pixel: :func:`~hybridgen.render.adaptive_sampling.render_adaptive` calls it once
+    per round, however many pixels are active."""
 
     def __init__(self, view: PathTraceView) -> None:
         self.view = view
@@ -343,11 +354,15 @@ class FullFrameTracer:
     def trace(self, pixels: np.ndarray, spp: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
         import mitsuba as mi
 
+        sampler = self.view.sensor.sampler().class_name()
         sums = []
         for half, count in enumerate((spp // 2, spp - spp // 2) if spp % 2 == 0 else (spp,)):
-            image = mi.render(self.view.mi_scene, sensor=self.view.sensor, spp=count,
-                              seed=(int(seed) + half * 0x9E3779B9) % 2**32)
-            sums.append(np.array(image, dtype=np.float64)[..., :3].reshape(-1, 3)[pixels] * count)
+            total = np.zeros((len(pixels), 3))
+            for launch, size in enumerate(launch_counts(count, sampler)):
+                image = mi.render(self.view.mi_scene, sensor=self.view.sensor, spp=size,
+                                  seed=(int(seed) + (2 * launch + half) * 0x9E3779B9) % 2**32)
+                total += np.array(image, dtype=np.float64)[..., :3].reshape(-1, 3)[pixels] * size
+            sums.append(total)
         return sums[0], (sums[1] if len(sums) > 1 else np.zeros_like(sums[0]))
 
 

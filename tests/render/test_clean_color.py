@@ -88,6 +88,21 @@ def test_sampling_plan_rounds_double_up_to_the_maximum():
         SamplingPlan(8, 16, 0.01)
 
 
+def test_threshold_zero_turns_adaptivity_off_and_bad_thresholds_are_input_errors():
+    """``noise_threshold: 0`` (BlenderProc's way to switch adaptive sampling off) gives every pixel the maximum:
+    ``samples``, or BlenderProc's 1024 without it. A negative or non-finite threshold, and adaptive sampling with
+    fewer than the two samples its halves need, are named input errors."""
+    assert PathTraceSettings(noise_threshold=0.0).plan() == SamplingPlan(1024, 1024, 0.0)
+    assert PathTraceSettings(noise_threshold=0.0, min_samples=16).plan() == SamplingPlan(1024, 1024, 0.0)
+    assert PathTraceSettings(samples=48, noise_threshold=0.0).plan() == SamplingPlan(48, 48, 0.0)
+    for bad in (-0.01, math.nan, math.inf):
+        with pytest.raises(hg.InputError, match="noise_threshold must be >= 0"):
+            PathTraceSettings(noise_threshold=bad)
+    with pytest.raises(hg.InputError, match="samples must be >= 2"):
+        PathTraceSettings(samples=1, noise_threshold=0.01)
+    assert not PathTraceSettings(samples=1).plan().adaptive  # one sample without a threshold is a plain estimate
+
+
 def test_explicit_samples_are_a_plain_fixed_count_and_defaults_are_adaptive(variant):
     assert not PathTraceSettings(samples=8).plan().adaptive
     default = PathTraceSettings().plan()
@@ -186,6 +201,33 @@ def test_clamping_never_changes_direct_light_but_clamps_indirect(variant):
     b = PathTraceView(scene, PathTraceSettings(samples=64, clamp_indirect=0.0), variant=variant).render(pose, seed=3)
     assert a.mean() < 0.995 * b.mean()
     assert (a <= b * (1 + 1e-5) + 1e-6).all()
+
+
+def test_indirect_clamp_is_cycles_sum_rule_and_non_finite_values_count_as_zero(variant):
+    """Cycles' ``film_clamp_light``: an indirect contribution whose R + G + B exceeds 3 x sample_clamp_indirect is
+    scaled to that sum (grey light is clamped at the clamp per channel; a saturated one keeps up to 3x in its
+    channel), direct light never; every contribution first has its non-finite components set to 0."""
+    if not is_jit(variant):
+        pytest.skip("the clamped integrator needs a JIT variant")
+    import mitsuba as mi
+
+    from hybridgen.render import clamped_path
+
+    mi.set_variant(variant)
+    clamped_path.register(variant)
+    values = [(25.0, 0.0, 0.0), (40.0, 0.0, 0.0), (20.0, 20.0, 20.0), (4.0, 5.0, 6.0), (math.nan, 1.0, math.inf)]
+    contribution = mi.Color3f(*(mi.Float([v[c] for v in values]) for c in range(3)))
+
+    def clamp(clamp_indirect: float, indirect: bool) -> np.ndarray:
+        integrator = mi.load_dict({"type": clamped_path.PLUGIN_NAME, "clamp_indirect": clamp_indirect})
+        out = integrator._clamped(contribution, mi.Bool(indirect))
+        return np.stack([np.array(out[c]) for c in range(3)], axis=1)
+
+    expected = [(25.0, 0.0, 0.0), (30.0, 0.0, 0.0), (10.0, 10.0, 10.0), (4.0, 5.0, 6.0), (0.0, 1.0, 0.0)]
+    np.testing.assert_allclose(clamp(10.0, True), expected, rtol=1e-6)
+    finite = [(25.0, 0.0, 0.0), (40.0, 0.0, 0.0), (20.0, 20.0, 20.0), (4.0, 5.0, 6.0), (0.0, 1.0, 0.0)]
+    np.testing.assert_allclose(clamp(10.0, False), finite, rtol=1e-6)  # direct light: only made finite
+    np.testing.assert_allclose(clamp(0.0, True), finite, rtol=1e-6)  # clamp off: only made finite
 
 
 def test_shadow_rays_darken_exactly_the_shadow_of_an_occluder(variant):
@@ -346,16 +388,32 @@ def test_glossy_bounce_limit_ends_paths_after_a_glossy_reflection(variant):
     assert limited[floor].mean() < full[floor].mean()  # the mirror's reflection of the lit floor is gone
 
 
-def test_scalar_variant_samples_adaptively_through_whole_frames():
-    """scalar_rgb has no per-pixel tracer: each round renders the frame, but counts and mean follow the plan."""
+def test_scalar_variant_samples_adaptively_through_whole_frames(monkeypatch):
+    """scalar_rgb has no per-pixel tracer: each round renders the frame, but counts and mean follow the plan.
+    A round is rendered once however many launches a per-pixel tracer would split it into, and as counts the
+    low-discrepancy sampler takes whole (powers of 4), so the samples traced are the samples counted."""
+    import mitsuba as mi
+
+    from hybridgen.render import adaptive_sampling
+
     scene = _half_lit_scene()
     # the lit floor is bright (R+G+B ~ 6), where Cycles' error is relative to the intensity itself: at 0.01
     # every pixel converges after 8 samples; 0.002 keeps some of them sampling up to 64
     settings = PathTraceSettings(samples=64, noise_threshold=0.002, min_samples=8)
     view = PathTraceView(scene, settings, variant="scalar_rgb")
     assert not view.clamped  # the clamped integrator needs a JIT variant
+    monkeypatch.setattr(adaptive_sampling, "MAX_WAVEFRONT", 64)  # a per-pixel tracer would launch 1-8 pixels at once
+    traced: list[int] = []
+    render = mi.render
+
+    def counted(*args, spp, **kwargs):
+        traced.append(spp)
+        return render(*args, spp=spp, **kwargs)
+
+    monkeypatch.setattr(mi, "render", counted)
     image, counts = view.render_with_counts(scene.camera.keypoints[0], seed=1)
     assert counts.min() == 8 and counts.max() == 64 and set(np.unique(counts)) <= {8, 16, 32, 64}
+    assert sum(traced) == 64 and all(n in (4, 16, 64, 256, 1024) for n in traced)  # rounds 8, 8, 16, 32 in halves
     reference = view.render(scene.camera.keypoints[0], seed=2, spp=256)
     assert image.mean() == pytest.approx(reference.mean(), rel=0.03)
 

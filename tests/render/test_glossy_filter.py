@@ -19,8 +19,13 @@ def test_roughness_floor_is_cycles_blur(jit_variant):
     floor = np.array(glossy_filter.roughness_floor(1.0, pdf))
     alpha = [0.0, 0.0, 0.0, math.sqrt(1 - 1 / math.pi) / 2, 0.5]  # Cycles: sqrt(1 - blur_pdf) / 2 when < 1
     np.testing.assert_allclose(floor ** 2, alpha, atol=1e-6)  # principled alpha = roughness^2
-    assert np.array(glossy_filter.roughness_floor(0.1, mi.Float([1 / math.pi])))[0] ** 2 == pytest.approx(
-        math.sqrt(1 - 0.1 / math.pi) / 2, rel=1e-5)
+    # Cycles keeps 1 / blur_glossy as its kernel's filter_glossy: a larger blur_glossy blurs more, a smaller less
+    after_diffuse = mi.Float([1 / math.pi])  # a cosine-sampled direction straight up
+    assert np.array(glossy_filter.roughness_floor(2.0, after_diffuse))[0] ** 2 == pytest.approx(
+        math.sqrt(1 - 1 / (2 * math.pi)) / 2, rel=1e-5)
+    assert np.array(glossy_filter.roughness_floor(0.5, after_diffuse))[0] ** 2 == pytest.approx(
+        math.sqrt(1 - 2 / math.pi) / 2, rel=1e-5)
+    assert np.array(glossy_filter.roughness_floor(0.1, after_diffuse))[0] == 0.0  # blur_pdf 10 / pi >= 1: sharp
 
 
 def _glossy_scene() -> hg.Scene:
