@@ -31,6 +31,7 @@ class GLWorker(Generic[T]):
     def __init__(self, build: Callable[[Any], T], release: Callable[[T], None], name: str,
                  timeout: float) -> None:
         self.timeout = float(timeout)
+        self.hung = False  # a wait ran out of time: the thread may never end, so close() does not wait for it
         self.jobs: queue.Queue[tuple[Callable[[T], Any], Future] | None] = queue.Queue()
         self.ready: Future = Future()
         self.thread = threading.Thread(target=self._run, args=(build, release), name=name, daemon=True)
@@ -79,9 +80,13 @@ class GLWorker(Generic[T]):
         try:
             return result.result(timeout=self.timeout)
         except TimeoutError as exc:
+            self.hung = True
             raise SystemSetupError(f"a raster thread gave no answer for {what} within {self.timeout:g} s") from exc
 
     def close(self) -> None:
-        """Ends the thread after the jobs queued so far (releasing what it owns) and waits for it."""
+        """Ends the thread after the jobs queued so far (releasing what it owns) and waits for it, unless a job
+        already outlived the timeout in :meth:`wait`: the daemon thread is then left behind, so a hung driver costs
+        one timeout, not two."""
         self.jobs.put(None)
-        self.thread.join(timeout=self.timeout)
+        if not self.hung:
+            self.thread.join(timeout=self.timeout)

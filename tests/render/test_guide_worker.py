@@ -131,3 +131,26 @@ def test_the_denoiser_is_prepared_on_the_guide_thread(gl_context, monkeypatch):
     finally:
         worker.release()
     assert names == ["hybridgen-guides"]
+
+
+def test_a_job_that_outlives_the_timeout_is_an_error_and_close_does_not_wait_for_it_again(gl_context):
+    """A hung job (a driver that never returns) costs one timeout: :meth:`GLWorker.wait` raises a SystemSetupError
+    naming what was waited for, and closing the worker then returns at once instead of joining the thread."""
+    import threading
+    import time
+
+    from hybridgen.render.gl_worker import GLWorker
+
+    release = threading.Event()
+    worker: GLWorker = GLWorker(lambda ctx: "built", lambda owned: None, "test-gl-worker", timeout=0.5)
+    assert worker.wait(worker.ready, "the build") == "built"
+    stuck = worker.submit(lambda owned: release.wait(30))
+    with pytest.raises(hg.SystemSetupError, match="no answer for the stuck job within 0.5 s"):
+        worker.wait(stuck, "the stuck job")
+    start = time.perf_counter()
+    worker.close()
+    assert time.perf_counter() - start < 0.2
+    release.set()
+    worker.thread.join(timeout=5)
+    assert not worker.thread.is_alive()  # the job ended, and the thread with it (the close was queued)
+
