@@ -16,6 +16,13 @@ from tools.reference_cache import (ReferenceCache, cache_root, code_digest, esti
 REPO = Path(__file__).resolve().parents[2]
 
 
+def _digests(sources: dict[str, str], folder: Path) -> dict[str, str]:
+    """:func:`code_digest` of each named source, written to ``folder/<name>.py``."""
+    for name, text in sources.items():
+        (folder / f"{name}.py").write_text(text)
+    return {name: code_digest(folder / f"{name}.py") for name in sources}
+
+
 def test_code_digest_ignores_docstrings_and_comments_not_code(tmp_path: Path) -> None:
     base = 'def f(x):\n    """Doubles."""\n    return 2 * x\n'
     variants = {
@@ -24,10 +31,7 @@ def test_code_digest_ignores_docstrings_and_comments_not_code(tmp_path: Path) ->
         "nodoc": "def f(x):\n    return 2 * x\n",
         "code": 'def f(x):\n    """Doubles."""\n    return 3 * x\n',
     }
-    digests = {}
-    for name, text in variants.items():
-        (tmp_path / f"{name}.py").write_text(text)
-        digests[name] = code_digest(tmp_path / f"{name}.py")
+    digests = _digests(variants, tmp_path)
     assert digests["same"] == digests["docs"] == digests["nodoc"]
     assert digests["code"] != digests["same"]
 
@@ -42,10 +46,7 @@ def test_code_digest_ignores_attribute_docstrings_not_constants(tmp_path: Path) 
         "value": 'LIMIT = 5\n"""At most four."""\n\nclass C:\n    size: int = 2\n    """Pixels."""\n',
         "field": 'LIMIT = 4\n"""At most four."""\n\nclass C:\n    size: int = 3\n    """Pixels."""\n',
     }
-    digests = {}
-    for name, text in variants.items():
-        (tmp_path / f"{name}.py").write_text(text)
-        digests[name] = code_digest(tmp_path / f"{name}.py")
+    digests = _digests(variants, tmp_path)
     assert digests["base"] == digests["reworded"] == digests["bare"]
     assert len({digests["base"], digests["value"], digests["field"]}) == 3
 
