@@ -3,12 +3,11 @@
 A sharp highlight seen through a diffuse bounce (floor -> glossy mug -> lamp) is a caustic path: a diffuse
 BSDF sample rarely finds the narrow lobe, and when it does the sample is very bright. Cycles regularizes
 such paths by default (``blur_glossy`` 1.0, which BlenderProc keeps): it tracks the smallest BSDF-sampling
-pdf of the path so far, ``min_ray_pdf``, and at every later vertex with ``blur_pdf = min_ray_pdf /
-blur_glossy < 1`` raises each microfacet lobe's alpha to at least ``sqrt(1 - blur_pdf) / 2`` (Cycles' scene sync
-stores ``1 / blur_glossy`` as the kernel's ``filter_glossy`` and the kernel multiplies ``min_ray_pdf`` by it: a
-larger ``blur_glossy`` blurs more). After a
-diffuse bounce (pdf cos / pi <= 0.32) that is alpha >= 0.41 (roughness >= 0.64); camera rays and paths that
-only followed sharp lobes are untouched. It is a bias (indirectly seen highlights are blurred) traded for
+pdf of the path so far, ``min_ray_pdf``, and at every later vertex with ``blur_pdf = min_ray_pdf / blur_glossy
+< 1`` raises each microfacet lobe's alpha to at least ``sqrt(1 - blur_pdf) / 2`` (Cycles' scene sync stores
+``1 / blur_glossy`` as the kernel's ``filter_glossy``, which multiplies ``min_ray_pdf``: a larger
+``blur_glossy`` blurs more). After a diffuse bounce (pdf cos / pi <= 0.32) that is alpha >= 0.41 (roughness >=
+0.64); camera rays and paths that only followed sharp lobes are untouched. It is a bias (indirectly seen highlights are blurred) traded for
 much less noise; ``filter_glossy: 0`` turns it off.
 
 hybridgen does the same in its path tracer (:mod:`hybridgen.render.clamped_path`, JIT variants): the
