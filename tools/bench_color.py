@@ -294,8 +294,12 @@ def export_for_cycles(scene: Any, path: Path, spp: int, bounces: int, min_bounce
     world = scene.world
     intr = scene.camera.intrinsics
     meta = {"objects": objects, "world": (np.asarray(world.color)[:3] * world.strength).tolist(), "lights": lights,
+            # "rotation": the Z angle of Blender's Mapping node between the world's Generated coordinates and the
+            # Environment Texture (BlenderProc's set_world_background_hdr_img wiring). The node turns the lookup
+            # direction, so the map turns the other way: hybridgen's hdri_rotation (the map turned counter-clockwise
+            # about +Z, README) is the node's minus that angle.
             "hdri": {"path": str(world.hdri_path), "strength": float(world.strength),
-                     "rotation": float(world.hdri_rotation)} if world.hdri_path else None,
+                     "rotation": -float(world.hdri_rotation)} if world.hdri_path else None,
             "resolution": [intr.width, intr.height], "K": intr.K.tolist(), "clip": [intr.clip_start, intr.clip_end],
             "spp": spp, "max_bounces": bounces, "min_bounces": min_bounces, "threads": threads or os.cpu_count() or 2}
     np.savez(path, meta=np.array(json.dumps(meta)), poses=np.stack(scene.camera.keypoints), **arrays)

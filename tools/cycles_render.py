@@ -109,6 +109,7 @@ def build(path: str) -> tuple[bpy.types.Scene, bpy.types.Object, np.ndarray]:
         environment.image = bpy.data.images.load(meta["hdri"]["path"])
         mapping = world.node_tree.nodes.new("ShaderNodeMapping")
         coords = world.node_tree.nodes.new("ShaderNodeTexCoord")
+        # the node turns the lookup direction by this angle (the export gives minus hybridgen's hdri_rotation)
         mapping.inputs["Rotation"].default_value = (0.0, 0.0, meta["hdri"]["rotation"])
         world.node_tree.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
         world.node_tree.links.new(mapping.outputs["Vector"], environment.inputs["Vector"])
