@@ -54,10 +54,15 @@ def _cli(*argv: str) -> subprocess.Popen:
 
 
 def _descendants(pid: int) -> set[int]:
+    """Every live descendant of ``pid`` found in /proc (a process that exits while it is read is skipped)."""
     found, queue = set(), [pid]
     while queue:
         current = queue.pop()
-        for children in Path(f"/proc/{current}/task").glob("*/children"):
+        try:  # Python 3.11's glob raises if the process's task folder vanishes while it is listed
+            listed = list(Path(f"/proc/{current}/task").glob("*/children"))
+        except OSError:
+            continue
+        for children in listed:
             try:
                 kids = {int(c) for c in children.read_text().split()}
             except OSError:
