@@ -160,19 +160,16 @@ class PathTraceSettings:
 
     def plan(self) -> SamplingPlan:
         """The per-pixel sample plan these settings stand for (rule in the class docstring)."""
-        if self.samples is None:
-            if self.noise_threshold is None:  # hybridgen's defaults
-                threshold, most = DEFAULT_NOISE_THRESHOLD, DEFAULT_MAX_SAMPLES
-                least = self.min_samples or DEFAULT_MIN_SAMPLES
-            elif self.noise_threshold == 0:  # adaptivity off: BlenderProc's sample count in every pixel
-                return SamplingPlan(CYCLES_MAX_SAMPLES, CYCLES_MAX_SAMPLES, 0.0)
-            else:  # BlenderProc's maximum, Cycles' automatic minimum for the given threshold
-                threshold, most = self.noise_threshold, CYCLES_MAX_SAMPLES
-                least = self._min_samples(threshold)
-            return SamplingPlan(most, min(least, most), threshold)
-        threshold = self.noise_threshold or 0.0
-        return SamplingPlan(self.samples, min(self._min_samples(threshold), self.samples) if threshold
-                            else self.samples, threshold)
+        if self.samples is None and self.noise_threshold is None:  # hybridgen's defaults
+            threshold, most = DEFAULT_NOISE_THRESHOLD, DEFAULT_MAX_SAMPLES
+            least = self.min_samples or DEFAULT_MIN_SAMPLES
+        else:  # the given samples, else BlenderProc's maximum; Cycles' automatic minimum for a given threshold
+            threshold = self.noise_threshold or 0.0
+            most = CYCLES_MAX_SAMPLES if self.samples is None else self.samples
+            if threshold == 0:  # adaptivity off: the maximum in every pixel
+                return SamplingPlan(most, most, 0.0)
+            least = self._min_samples(threshold)
+        return SamplingPlan(most, min(least, most), threshold)
 
     def _min_samples(self, threshold: float) -> int:
         """``min_samples``, or Cycles' automatic minimum for ``threshold`` (> 0) when it is 0."""
