@@ -63,9 +63,10 @@ def code_digest(path: Path) -> str:
     for node in ast.walk(tree):
         for field in ("body", "orelse", "finalbody"):
             block = getattr(node, field, None)
-            if isinstance(block, list) and any(isinstance(s, ast.stmt) and _is_bare_string(s) for s in block):
+            if isinstance(block, list):
                 kept = [s for s in block if not _is_bare_string(s)]
-                setattr(node, field, kept or [ast.Pass()])
+                if len(kept) < len(block):
+                    setattr(node, field, kept or [ast.Pass()])
     return _sha(ast.dump(tree))
 
 
