@@ -1,0 +1,166 @@
+"""``bproc.types.Material``: a Blender material with one Principled BSDF, over hybridgen's
+:class:`~hybridgen.scene.material.Material` (BlenderProc's MaterialUtility).
+
+Principled BSDF inputs are named as in Blender 3 or Blender 4 (``"Specular"`` / ``"Specular IOR Level"``,
+``"Emission"`` / ``"Emission Color"``, ``"Transmission"`` / ``"Transmission Weight"``); see :data:`INPUTS`.
+Colors are linear RGBA in 0..1, as Blender's socket values. An image (``bpy.data.images.load(...)``, anything
+with a ``filepath``) linked to an input becomes that input's texture map. Node-level calls (``new_node``,
+``link`` ...) have no counterpart in hybridgen's material model and raise one line naming the call.
+"""
+from __future__ import annotations
+
+from typing import Any, Callable
+
+import numpy as np
+
+from ...errors import InputError
+from ...scene.material import Material as SceneMaterial
+from ..session import SESSION
+from .struct import Struct
+from .unsupported import unsupported_method
+
+INPUTS: dict[str, tuple[str, str | None]] = {
+    "Base Color": ("base_color", "base_color_texture"),
+    "Metallic": ("metallic", "metallic_texture"),
+    "Roughness": ("roughness", "roughness_texture"),
+    "Specular": ("specular", "specular_texture"),
+    "Specular IOR Level": ("specular", "specular_texture"),
+    "IOR": ("ior", None),
+    "Alpha": ("alpha", "alpha_texture"),
+    "Transmission": ("transmission", None),
+    "Transmission Weight": ("transmission", None),
+    "Emission": ("emission", "emission_texture"),
+    "Emission Color": ("emission", "emission_texture"),
+    "Emission Strength": ("emission_strength", None),
+}
+"""Principled BSDF input (Blender 3 and 4 names) -> (hybridgen material field, its texture field or None)."""
+COLOR_FIELDS = ("base_color", "emission")
+
+
+def _is_image(value: Any) -> bool:
+    return hasattr(value, "filepath") and not isinstance(value, (str, bytes))
+
+
+def _input(input_name: str) -> tuple[str, str | None]:
+    if input_name not in INPUTS:
+        raise InputError(f"Principled BSDF input '{input_name}' is not supported by hybridgen yet "
+                         f"(supported: {', '.join(INPUTS)})")
+    return INPUTS[input_name]
+
+
+class Material(Struct):
+    """A material: ``blender_obj`` is the hybridgen material every mesh slot holding this one renders with."""
+
+    KIND = "material"
+    ATTRIBUTES = ("name", "users")
+
+    def __init__(self, name: str, scene_material: SceneMaterial | None = None) -> None:
+        super().__init__(name)
+        self.blender_obj = scene_material if scene_material is not None else SceneMaterial(name=self.get_name())
+        self.blender_obj.name = self.get_name()
+        SESSION.materials.append(self)
+
+    def set_name(self, name: str) -> None:
+        super().set_name(name)
+        self.blender_obj.name = self.get_name()
+
+    def get_users(self) -> int:
+        """How many mesh material slots hold this material."""
+        return sum(1 for e in SESSION.entities for m in getattr(e, "_slots", ()) if m is self)
+
+    def duplicate(self) -> "Material":
+        """An independent copy named ``<name>.001``."""
+        from dataclasses import replace
+
+        return Material(self.get_name(), replace(self.blender_obj, extra=dict(self.blender_obj.extra)))
+
+    def set_principled_shader_value(self, input_name: str, value: Any) -> None:
+        """Set a Principled BSDF input to a number, a color (3 or 4 values; alpha 1 when 3) or an image."""
+        field, texture = _input(input_name)
+        mat = self.blender_obj
+        if _is_image(value):
+            if texture is None:
+                raise InputError(f"an image on Principled BSDF input '{input_name}' is not supported by hybridgen yet")
+            setattr(mat, texture, str(value.filepath))
+            return
+        if hasattr(value, "is_output_socket"):
+            raise InputError(f"linking a node socket to '{input_name}' is not supported by hybridgen yet")
+        if texture is not None:
+            setattr(mat, texture, None)  # a value replaces the linked image, as BlenderProc unlinks it
+        if field in COLOR_FIELDS:
+            rgba = np.asarray(value, dtype=np.float64).reshape(-1)
+            if rgba.size not in (3, 4) or not np.all(np.isfinite(rgba)):
+                raise InputError(f"'{input_name}' takes 3 or 4 finite numbers, got {rgba.tolist()}")
+            rgba = np.append(rgba, 1.0) if rgba.size == 3 else rgba
+            setattr(mat, field, tuple(float(c) for c in rgba[: 4 if field == "base_color" else 3]))
+        else:
+            setattr(mat, field, float(value))
+
+    def get_principled_shader_value(self, input_name: str) -> Any:
+        """The input's value (colors as RGBA lists), or the linked image (an object with ``filepath``)."""
+        field, texture = _input(input_name)
+        mat = self.blender_obj
+        if texture is not None and getattr(mat, texture) is not None:
+            from ..bpy_standin import Image
+
+            linked = getattr(mat, texture)
+            return Image(linked if isinstance(linked, str) else "<array>")
+        value = getattr(mat, field)
+        return list(value) + ([1.0] if field == "emission" else []) if field in COLOR_FIELDS else value
+
+    def make_emissive(self, emission_strength: float, replace: bool = False,
+                      emission_color: list[float] | None = None, non_emissive_color_socket: Any = None) -> None:
+        """Emit ``emission_strength`` x color (default: the base color or its image). Not ``replace``: camera
+        rays see the surface as before and every other ray sees the emission (BlenderProc's "Is Camera Ray"
+        mix); ``replace``: the surface is the emission alone."""
+        if non_emissive_color_socket is not None:
+            raise InputError("make_emissive(non_emissive_color_socket=...) is not supported by hybridgen yet")
+        mat = self.blender_obj
+        if emission_color is None:
+            mat.emission, mat.emission_texture = tuple(mat.base_color[:3]), mat.base_color_texture  # type: ignore[assignment]
+        else:
+            mat.emission = tuple(float(c) for c in list(emission_color)[:3])  # type: ignore[assignment]
+            mat.emission_texture = None
+        mat.emission_strength = float(emission_strength)
+        mat.emission_hidden_from_camera = not replace
+        if replace:
+            mat.base_color, mat.base_color_texture = (0.0, 0.0, 0.0, mat.base_color[3]), None
+            mat.specular, mat.metallic = 0.0, 0.0
+
+    def remove_emissive(self) -> None:
+        """Undo :meth:`make_emissive`'s emission."""
+        mat = self.blender_obj
+        mat.emission_strength, mat.emission_texture, mat.emission_hidden_from_camera = 0.0, None, False
+
+    def set_displacement_from_principled_shader_value(self, input_name: str, multiply_factor: float) -> None:
+        """The image linked to ``input_name`` times ``multiply_factor`` (m) becomes the displacement (Blender's
+        default "Bump Only": shading normals change, geometry and labels do not). hybridgen reads the image's
+        first channel as height where Blender's math node takes the color's luminance."""
+        _, texture = _input(input_name)
+        linked = getattr(self.blender_obj, texture) if texture is not None else None
+        if linked is None:
+            raise InputError(f"material '{self.get_name()}': the input {input_name} of the principled shader does "
+                             "not have any incoming connection (as in BlenderProc)")
+        self.blender_obj.displacement_texture = linked
+        self.blender_obj.displacement_scale = float(multiply_factor)
+
+    def map_vertex_color(self, layer_name: str = "Col", active_shading: bool = True) -> None:
+        """The mesh's vertex colors become the base color (Blender's color attribute linked to Base Color)."""
+        self.blender_obj.base_color_from_vertices = True
+
+    def _attribute(self, attr_name: str) -> Any:
+        return self.get_users() if attr_name == "users" else self.get_name()
+
+    get_the_one_node_with_type: Callable[..., Any] = unsupported_method("Material", "get_the_one_node_with_type")
+    get_nodes_with_type: Callable[..., Any] = unsupported_method("Material", "get_nodes_with_type")
+    get_nodes_created_in_func: Callable[..., Any] = unsupported_method("Material", "get_nodes_created_in_func")
+    new_node: Callable[..., Any] = unsupported_method("Material", "new_node")
+    remove_node: Callable[..., Any] = unsupported_method("Material", "remove_node")
+    insert_node_instead_existing_link: Callable[..., Any] = unsupported_method(
+        "Material", "insert_node_instead_existing_link")
+    link: Callable[..., Any] = unsupported_method("Material", "link")
+    unlink: Callable[..., Any] = unsupported_method("Material", "unlink")
+    get_node_connected_to_the_output_and_unlink_it: Callable[..., Any] = unsupported_method(
+        "Material", "get_node_connected_to_the_output_and_unlink_it")
+    infuse_texture: Callable[..., Any] = unsupported_method("Material", "infuse_texture")
+    infuse_material: Callable[..., Any] = unsupported_method("Material", "infuse_material")

@@ -1,0 +1,227 @@
+"""``bproc.types.MeshObject``: a Blender mesh object over hybridgen :class:`~hybridgen.scene.mesh_object.MeshObject`
+parts (BlenderProc's MeshObjectUtility).
+
+A Blender object may hold several materials; a hybridgen mesh holds one, so a mesh object is a list of parts
+(``parts``, one per material of the file) whose geometry is in the object's local frame (metres). Material slots
+are ``bproc.types.Material`` objects; part ``i`` renders with slot ``min(i, slots - 1)`` as Blender clamps a
+face's material index, and with Blender's default grey surface when there is no slot. A render poses every part
+at the object's ``matrix_world`` of the frame (:meth:`MeshObject.scene_parts`).
+"""
+from __future__ import annotations
+
+import copy
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from ...errors import InputError
+from ...scene.material import Material as SceneMaterial
+from ...scene.mesh_object import MeshObject as ScenePart
+from ...scene.shading import shade
+from .entity import Entity, compose, vector3
+from .material import Material
+from .unsupported import unsupported_method
+
+BOUND_BOX_CORNERS = np.array([[0, 0, 0], [0, 0, 1], [0, 1, 1], [0, 1, 0], [1, 0, 0], [1, 0, 1], [1, 1, 1], [1, 1, 0]])
+"""Blender's ``bound_box`` corner order: (min/max x, y, z) flags of the 8 corners."""
+DEFAULT_SURFACE = SceneMaterial(name="blender_default_surface")
+"""What Blender renders a mesh without material with: grey 0.8 Principled, roughness 0.5."""
+
+
+class MeshObject(Entity):
+    """A mesh object; ``parts`` are hybridgen meshes in its local frame, ``_slots`` its material slots."""
+
+    TYPE = "MESH"
+
+    def __init__(self, name: str, parts: Sequence[ScenePart], slots: Sequence[Material | None] = (),
+                 local2world: np.ndarray | None = None) -> None:
+        if not parts:
+            raise InputError(f"mesh object '{name}' has no geometry")
+        super().__init__(name, local2world)
+        self.parts: list[ScenePart] = list(parts)
+        self._slots: list[Material | None] = list(slots)
+
+    # --- materials ----------------------------------------------------------------------------------------
+    def get_materials(self) -> list[Material | None]:
+        return list(self._slots)
+
+    def has_materials(self) -> bool:
+        return bool(self._slots)
+
+    def set_material(self, index: int, material: Material) -> None:
+        if not 0 <= index < len(self._slots):
+            raise InputError(f"'{self.get_name()}' has no material slot {index} ({len(self._slots)} slot(s))")
+        self._slots[index] = material
+
+    def add_material(self, material: Material) -> None:
+        self._slots.append(material)
+
+    def new_material(self, name: str) -> Material:
+        """A new default material named ``name``, added as a slot."""
+        material = Material(name)
+        self.add_material(material)
+        return material
+
+    def clear_materials(self) -> None:
+        self._slots.clear()
+
+    def replace_materials(self, material: Material) -> None:
+        """Every slot goes; ``material`` becomes the only one."""
+        self._slots = [material]
+
+    def part_material(self, index: int) -> SceneMaterial:
+        """The hybridgen material part ``index`` renders with."""
+        if not self._slots:
+            return DEFAULT_SURFACE
+        slot = self._slots[min(index, len(self._slots) - 1)]
+        return DEFAULT_SURFACE if slot is None else slot.blender_obj
+
+    # --- geometry -----------------------------------------------------------------------------------------
+    def local_vertices(self) -> np.ndarray:
+        """(V, 3) every part's vertices in the local frame, metres."""
+        return np.concatenate([part.vertices for part in self.parts])
+
+    def get_bound_box(self, local_coords: bool = False) -> np.ndarray:
+        """(8, 3) corners of the local axis-aligned box in Blender's order; world coordinates unless
+        ``local_coords``."""
+        vertices = self.local_vertices()
+        low, high = vertices.min(axis=0), vertices.max(axis=0)
+        corners = np.where(BOUND_BOX_CORNERS == 1, high, low)
+        if local_coords:
+            return corners
+        matrix = self.get_local2world_mat()
+        return corners @ matrix[:3, :3].T + matrix[:3, 3]
+
+    def get_bound_box_volume(self) -> float:
+        """Volume of the world-space box spanned by the bound box corners (m^3)."""
+        box = self.get_bound_box()
+        return float(np.prod(box.max(axis=0) - box.min(axis=0)))
+
+    def _transform_parts(self, matrix: np.ndarray) -> None:
+        """Apply a local 4x4 to every part's vertices (and its normals)."""
+        linear = matrix[:3, :3]
+        normal_matrix = np.linalg.inv(linear).T
+        for index, part in enumerate(self.parts):
+            twin = copy.copy(part)
+            twin.__dict__.pop("face_normals", None)
+            twin.__dict__.pop("is_closed", None)
+            twin.vertices = part.vertices @ linear.T + matrix[:3, 3]
+            if part.vertex_normals is not None:
+                normals = part.vertex_normals @ normal_matrix.T
+                twin.vertex_normals = normals / np.linalg.norm(normals, axis=1, keepdims=True)
+            self.parts[index] = twin
+
+    def persist_transformation_into_mesh(self, location: bool = True, rotation: bool = True,
+                                         scale: bool = True) -> None:
+        """Bake the chosen parts of the pose into the vertices and reset them (the object stays in place)."""
+        current = [self._location.value, self._rotation.value, self._scale.value]
+        kept = [np.zeros(3) if location else current[0], np.zeros(3) if rotation else current[1],
+                np.ones(3) if scale else current[2]]
+        self._transform_parts(np.linalg.inv(compose(*kept)) @ compose(*current))
+        self._location.set(kept[0])
+        self._rotation.set(kept[1])
+        self._scale.set(kept[2])
+
+    def get_origin(self) -> np.ndarray:
+        """The origin (Blender's ``location``), metres."""
+        return self.get_location()
+
+    def set_origin(self, point: Sequence[float] | None = None, mode: str = "POINT") -> np.ndarray:
+        """Move the origin to ``point`` (world, ``POINT``) or to the area-weighted surface centroid
+        (``CENTER_OF_MASS``) without moving the geometry; returns the new origin."""
+        basis = self.basis()
+        if mode == "POINT":
+            if point is None:
+                raise InputError("set_origin: mode POINT needs a point")
+            world = self.get_local2world_mat()
+            local = np.linalg.inv(world) @ np.append(vector3(point, "point"), 1.0)
+            target = local[:3]
+        elif mode == "CENTER_OF_MASS":
+            corners = np.concatenate([part.vertices[part.faces] for part in self.parts])
+            areas = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+            target = (corners.mean(axis=1) * areas[:, None]).sum(axis=0) / max(areas.sum(), 1e-300)
+        else:
+            raise InputError(f"bproc.types.MeshObject.set_origin(mode={mode!r}) is not supported by hybridgen yet")
+        shift = np.eye(4)
+        shift[:3, 3] = -target
+        self._transform_parts(shift)
+        self._location.set(basis[:3, 3] + basis[:3, :3] @ target)
+        return self.get_origin()
+
+    def move_origin_to_bottom_mean_point(self) -> None:
+        """Move the vertices by minus (world bound box centre x, y, its lowest z), as BlenderProc does (a
+        global-axes translation of the mesh; the origin stays)."""
+        box = self.get_bound_box()
+        delta = -np.array([box.mean(axis=0)[0], box.mean(axis=0)[1], box.min(axis=0)[2]])
+        shift = np.eye(4)
+        shift[:3, 3] = np.linalg.solve(self.get_local2world_mat()[:3, :3], delta)
+        self._transform_parts(shift)
+
+    def set_shading_mode(self, mode: str, angle_value: float = 30) -> None:
+        """Blender's ``FLAT``, ``SMOOTH`` or ``AUTO`` (smooth up to ``angle_value`` degrees) shading."""
+        for index, part in enumerate(self.parts):
+            try:
+                shaded = shade(part.vertices, part.faces, mode, angle_value, part.uvs, part.vertex_colors)
+            except ValueError as exc:
+                raise InputError(str(exc)) from None
+            twin = copy.copy(part)
+            twin.vertices, twin.faces, twin.vertex_normals = shaded.vertices, shaded.faces, shaded.vertex_normals
+            twin.uvs, twin.vertex_colors = shaded.uvs, shaded.vertex_colors
+            self.parts[index] = twin
+
+    def mesh_as_trimesh(self) -> Any:
+        """The local-frame mesh (all parts) as a ``trimesh.Trimesh``."""
+        import trimesh
+
+        offsets = np.cumsum([0] + [len(part.vertices) for part in self.parts])
+        faces = np.concatenate([part.faces + offset for part, offset in zip(self.parts, offsets)])
+        return trimesh.Trimesh(self.local_vertices(), faces, process=False)
+
+    def scene_parts(self, frame: int | None) -> list[ScenePart]:
+        """The parts as hybridgen meshes posed at ``frame`` with their slot materials (fresh shallow copies:
+        a scene assigns them instance ids)."""
+        pose = self.world_matrix(frame)
+        posed = []
+        for index, part in enumerate(self.parts):
+            twin = copy.copy(part)
+            twin.local2world = pose
+            twin.material = self.part_material(index)
+            twin.name = self.get_name()
+            posed.append(twin)
+        return posed
+
+    def _copy_state_from(self, other: Entity) -> None:
+        super()._copy_state_from(other)
+        assert isinstance(other, MeshObject)
+        self.parts = [copy.copy(part) for part in other.parts]
+        self._slots = list(other._slots)
+
+    get_mesh: Callable[..., Any] = unsupported_method("MeshObject", "get_mesh", "there is no Blender mesh")
+    enable_rigidbody: Callable[..., Any] = unsupported_method("MeshObject", "enable_rigidbody")
+    build_convex_decomposition_collision_shape: Callable[..., Any] = unsupported_method(
+        "MeshObject", "build_convex_decomposition_collision_shape")
+    disable_rigidbody: Callable[..., Any] = unsupported_method("MeshObject", "disable_rigidbody")
+    get_rigidbody: Callable[..., Any] = unsupported_method("MeshObject", "get_rigidbody")
+    mesh_as_bmesh: Callable[..., Any] = unsupported_method("MeshObject", "mesh_as_bmesh", "there is no bmesh")
+    update_from_bmesh: Callable[..., Any] = unsupported_method("MeshObject", "update_from_bmesh")
+    join_with_other_objects: Callable[..., Any] = unsupported_method("MeshObject", "join_with_other_objects")
+    edit_mode: Callable[..., Any] = unsupported_method("MeshObject", "edit_mode")
+    object_mode: Callable[..., Any] = unsupported_method("MeshObject", "object_mode")
+    create_bvh_tree: Callable[..., Any] = unsupported_method("MeshObject", "create_bvh_tree")
+    position_is_above_object: Callable[..., Any] = unsupported_method("MeshObject", "position_is_above_object")
+    ray_cast: Callable[..., Any] = unsupported_method("MeshObject", "ray_cast")
+    add_uv_mapping: Callable[..., Any] = unsupported_method("MeshObject", "add_uv_mapping")
+    scale_uv_coordinates: Callable[..., Any] = unsupported_method("MeshObject", "scale_uv_coordinates")
+    add_displace_modifier: Callable[..., Any] = unsupported_method("MeshObject", "add_displace_modifier")
+    add_modifier: Callable[..., Any] = unsupported_method("MeshObject", "add_modifier")
+    add_geometry_nodes: Callable[..., Any] = unsupported_method("MeshObject", "add_geometry_nodes")
+    add_auto_smooth_modifier: Callable[..., Any] = unsupported_method("MeshObject", "add_auto_smooth_modifier")
+    clear_custom_splitnormals: Callable[..., Any] = unsupported_method("MeshObject", "clear_custom_splitnormals")
+
+    def has_uv_mapping(self) -> bool:
+        """Whether every part has texture coordinates."""
+        return all(part.uvs is not None for part in self.parts)
+
+    def has_rigidbody_enabled(self) -> bool:
+        """Rigid bodies are not supported, so never."""
+        return False
