@@ -56,9 +56,20 @@ def encode_normals(normals: np.ndarray, cam2world_cv: np.ndarray, space: str) ->
 class BlenderProcHdf5Writer:
     """A :class:`~hybridgen.io.frame_sink.FrameSink` writing BlenderProc's per-keypoint layout into ``directory``."""
 
-    def __init__(self, directory: str | Path, options: Hdf5Options | None = None, *, append: bool = False) -> None:
+    def __init__(self, directory: str | Path, options: Hdf5Options | None = None, *, append: bool = False,
+                 versions: dict[str, str] | None = None, untrimmed: tuple[str, ...] = (),
+                 stereo_separate_keys: bool = False, dtypes: dict[str, str] | None = None) -> None:
         """``options``: compression and level as for ``data.hdf5`` (its ``encoding`` does not apply: this layout
-        stores BlenderProc's encodings)."""
+        stores BlenderProc's encodings). BlenderProc 1.x's writer also gives: ``versions`` - a ``<key>_version``
+        dataset (a one-element byte-string array) beside each pass, ``versions[key]`` or ``versions["*"]``;
+        ``untrimmed`` - keys of single-channel float passes (depth, distance) stored H x W x 3, three equal
+        channels, as 1.x stores an EXR pass no ``postprocessing.TrimRedundantChannels`` trimmed;
+        ``stereo_separate_keys`` - a stereo pass as ``<key>_0`` (left) and ``<key>_1`` instead of one array
+        with a leading axis of 2; ``dtypes`` - keys stored as another NumPy dtype (1.x's segmap: float64)."""
+        self.dtypes = {key: np.dtype(name) for key, name in (dtypes or {}).items()}
+        self.versions = dict(versions or {})
+        self.untrimmed = frozenset(untrimmed)
+        self.stereo_separate_keys = stereo_separate_keys
         opts = options if options is not None else Hdf5Options()
         compression, compression_level = opts.compression, opts.compression_level
         self.directory = prepare_output_dir(Path(directory))
@@ -98,14 +109,32 @@ class BlenderProcHdf5Writer:
         layout = self._layouts.get(key)
         if layout is not None and layout.dtype == "json":
             h5.create_dataset(key, data=np.bytes_(json.dumps(value)))
+            self._store_version(h5, key)
             return
         array = np.asarray(value)
         entry = exact(key)
-        if entry is not None and entry.blenderproc == "blender_half_unit":
+        renamed_normals = entry is None and layout is not None and layout.frame in ("camera", "world")
+        if renamed_normals or (entry is not None and entry.blenderproc == "blender_half_unit"):
             cam2world = self._records["cam2world"][index]
             frame = layout.frame if layout is not None and layout.frame else "camera"
             array = encode_normals(array, cam2world, frame)
-        h5.create_dataset(key, data=array, compression=self.compression, compression_opts=self.level)
+        if key in self.dtypes:
+            array = array.astype(self.dtypes[key])
+        stereo = layout is not None and layout.stereo
+        if key in self.untrimmed and array.ndim == (3 if stereo else 2) and array.dtype.kind == "f":
+            array = np.repeat(array[..., None], 3, axis=-1)
+        if stereo and self.stereo_separate_keys:
+            for side in (0, 1):
+                h5.create_dataset(f"{key}_{side}", data=array[side], compression=self.compression,
+                                  compression_opts=self.level)
+        else:
+            h5.create_dataset(key, data=array, compression=self.compression, compression_opts=self.level)
+        self._store_version(h5, key)
+
+    def _store_version(self, h5: h5py.File, key: str) -> None:
+        version = self.versions.get(key, self.versions.get("*"))
+        if version is not None and f"{key}_version" not in h5:
+            h5.create_dataset(f"{key}_version", data=np.array([version.encode()], dtype=np.bytes_))
 
     def end(self) -> None:
         """Nothing is buffered between keypoints."""

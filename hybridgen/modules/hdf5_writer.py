@@ -45,6 +45,14 @@ class Hdf5Writer(Module):
               doc="single: one file, keypoint axis first; blenderproc: one <i>.hdf5 per keypoint, BlenderProc's keys"),
         Param("append_to_existing_output", "bool", False,
               doc="blenderproc layout: number the files after the highest <i>.hdf5 already in output_dir"),
+        Param("key_versions", "dict", {}, doc="blenderproc layout: a '<key>_version' dataset beside each pass, "
+              "as BlenderProc 1.x's Hdf5Writer writes ({key: version}; '*' for every other key)"),
+        Param("untrimmed_keys", "list", [], doc="blenderproc layout: single-channel float passes (depth, distance) "
+              "stored H x W x 3, as BlenderProc 1.x stores them without postprocessing.TrimRedundantChannels"),
+        Param("stereo_separate_keys", "bool", False, doc="blenderproc layout: a stereo pass as <key>_0 (left) and "
+              "<key>_1 instead of one array with a leading axis of 2 (BlenderProc's option)"),
+        Param("key_dtypes", "dict", {}, doc="blenderproc layout: keys stored as another NumPy dtype ({key: "
+              "dtype}; BlenderProc 1.x's segmap is float64)"),
         *option_params(Hdf5Options),
         Param("resume_chunk_keypoints", "int", -1,
               doc="single layout, run without sharding as the only writer: render this many keypoints per "
@@ -70,7 +78,11 @@ class Hdf5Writer(Module):
             if options.compression == "blosc2":  # BlenderProc's tools (plain h5py) cannot read Blosc2 chunks
                 raise ConfigError("'blosc2' is for the single layout; layout: blenderproc stores gzip (or lzf, "
                                   "none) for BlenderProc's tools", key="compression")
-            self.writer = BlenderProcHdf5Writer(cfg["output_dir"], options, append=cfg["append_to_existing_output"])
+            self.writer = BlenderProcHdf5Writer(cfg["output_dir"], options, append=cfg["append_to_existing_output"],
+                                                versions={str(k): str(v) for k, v in cfg["key_versions"].items()},
+                                                untrimmed=tuple(str(k) for k in cfg["untrimmed_keys"]),
+                                                stereo_separate_keys=cfg["stereo_separate_keys"],
+                                                dtypes={str(k): str(v) for k, v in cfg["key_dtypes"].items()})
         elif context.unit is not None:  # one work unit of a sharded run (or part of a staged one): its own file
             plain = context.unit.folder == SHARD_FOLDER or context.unit.whole  # whole: a staged run's only part
             writer_class = Hdf5SingleFileWriter if plain else JournalingWriter

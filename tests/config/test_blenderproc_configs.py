@@ -18,6 +18,7 @@ from hybridgen.config.notices import set_sink, set_strict
 from hybridgen.errors import ConfigError
 from hybridgen.run.pipeline import build_modules, execute, run_config
 from hybridgen.scene.frames import look_at_blender, make_pose
+from tests.blenderproc_files import read_numbered
 
 # A room floor and two boxes as a Y-up modelling tool writes them (Blender's OBJ importer turns them Z-up).
 SCENE_OBJ = """mtllib scene.mtl
@@ -122,8 +123,12 @@ def test_basic_v3_runs_unchanged_and_the_floor_is_horizontal(tmp_path, notices, 
     # one notice line each for the Blender setup keys and the Cycles-only global key; none is an error
     assert any("blender_install_path" in n and "ignored" in n for n in notices)
     assert any("transparency_bounces" in n for n in notices)
-    with h5py.File(out / "data.hdf5") as f:
+    # BlenderProc's files: one <i>.hdf5 per keypoint, Dist2Depth's depth (trimmed, its version 1.0.0)
+    assert sorted(p.name for p in out.iterdir()) == ["0.hdf5", "1.hdf5"]
+    with h5py.File(out / "0.hdf5") as f:
         assert "depth" in f and "distance" not in f  # Dist2Depth: depth instead of distance
+        assert f["depth"].shape == (36, 48) and f["depth"].dtype == np.float32
+        assert f["depth_version"][()].tolist() == [b"1.0.0"] and f["colors_version"][()].tolist() == [b"2.0.0"]
     from hybridgen.data import KeypointDataset
 
     samples = list(KeypointDataset(out, keys=["normals", "cam2world", "depth"]))
@@ -477,7 +482,6 @@ RENAMED_KEYS_V3 = """\
 
 def test_output_keys_rename_the_stored_datasets(tmp_path, notices):
     from hybridgen.data import KeypointDataset
-    from hybridgen.io.label_encoding import decode_dataset
 
     obj = write_scene(tmp_path)
     runs = {}
@@ -488,21 +492,20 @@ def test_output_keys_rename_the_stored_datasets(tmp_path, notices):
         text = RENAMED_KEYS_V3.replace("RGB_KEYS", rgb_keys).replace("SEG_KEYS", seg_keys)
         out = tmp_path / name
         run_config(write(tmp_path, f"{name}.yaml", text), [str(obj), str(out)])
-        with h5py.File(out / "data.hdf5") as f:
-            runs[name] = {k: decode_dataset(f[k]) for k in f if isinstance(f[k], h5py.Dataset)}
+        runs[name] = read_numbered(out)  # BlenderProc's 0.hdf5, 1.hdf5
         runs[name + "_coco"] = json.loads((out / "coco_data" / "coco_annotations.json").read_text())
     default, renamed = runs["default"], runs["renamed"]
     pairs = {"colors": "rgb", "depth": "depth_m", "normals": "nrm", "instance_attribute_maps": "segcolormap"}
+    pairs.update({f"{own}_version": f"{stored}_version" for own, stored in pairs.items()})
     for own, stored in pairs.items():
         assert own in default and own not in renamed and stored in renamed and stored not in default
     assert "never_rendered" not in renamed  # a name for a pass not rendered is no error, as in BlenderProc
     np.testing.assert_array_equal(renamed["rgb"], default["colors"])  # same seed: the same image
     np.testing.assert_array_equal(renamed["depth_m"], default["depth"])
-    # default normals are stored octahedral (within 1e-4 rad); the renamed ones plain float32
-    np.testing.assert_allclose(renamed["nrm"], default["normals"], atol=2e-4)
-    assert renamed["nrm"].dtype == np.float32
-    assert [json.loads(v) if isinstance(v, (bytes, str)) else v for v in renamed["segcolormap"]] == \
-        [json.loads(v) if isinstance(v, (bytes, str)) else v for v in default["instance_attribute_maps"]]
+    # renamed or not, normals are BlenderProc's: float32, Blender camera axes, 0.5 n + 0.5
+    np.testing.assert_array_equal(renamed["nrm"], default["normals"])
+    assert renamed["nrm"][0].dtype == np.float32 and 0.0 <= np.min(renamed["nrm"]) <= np.max(renamed["nrm"]) <= 1.0
+    assert [json.loads(v) for v in renamed["segcolormap"]] == [json.loads(v) for v in default["instance_attribute_maps"]]
     for key in set(default) - set(pairs):
         np.testing.assert_array_equal(renamed[key], default[key], err_msg=key)
     # the COCO writer found the renamed passes (finish() points it at segcolormap): the same annotations

@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import json
 
-import h5py
 import numpy as np
 import pytest
 
 from hybridgen.errors import HybridgenError
-from hybridgen.io.label_encoding import decode_dataset
 from hybridgen.run.pipeline import run_config
+from tests.blenderproc_files import read_numbered
 
 # A 6 m floor (class 2, weight 7 by default, kind "floor") and a 1 m cube on it (class 5, weight 3, no kind);
 # the camera looks straight down at the cube from 5 m (Blender rotation 0 looks along -Z).
@@ -38,8 +37,7 @@ def _run(tmp_path, map_by, defaults, output=""):
     config.write_text(text)
     out = tmp_path / "out"
     run_config(config, [str(out)])
-    with h5py.File(out / "data.hdf5") as f:
-        return {k: decode_dataset(f[k]) for k in f if isinstance(f[k], h5py.Dataset)}
+    return read_numbered(out)  # BlenderProc's 0.hdf5: one value per key
 
 
 def test_one_segmap_with_a_channel_per_numeric_attribute(tmp_path):
@@ -48,6 +46,7 @@ def test_one_segmap_with_a_channel_per_numeric_attribute(tmp_path):
     assert "segmap" not in data
     segmap = np.asarray(data["my_segmap"])[0]
     assert segmap.shape == (24, 32, 3)  # instance, class, weight; name and kind are text: no channel
+    assert segmap.dtype == np.float64  # as BlenderProc 1.x stores it (its channels are built in float64)
     instance = np.asarray(data["instance_segmaps"])[0]
     np.testing.assert_array_equal(segmap[..., 0], instance)
     # the cube covers the image centre, the floor the corners (geometry, not the renderer's tables)

@@ -94,11 +94,11 @@ def test_each_board_pose_renders_in_its_keypoint(tmp_path):
     after = [{"module": "renderer.SegMapRenderer", "config": {"map_by": ["instance"]}},
              {"module": "writer.Hdf5Writer", "config": {}}]
     context = run_config_text(tmp_path, _config(tmp_path, [0.0, 0.0, 0.0], extra, after))
-    import h5py
+    from tests.blenderproc_files import read_numbered
 
-    [path] = [p for p in context.outputs if str(p).endswith(".hdf5")]
-    with h5py.File(path) as f:
-        masks = f["instance_segmaps"][()]
+    paths = [p for p in context.outputs if str(p).endswith(".hdf5")]  # BlenderProc's 0.hdf5, 1.hdf5, ...
+    assert [p.name for p in paths] == [f"{i}.hdf5" for i in range(len(paths))]
+    masks = read_numbered(paths[0].parent)["instance_segmaps"]
     scene = context.scene
     board = scene.by_name("Board")
     assert len(masks) == len(scene.camera) >= 2

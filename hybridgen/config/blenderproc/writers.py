@@ -9,10 +9,13 @@ from .common import Note, pop_ignored
 from .image_options import apply_image_types
 
 
-def postprocessing(cfg: dict[str, Any], note: Note, state: dict[str, Any]) -> None:
+def postprocessing(cfg: dict[str, Any], note: Note, state: dict[str, Any]) -> set[str]:
+    """Take ``postprocessing_modules`` out of a writer's ``cfg``; the output keys whose channels are trimmed
+    (TrimRedundantChannels, or Dist2Depth, which trims too)."""
     modules = cfg.pop("postprocessing_modules", None)
+    trimmed: set[str] = set()
     if not modules:
-        return
+        return trimmed
     if not isinstance(modules, dict):
         raise ConfigError("must map an output key to a list of {module: postprocessing.X}",
                           key="postprocessing_modules")
@@ -21,20 +24,26 @@ def postprocessing(cfg: dict[str, Any], note: Note, state: dict[str, Any]) -> No
             name = step.get("module") or step.get("name") if isinstance(step, dict) else step
             if name == "postprocessing.Dist2Depth":
                 state["dist2depth"] = True  # depth is rendered exactly instead of converted from distance
+                trimmed.add(str(output))
             elif name == "postprocessing.TrimRedundantChannels":
-                pass  # hybridgen's depth/distance are single-channel already
+                trimmed.add(str(output))  # hybridgen's depth/distance are single-channel already
             elif name == "postprocessing.OilPaintFilter":
                 note("the oil-paint filter is not implemented", f"postprocessing_modules.{output}")
             else:
                 raise ConfigError(f"unknown postprocessing module {name!r}; hybridgen knows "
                                   "postprocessing.Dist2Depth and postprocessing.TrimRedundantChannels",
                                   key=f"postprocessing_modules.{output}")
+    return trimmed
 
 
 def writer(kind: str) -> Callable[[dict[str, Any], Note, dict[str, Any]], list[tuple[str, dict[str, Any]]]]:
     def translate(config: dict[str, Any], note: Note, state: dict[str, Any]) -> list[tuple[str, dict[str, Any]]]:
         cfg = dict(config)
-        postprocessing(cfg, note, state)
+        trimmed = postprocessing(cfg, note, state)
+        if kind == "writer.Hdf5Writer" and state.get("blenderproc"):
+            cfg.setdefault("layout", "blenderproc")  # BlenderProc's <i>.hdf5 files, its keys and encodings
+            state.setdefault("trimmed", {})[id(cfg)] = trimmed
+            pop_ignored(cfg, "delete_temporary_files_afterwards", note, "hybridgen keeps no temporary files")
         pop_ignored(cfg, "write_alpha_channel", note, "hybridgen images carry no alpha channel")
         pop_ignored(cfg, "output_file_prefix", note, "hybridgen names its own files")
         if kind == "writer.BopWriter":
@@ -97,6 +106,11 @@ def finish(entries: list[Any], state: dict[str, Any], output_dir: Any) -> None:
             last["map_by"] = [*_as_list(last.get("map_by")), "instance"]
         if entry.name == "writer.BopWriter" and not any(e.config.get("render_depth") for e in renderers):
             last["render_depth"] = True
+    for position, entry in enumerate(entries):
+        trimmed = state.get("trimmed", {}).get(id(entry.config))
+        if trimmed is not None and entry.config.get("layout") == "blenderproc":
+            _blenderproc_v1_hdf5(entry.config, [e.config for e in entries[:position] if e.name.startswith("renderer.")],
+                                 trimmed, bool(state.get("dist2depth")))
     apply_image_types(entries, state.get("image_types", {}))
     subdirs = state.get("subdirs", {})
     if subdirs and isinstance(output_dir, str):
@@ -104,3 +118,21 @@ def finish(entries: list[Any], state: dict[str, Any], output_dir: Any) -> None:
             sub = subdirs.get(id(entry.config))
             if sub is not None:
                 entry.config["output_dir"] = f"{output_dir.rstrip('/')}/{sub}"
+
+
+def _blenderproc_v1_hdf5(writer: dict[str, Any], renderers: list[dict[str, Any]], trimmed: set[str],
+                         dist2depth: bool) -> None:
+    """What BlenderProc 1.x's Hdf5Writer adds to its files: ``<key>_version`` datasets ("2.0.0" for rendered
+    passes, "1.0.0" for a Dist2Depth depth), depth/distance as H x W x 3 where no TrimRedundantChannels
+    trimmed them (the EXR's three channels), and the SegMapRenderer's segmap as float64."""
+    untrimmed = []
+    for renderer in renderers:
+        names = renderer.get("output_keys") or {}
+        for flag, own in (("render_depth", "depth"), ("render_distance", "distance")):
+            stored = str(names.get(own, own))
+            if renderer.get(flag) and stored not in trimmed and not (dist2depth and own == "depth"):
+                untrimmed.append(stored)
+    writer.setdefault("untrimmed_keys", list(dict.fromkeys(untrimmed)))
+    writer.setdefault("key_versions", {"*": "2.0.0", **({"depth": "1.0.0"} if dist2depth else {})})
+    segmaps = [r["blenderproc_segmap"]["key"] for r in renderers if isinstance(r.get("blenderproc_segmap"), dict)]
+    writer.setdefault("key_dtypes", {str(key): "float64" for key in segmaps})  # 1.x's np.empty-built segmap
