@@ -30,11 +30,11 @@ if TYPE_CHECKING:  # what static analysers see; at run time the same names come 
     from .io.hdf5_single import Hdf5SingleFileWriter
     from .io.memory_sink import MemorySink
     from .io.mesh_cache import load_objects_cached as load_objects
-    from .render.label_request import LabelRequest
-    from .render.path_trace import PathTraceSettings
-    from .render.raster import RasterView
+    from .render.raster.label_request import LabelRequest
+    from .render.pathtrace.path_trace import PathTraceSettings
+    from .render.raster.raster_view import RasterView
     from .render.render_color import render_color
-    from .render.render_labels import render_labels
+    from .render.raster.render_labels import render_labels
     from .run.pipeline import run_config
     from .scene import Camera, Intrinsics, Light, Material, MeshObject, Scene, World
     from .scene.frames import blender_to_opencv, make_pose, object_pose, opencv_to_blender
@@ -43,8 +43,9 @@ if TYPE_CHECKING:  # what static analysers see; at run time the same names come 
 _LAZY = {
     "Hdf5SingleFileWriter": ".io.hdf5_single", "MemorySink": ".io.memory_sink",
     "load_objects": ".io.mesh_cache:load_objects_cached",
-    "LabelRequest": ".render.label_request", "PathTraceSettings": ".render.path_trace", "RasterView": ".render.raster",
-    "render_color": ".render.render_color", "render_labels": ".render.render_labels", "run_config": ".run.pipeline",
+    "LabelRequest": ".render.raster.label_request", "PathTraceSettings": ".render.pathtrace.path_trace",
+    "RasterView": ".render.raster.raster_view", "render_color": ".render.render_color",
+    "render_labels": ".render.raster.render_labels", "run_config": ".run.pipeline",
     "Camera": ".scene", "Intrinsics": ".scene", "Light": ".scene", "Material": ".scene", "MeshObject": ".scene",
     "Scene": ".scene", "World": ".scene", "blender_to_opencv": ".scene.frames", "make_pose": ".scene.frames",
     "object_pose": ".scene.frames", "opencv_to_blender": ".scene.frames", "make_primitive": ".scene.primitives",

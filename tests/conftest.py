@@ -16,7 +16,7 @@ REPO = Path(__file__).resolve().parents[1]
 
 @pytest.fixture(scope="session")
 def gl_context():
-    from hybridgen.render.gl_context import shared_context
+    from hybridgen.render.raster.gl_context import shared_context
 
     return shared_context()
 

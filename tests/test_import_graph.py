@@ -1,5 +1,6 @@
-"""The package has no import cycles: the static graph of every ``import`` in hybridgen, function-level
-(lazy) imports included and ``if TYPE_CHECKING:`` imports excluded, has no strongly connected component."""
+"""The package has no import cycles: the static graph of every ``import`` in hybridgen, function-level (lazy)
+and ``if TYPE_CHECKING:`` imports included, has no strongly connected component; and the rooms of render/ keep
+to their import rules (hybridgen/render/__init__.py, docs/architecture.md)."""
 from __future__ import annotations
 
 import ast
@@ -15,23 +16,9 @@ def _module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-def _is_type_checking(node: ast.AST) -> bool:
-    test = getattr(node, "test", None)
-    return isinstance(node, ast.If) and isinstance(test, ast.Name) and test.id == "TYPE_CHECKING"
-
-
 def _imports(tree: ast.AST) -> list[ast.Import | ast.ImportFrom]:
-    found: list[ast.Import | ast.ImportFrom] = []
-    stack = [tree]
-    while stack:
-        node = stack.pop()
-        if _is_type_checking(node):
-            stack.extend(getattr(node, "orelse", []))
-            continue
-        if isinstance(node, (ast.Import, ast.ImportFrom)):
-            found.append(node)
-        stack.extend(ast.iter_child_nodes(node))
-    return found
+    """Every import statement of a module, at any depth: module level, in functions, under ``TYPE_CHECKING``."""
+    return [node for node in ast.walk(tree) if isinstance(node, (ast.Import, ast.ImportFrom))]
 
 
 def import_graph() -> dict[str, set[str]]:
@@ -101,10 +88,47 @@ def test_cycle_finder_finds_a_planted_cycle():
     assert cycles({"a": {"b"}, "b": set()}) == []
 
 
-def test_the_graph_sees_relative_and_lazy_imports():
+def test_the_graph_sees_relative_lazy_and_type_checking_imports():
     graph = import_graph()
     assert "hybridgen.run.steps" in graph["hybridgen.run.pipeline"]  # from .steps import ... (top level)
     assert "hybridgen.sampling.registry" in graph["hybridgen.config.schema"]  # inside Param.validate
+    assert "hybridgen.run.context" in graph["hybridgen.modules.base"]  # under if TYPE_CHECKING:
+    assert "hybridgen.render.pathtrace.denoise" in graph["hybridgen.render.render_color"]  # from .pathtrace.denoise
+
+
+def _edges(graph: dict[str, set[str]], source: str, target: str) -> list[str]:
+    """The imports from modules under ``source`` into modules under ``target`` (package prefixes)."""
+    def under(name: str, prefix: str) -> bool:
+        return name == prefix or name.startswith(prefix + ".")
+    return sorted(f"{m} -> {t}" for m, ts in graph.items() if under(m, source) for t in ts if under(t, target))
+
+
+def test_raster_and_pathtrace_never_import_each_other():
+    """Labels (GL) and color (Mitsuba) are separate rooms: what joins them lives at render/'s top."""
+    graph = import_graph()
+    assert _edges(graph, "hybridgen.render.raster", "hybridgen.render.pathtrace") == []
+    assert _edges(graph, "hybridgen.render.pathtrace", "hybridgen.render.raster") == []
+    assert _edges(graph, "hybridgen.render.render_color", "hybridgen.render.raster")  # the join uses both sides
+    assert _edges(graph, "hybridgen.render.render_color", "hybridgen.render.pathtrace")
+
+
+def test_render_imports_no_config_module_run_or_api_layer():
+    """render/ sits below the config, module and run layers (and the BlenderProc API above them); the one
+    exception is the notice channel, a leaf that config/ hosts."""
+    graph = import_graph()
+    upward = [edge for layer in ("config", "modules", "run", "cli", "bproc", "data")
+              for edge in _edges(graph, "hybridgen.render", f"hybridgen.{layer}")
+              if not edge.endswith("-> hybridgen.config.notices")]
+    assert upward == [], "\n".join(upward)
+
+
+def test_a_planted_cross_import_is_caught():
+    """The rule check sees a lazy import planted in a raster module."""
+    graph = import_graph()
+    graph["hybridgen.render.raster.readback"] = graph["hybridgen.render.raster.readback"] | {
+        "hybridgen.render.pathtrace.path_trace"}
+    assert _edges(graph, "hybridgen.render.raster", "hybridgen.render.pathtrace") == [
+        "hybridgen.render.raster.readback -> hybridgen.render.pathtrace.path_trace"]
 
 
 def test_no_import_cycles():
@@ -128,8 +152,8 @@ def test_config_uses_sampling_but_sampling_never_imports_config():
 HEAVY = ("numpy", "h5py", "yaml", "packaging", "moderngl", "mitsuba", "drjit", "trimesh", "scipy", "PIL", "tqdm")
 """Packages ``import hybridgen`` and ``hybridgen --help`` must not load (each costs 10 ms to 1 s of start-up)."""
 
-COLOR_ONLY = ("mitsuba", "drjit", "pyoidn", "hybridgen.render.path_trace", "hybridgen.render.render_color",
-              "hybridgen.render.mitsuba_scene", "hybridgen.render.mitsuba_variant", "hybridgen.render.denoise")
+COLOR_ONLY = ("mitsuba", "drjit", "pyoidn", "hybridgen.render.pathtrace.path_trace", "hybridgen.render.render_color",
+              "hybridgen.render.pathtrace.mitsuba_scene", "hybridgen.render.pathtrace.mitsuba_variant", "hybridgen.render.pathtrace.denoise")
 """What only a color (path-traced) run needs: a labels-only run imports none of it."""
 
 LABELS_ONLY_CONFIG = """
@@ -186,6 +210,6 @@ def test_labels_only_run_loads_no_color_code_and_a_cached_mesh_no_trimesh(tmp_pa
                 f"assert main(['run', '-q', {str(config)!r}, {str(tmp_path / run)!r}]) == 0")
         modules = _modules_after(code, env)
         assert (tmp_path / run / "data.hdf5").is_file()
-        assert "hybridgen.render.render_labels" in modules  # the labels were rendered in this process
+        assert "hybridgen.render.raster.render_labels" in modules  # the labels were rendered in this process
         assert _loaded(modules, COLOR_ONLY) == [], run
     assert _loaded(modules, ("trimesh", "scipy", "hybridgen.physics")) == []

@@ -118,8 +118,8 @@ def run_mode(config: Path, shared: bool, width: int, height: int, spp: int) -> d
     from hybridgen.config.config_file import load_config
     from hybridgen.modules.material_library import material_library
     from hybridgen.render import shared_geometry
-    from hybridgen.render.mitsuba_variant import choose_variant
-    from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+    from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
+    from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
     from hybridgen.run.pipeline import build_modules, execute
 
     shared_geometry.ENABLED = shared

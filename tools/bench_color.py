@@ -192,7 +192,7 @@ def blurred_difference(a: np.ndarray, b: np.ndarray, block: int = 8) -> float:
 class BareMitsuba:
     """The bare script: one ``mi.load_dict``, a plain ``perspective`` sensor moved through ``mi.traverse``.
 
-    The dictionary's geometry, materials and emitters come from ``hybridgen.render.mitsuba_scene.scene_dict``
+    The dictionary's geometry, materials and emitters come from ``hybridgen.render.pathtrace.mitsuba_scene.scene_dict``
     (so both engines trace exactly the same meshes, BSDFs and emitters - a hand-written copy could differ
     in a detail and measure something else); the integrator is ``PathTraceSettings.integrator()`` (path,
     max_depth = bounces + 2, same rr_depth); sensor, film (one-pixel box filter, RGB) and sampler
@@ -202,7 +202,7 @@ class BareMitsuba:
     def __init__(self, scene: Any, settings: Any) -> None:
         import mitsuba as mi
 
-        from hybridgen.render.mitsuba_scene import scene_dict
+        from hybridgen.render.pathtrace.mitsuba_scene import scene_dict
 
         intr = scene.camera.intrinsics
         self.spp = settings.samples
@@ -224,7 +224,7 @@ class BareMitsuba:
     def render(self, cam2world: np.ndarray, seed: int) -> np.ndarray:
         import mitsuba as mi
 
-        from hybridgen.render.path_trace import OPENCV_TO_MITSUBA
+        from hybridgen.render.pathtrace.path_trace import OPENCV_TO_MITSUBA
 
         self.params["to_world"] = mi.ScalarTransform4f((np.asarray(cam2world) @ OPENCV_TO_MITSUBA).tolist())
         self.params.update()
@@ -263,7 +263,7 @@ def export_for_cycles(scene: Any, path: Path, spp: int, bounces: int, min_bounce
     """Meshes in world coordinates (with the world-space vertex normals hybridgen gives Mitsuba), materials
     (base-color textures and UVs included), lights, world (color or HDRI), camera and poses, for
     tools/cycles_render.py, which renders with ``threads`` CPU threads (default: every core)."""
-    from hybridgen.render.mitsuba_scene import emitted_radiance
+    from hybridgen.render.pathtrace.mitsuba_scene import emitted_radiance
 
     arrays: dict[str, np.ndarray] = {}
     objects = []
@@ -385,7 +385,7 @@ class TimingSink:
 def profile_fixed_cost(scene: Any, args: argparse.Namespace, bare_settings: Any) -> None:
     """hybridgen vs the bare script at 1 spp, where the fixed per-keypoint cost is visible, and a cProfile
     of hybridgen's per-keypoint call."""
-    from hybridgen.render.path_trace import PathTraceSettings
+    from hybridgen.render.pathtrace.path_trace import PathTraceSettings
     from hybridgen.render.render_color import ColorProducer, keypoint_seed
 
     settings = PathTraceSettings(samples=1, max_bounces=args.bounces)
@@ -489,8 +489,8 @@ def main() -> None:
     import drjit as dr
     import mitsuba as mi
 
-    from hybridgen.render import mitsuba_variant, path_trace
-    from hybridgen.render.path_trace import PathTraceSettings
+    from hybridgen.render.pathtrace import mitsuba_variant, path_trace
+    from hybridgen.render.pathtrace.path_trace import PathTraceSettings
     from hybridgen.render.render_color import keypoint_seed, render_color
 
     load_before = os.getloadavg()

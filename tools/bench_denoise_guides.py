@@ -1,6 +1,6 @@
 """A/B of the denoiser's guides on the scenes of tools/color_quality.py: the same noisy hybridgen render (its
 default settings) denoised once with the raster guides and once with guides that follow sharp specular
-surfaces (hybridgen/render/specular_guides.py), each scored (8-bit sRGB) against the scene's fixed-spp
+surfaces (hybridgen/render/pathtrace/specular_guides.py), each scored (8-bit sRGB) against the scene's fixed-spp
 references without denoising, also per object (instance mask of the raster view). Same samples, so the
 difference is the guides' alone.
 
@@ -28,10 +28,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 def main() -> None:
     import color_quality as cq
 
-    from hybridgen.render.denoise import denoise
+    from hybridgen.render.pathtrace.denoise import denoise
     from hybridgen.render.denoise_guides import DenoiseGuides
-    from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
-    from hybridgen.render.raster import RasterView
+    from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
+    from hybridgen.render.raster.raster_view import RasterView
     from hybridgen.render.tonemap import to_srgb8
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])

@@ -10,7 +10,7 @@ A round renders ``--frames`` orbit poses after an untimed warm-up; frames/s are 
 Readback and turning the raw buffers into arrays are included on both sides:
   hybridgen: the real label path (two-deep submit/collect pipeline) making depth + normals + instance ids
              + class ids (+ the per-keypoint instance records) in the form the default HDF5 file stores them
-             (packed targets, render/label_targets.py), handed to a sink that discards them ("raw");
+             (packed targets, render/raster/label_targets.py), handed to a sink that discards them ("raw");
   pyrender:  one ``render(flags=SEG)`` per keypoint (colour-coded instance ids + depth), ids decoded.
 ``--check`` compares both engines' depth and ids at one pose with an Embree ray cast through pixel centres.
 """
@@ -42,8 +42,8 @@ def _ours_worker(conn: Any, checkout: str | None = None) -> None:
 
     import hybridgen as hg
     from hybridgen.render.keypoint_loop import run_keypoints
-    from hybridgen.render.raster_passes import depth as depth_pass
-    from hybridgen.render.render_labels import LabelProducer
+    from hybridgen.render.raster.raster_passes import depth as depth_pass
+    from hybridgen.render.raster.label_producer import LabelProducer
 
     request = hg.LabelRequest(depth=True, normals=True, map_by=["class", "instance"])
     views: dict[str, tuple[Any, Any]] = {}

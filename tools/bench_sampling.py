@@ -151,7 +151,7 @@ def ray_failures(grid: RayGrid, cam2world: np.ndarray, intr: Any, checks: Any) -
 
 def bench_cameras(context: Any, module: Any, count: int, rounds: int) -> tuple[list[dict[str, Any]], dict]:
     from hybridgen.config.camera_poses import intrinsics_from_config, pose_from_entry
-    from hybridgen.render.raster import RasterView
+    from hybridgen.render.raster.raster_view import RasterView
     from hybridgen.sampling.camera_sampling import check_intrinsics, pose_failures
     from hybridgen.sampling.registry import DrawContext, draw
 

@@ -1,4 +1,4 @@
-"""Cost of transparent shadows (hybridgen/render/transparent_shadows.py): color time of a scene with an alpha
+"""Cost of transparent shadows (hybridgen/render/pathtrace/transparent_shadows.py): color time of a scene with an alpha
 cut-out, traced with transparent shadows (what hybridgen does for such scenes) and with opaque shadow rays
 (Mitsuba's test-for-any-hit, what it did before), in the same process and run.
 
@@ -49,9 +49,9 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     args = parser.parse_args()
     import hybridgen as hg
-    from hybridgen.render import transparent_shadows
-    from hybridgen.render.mitsuba_variant import choose_variant
-    from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+    from hybridgen.render.pathtrace import transparent_shadows
+    from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
+    from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
     variant = choose_variant(args.variant)
     width, height = (int(v) for v in args.res.split("x"))

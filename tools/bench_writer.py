@@ -39,7 +39,7 @@ def capture(scene_name: str, resolution: str, count: int,
 
     import hybridgen as hg
     from hybridgen.render.keypoint_loop import run_keypoints
-    from hybridgen.render.render_labels import LabelProducer
+    from hybridgen.render.raster.label_producer import LabelProducer
 
     scene = bs.ALL_SCENES[scene_name]()
     scene.camera.intrinsics = bs.intrinsics(*bs.RESOLUTIONS[resolution])

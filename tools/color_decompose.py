@@ -52,7 +52,7 @@ def scores(image: np.ndarray, reference: np.ndarray) -> dict[str, float]:
 
 
 def hybridgen_linear(scene: Any, spp: int, seed: int, **settings: Any) -> tuple[np.ndarray, float]:
-    from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+    from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
     cpu = time.process_time()
     view = PathTraceView(scene, PathTraceSettings(samples=spp, **settings))

@@ -258,7 +258,7 @@ def hybridgen_reference(scene: Any, spp: int, clamp: float,
     """hybridgen's own estimator at a fixed ``spp`` (no adaptivity, no denoising) with indirect clamp ``clamp``
     (0: off) and per-lobe bounces ``lobes`` (default: hybridgen's): the sRGB frame and its wall seconds, in
     this process."""
-    from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+    from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
     from hybridgen.render.tonemap import to_srgb8
 
     start = time.perf_counter()

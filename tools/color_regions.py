@@ -47,7 +47,7 @@ def cpu_seconds() -> float:
 
 def object_map(scene: Any) -> tuple[np.ndarray, dict[int, str]]:
     """The instance id each pixel centre sees (H x W; 0 = none) and the objects' names by id."""
-    from hybridgen.render.scene_raster import SceneRaster
+    from hybridgen.render.raster.scene_raster import SceneRaster
 
     raster = SceneRaster(scene)
     try:
@@ -67,9 +67,9 @@ def srgb_float(linear: np.ndarray) -> np.ndarray:
 def default_render(scene: Any, settings: Any) -> dict[str, Any]:
     """The default pipeline's raw and denoised sRGB frames, samples per pixel, sampling and denoising CPU s,
     and the path-trace view (for further tracing)."""
-    from hybridgen.render.denoise import denoise
+    from hybridgen.render.pathtrace.denoise import denoise
     from hybridgen.render.denoise_guides import DenoiseGuides
-    from hybridgen.render.path_trace import PathTraceView
+    from hybridgen.render.pathtrace.path_trace import PathTraceView
     from hybridgen.render.render_color import keypoint_seed
     from hybridgen.render.tonemap import to_srgb8
 
@@ -97,7 +97,7 @@ def sample_cost(view: Any, pixels: np.ndarray, spp: int = 64) -> float:
 
 def path_variances(scene: Any, base: dict[str, Any], ids: np.ndarray, spp: int) -> dict[str, dict[int, float]]:
     """Per light path class (:data:`PATH_CLASSES`): each object's mean per-pixel variance of raw sRGB values."""
-    from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+    from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
     out = {}
     for name, change in PATH_CLASSES.items():
@@ -126,7 +126,7 @@ def main() -> None:
     from bench_color import export_for_cycles
     from reference_cache import ReferenceCache, cache_root, scene_digest
 
-    from hybridgen.render.path_trace import PathTraceSettings
+    from hybridgen.render.pathtrace.path_trace import PathTraceSettings
 
     width, height = (int(v) for v in args.res.lower().split("x"))
     resolution = f"{width}x{height}"

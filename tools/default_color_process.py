@@ -63,7 +63,7 @@ def main() -> None:
     sink = hg.MemorySink()
     sampling: dict[str, Any] = {"noise_threshold": args.threshold}
     if args.max_samples is not None:  # samples with a threshold is a maximum (without one, a fixed count)
-        from hybridgen.render.path_trace import DEFAULT_NOISE_THRESHOLD
+        from hybridgen.render.pathtrace.path_trace import DEFAULT_NOISE_THRESHOLD
 
         sampling = {"samples": args.max_samples,
                     "noise_threshold": DEFAULT_NOISE_THRESHOLD if args.threshold is None else args.threshold}

@@ -34,7 +34,7 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_ROOT = Path("~/.cache/hybridgen/bench_color")
-ESTIMATOR_MODULES = ("hybridgen.render.path_trace", "hybridgen.render.tonemap")
+ESTIMATOR_MODULES = ("hybridgen.render.pathtrace.path_trace", "hybridgen.render.tonemap")
 """Where hybridgen's reference image is made (PathTraceView) and encoded (to_srgb8)."""
 
 

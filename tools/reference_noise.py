@@ -50,9 +50,9 @@ def db(value: float) -> float:
 def default_color(scene: Any) -> np.ndarray:
     """hybridgen's default color of keypoint 0 (adaptive sampling, denoised), sRGB uint8, as
     tools/default_color_process.py renders it (seed 1)."""
-    from hybridgen.render.denoise import denoise
+    from hybridgen.render.pathtrace.denoise import denoise
     from hybridgen.render.denoise_guides import DenoiseGuides
-    from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+    from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
     from hybridgen.render.render_color import keypoint_seed
     from hybridgen.render.tonemap import to_srgb8
 
@@ -71,7 +71,7 @@ def second_reference(refs: Any, name: str, scene: Any, content: str) -> np.ndarr
     from color_quality import CLAMP
     from default_color_process import LOBES
 
-    from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+    from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
     from hybridgen.render.tonemap import to_srgb8
 
     key = {**refs._key(name, content), "seed": SECOND_SEED, "clamp_indirect": CLAMP, "lobes": refs.lobes,

@@ -62,7 +62,7 @@ class MemoryCurve:
 def run(labels: int, color: int, width: int, height: int, every: int) -> list[tuple[str, int, float]]:
     """Render, write, and return the (pass, keypoints done, RSS MB) samples."""
     import hybridgen as hg
-    from hybridgen.render.path_trace import PathTraceSettings
+    from hybridgen.render.pathtrace.path_trace import PathTraceSettings
     from hybridgen.render.render_color import render_color
 
     curve = MemoryCurve(every)

@@ -22,6 +22,8 @@ import numpy as np
 
 from ..errors import InputError
 
+from .blender_camera import BlenderCamera
+
 if TYPE_CHECKING:
     from ..scene.camera import Intrinsics
 
@@ -101,10 +103,11 @@ class WorldState:
 
 @dataclass
 class CameraState:
-    """The scene camera: intrinsics (None until ``init()``), stereo settings and its pose as an
-    :class:`Animated` Blender-axes cam2world 4x4 (keyed by ``add_camera_pose``)."""
+    """The scene camera: Blender's lens, sensor, resolution and clip range (:mod:`hybridgen.bproc.blender_camera`),
+    stereo settings and its pose as an :class:`Animated` Blender-axes cam2world 4x4 (keyed by
+    ``add_camera_pose``)."""
 
-    intrinsics: "Intrinsics | None" = None
+    blender: BlenderCamera = field(default_factory=BlenderCamera)
     pose: Animated = field(default_factory=lambda: Animated(np.eye(4)))
     stereo: bool = False
     interocular_distance: float = 0.065
@@ -161,21 +164,15 @@ SESSION = Session()
 
 
 def current_intrinsics() -> "Intrinsics":
-    """The camera's intrinsics (BlenderProc's defaults before any call sets them: 512 x 512, fov 0.691111 rad,
+    """The camera's intrinsics (BlenderProc's defaults until a call changes them: 512 x 512, fov 0.691111 rad,
     clip 0.1..1000 m)."""
-    from ..scene.camera import Intrinsics
-
-    if SESSION.camera.intrinsics is None:
-        SESSION.camera.intrinsics = Intrinsics.default()
-    return SESSION.camera.intrinsics
+    return SESSION.camera.blender.intrinsics()
 
 
 def reset(keep_initialized: bool = True) -> Session:
     """Empty the session in place (``bproc.clean_up``: every object, material, camera pose and the world go;
     renderer settings are reset by ``init()`` only). Returns the session."""
-    renderer = SESSION.renderer
-    intrinsics = SESSION.camera.intrinsics
-    fresh = Session(initialized=keep_initialized, renderer=renderer)
-    fresh.camera.intrinsics = intrinsics
+    fresh = Session(initialized=keep_initialized, renderer=SESSION.renderer)
+    fresh.camera.blender = SESSION.camera.blender
     SESSION.__dict__.update(fresh.__dict__)
     return SESSION

@@ -14,6 +14,7 @@ from .blenderproc import finish as finish_translation
 from .notices import notice
 from .placeholders import resolve_placeholders
 from .requirements import NOT_A_REQUIREMENT, RequirementCheck, check_requirements
+from .roles import Role
 from .yaml_safety import MAX_CONFIG_BYTES, load_yaml, read_limited
 
 TOP_LEVEL_KEYS = ("setup", "global", "modules", "version")
@@ -198,7 +199,6 @@ def _keep_renderer_outputs(modules: list[ModuleEntry], file: str) -> None:
 
 def _sets_up_run(name: str) -> bool:
     """True if ``name`` is a setup module (run-wide settings, e.g. main.Initializer); unknown names are not."""
-    from ..modules.base import Role
     from .registry import get_module
 
     try:

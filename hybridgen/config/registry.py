@@ -7,12 +7,22 @@ ever names a registered module: nothing in a config is imported as Python.
 from __future__ import annotations
 
 import importlib
-from typing import TYPE_CHECKING, Callable, TypeVar
+from typing import Callable, ClassVar, Protocol, TypeVar
 
 from ..errors import ConfigError, closest
+from .roles import Role
+from .schema import Param
 
-if TYPE_CHECKING:
-    from ..modules.base import Module
+
+class Module(Protocol):
+    """What the registry and the config parser read of a registered class (a
+    :class:`hybridgen.modules.base.Module` subclass; a protocol here, so that config/ does not import modules/)."""
+
+    module_name: ClassVar[str]
+    role: ClassVar[Role]
+
+    @classmethod
+    def param_table(cls) -> dict[str, Param]: ...
 
 ENTRY_POINT_GROUP = "hybridgen.modules"
 _BUILTIN_NAMES = {

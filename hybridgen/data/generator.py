@@ -54,7 +54,7 @@ _inherited_renderer = False
 def _after_fork_in_child() -> None:
     """Remember whether the parent had a GL context or a Mitsuba variant when this process was forked."""
     global _inherited_renderer
-    gl = sys.modules.get("hybridgen.render.gl_context")
+    gl = sys.modules.get("hybridgen.render.raster.gl_context")
     mitsuba = sys.modules.get("mitsuba")
     _inherited_renderer = _inherited_renderer or bool(gl is not None and gl._shared) or \
         bool(mitsuba is not None and getattr(mitsuba, "variant", lambda: None)())

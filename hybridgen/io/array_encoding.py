@@ -20,7 +20,7 @@ _OCT_SCALE = 32767.0  # q in [-1, 1] -> (q + 1) * 32767 in [0, 65534], + 1: code
 
 @dataclass(frozen=True)
 class EncodedArray:
-    """A pass value already in its stored form (made by the raster pass itself, render/label_targets.py):
+    """A pass value already in its stored form (made by the raster pass itself, render/raster/label_targets.py):
     ``stored`` is what a writer stores under ``tag`` (:func:`storage_tag`); renderers hand such values only to
     sinks that said they store that tag (``accepted_encodings()``). :meth:`decode` gives the documented values."""
 

@@ -13,6 +13,7 @@ import errno
 import os
 import tempfile
 from pathlib import Path
+from typing import Any
 
 from ..errors import InputError
 from ..stop_request import deferred
@@ -96,6 +97,31 @@ def discard(temp: Path) -> None:
     try:
         os.unlink(temp)
     except FileNotFoundError:
+        pass
+
+
+def close_discarded_hdf5(h5: Any) -> None:
+    """Close the open h5py file ``h5`` whose temporary file is being given up, without the close writing to
+    the disk: its descriptor is first pointed at an anonymous in-memory file (Linux ``memfd``), so what HDF5
+    still flushes while closing (dirty metadata, cached chunks) cannot fail on a full disk. A close whose
+    flush failed leaves HDF5 with half-closed datasets, and closing them again - h5py's ``File.close``
+    retries, as does a later file's close or the process's exit - crashed the process (SIGSEGV in
+    ``H5D_close``, HDF5 2.0). The caller deletes the temporary file. Never raises."""
+    try:
+        if not h5.id.valid:
+            return
+        fd = h5.id.get_vfd_handle()
+        if isinstance(fd, int) and fd >= 0 and hasattr(os, "memfd_create"):
+            sink = os.memfd_create("hybridgen-discarded")
+            try:
+                os.dup2(sink, fd)
+            finally:
+                os.close(sink)
+    except Exception:  # another driver, a closed file: close it as it is
+        pass
+    try:
+        h5.close()
+    except Exception:
         pass
 
 

@@ -23,7 +23,7 @@ Masks are exact, not estimated from depth with a tolerance as the BOP toolkit do
 full silhouette also outside the image, as the BOP toolkit counts it), ``visib_fract`` and the toolkit boxes
 ``bbox_obj``/``bbox_visib`` (``[x, y, x_max - x, y_max - y]`` of the full / visible pixels, [-1, -1, -1, -1]
 when nothing is visible; ``bbox_obj`` may extend past the image) are the render-side passes
-``amodal_masks``, ``visible_fractions`` and ``object_boxes`` (:mod:`hybridgen.render.object_passes`), which
+``amodal_masks``, ``visible_fractions`` and ``object_boxes`` (:mod:`hybridgen.render.raster.object_passes`), which
 this writer asks for (``wanted_passes``); ``px_count_valid`` counts full-mask pixels with a depth value in
 the PNG. Poses: :mod:`hybridgen.scene.rigid_pose`; chunks and their JSON: :mod:`hybridgen.io.bop_chunks`.
 

@@ -3,7 +3,7 @@
 ``$HYBRIDGEN_CACHE_DIR``, else ``$XDG_CACHE_HOME/hybridgen``, else ``~/.cache/hybridgen``. Parsed meshes
 (:mod:`hybridgen.io.mesh_cache`), input-file hashes (:mod:`hybridgen.run.input_hashes`), convex
 decompositions (:mod:`hybridgen.physics.shapes`) and the raster view's triangle clusters
-(:mod:`hybridgen.render.cluster_cache`) live in it. ``HYBRIDGEN_CACHE_DIR=off`` (or ``0``, ``none``)
+(:mod:`hybridgen.render.raster.cluster_cache`) live in it. ``HYBRIDGEN_CACHE_DIR=off`` (or ``0``, ``none``)
 turns all four off. Nothing here imports more than the standard library, so every
 layer (io, run, physics) can use it.
 """

@@ -19,7 +19,7 @@
 
 Every object gets ``is_3d_front: true`` and ``category_id`` = the label mapping's id of its lower-cased name.
 Emissive ceilings and lamps show their principled surface to camera rays and emit only for other rays, as
-BlenderProc's (``emission_hidden_from_camera``, :mod:`hybridgen.render.camera_hidden_emission`; in JIT Mitsuba
+BlenderProc's (``emission_hidden_from_camera``, :mod:`hybridgen.render.pathtrace.camera_hidden_emission`; in JIT Mitsuba
 variants - ``scalar_rgb`` shows them glowing, with a notice).
 """
 from __future__ import annotations

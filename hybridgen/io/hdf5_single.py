@@ -30,7 +30,7 @@ import numpy as np
 
 from ..config.options import checked_options, option
 from ..errors import InputError
-from .atomic import commit, prepare_output_dir, temporary_path
+from .atomic import close_discarded_hdf5, commit, discard, prepare_output_dir, temporary_path
 from .blosc2_chunks import Blosc2Chunks
 from .frame_sink import PassLayout
 from .hdf5_filters import READ_HINT
@@ -187,6 +187,9 @@ class Hdf5SingleFileWriter:
         self._layouts: dict[str, PassLayout] = {}
         self._stored: dict[str, StoredPass] = {}
         self._datasets: dict[str, h5py.Dataset] = {}  # looked up once: h5[key] costs ~70 us per call
+        # Every other dataset made, held open until the file closes: a dataset whose last handle goes closes
+        # at once, and on a full disk that close fails half-way (HDF5 then crashed closing the file).
+        self._held: list[h5py.Dataset] = []
         self._streams: dict[str, ChunkStream] = {}  # chunked datasets' chunks, hashed as stored (the seal's)
         self._blosc2: dict[str, Blosc2Chunks] = {}  # passes stored through the Blosc2 filter
         self._pool: ThreadPoolExecutor | None = None
@@ -212,7 +215,7 @@ class Hdf5SingleFileWriter:
                 if not np.array_equal(h5[key][()], value):
                     raise InputError(f"'{key}' differs between two renderers of the same run")
             else:
-                h5.create_dataset(key, data=value, track_times=False)
+                self._held.append(h5.create_dataset(key, data=value, track_times=False))
         for key, value in attributes.items():
             h5.attrs[key] = value
         if self._pool is None:
@@ -252,12 +255,14 @@ class Hdf5SingleFileWriter:
         self._drain()
         h5 = self._open()
         for key, value in (records or {}).items():
-            h5.create_dataset(key, data=json.dumps(value), dtype=h5py.string_dtype(), track_times=False)
+            self._held.append(h5.create_dataset(key, data=json.dumps(value), dtype=h5py.string_dtype(),
+                                                track_times=False))
         for key, value in (attributes or {}).items():
             h5.attrs[key] = value
-        seal(h5, self._streams)  # content_sha256: resume and readers verify the file with it
+        seal(h5, self._streams)  # content_sha256: resume and readers verify the file with it (flushes)
+        self._file = None  # a close that fails is never tried again (abort): see close_discarded_hdf5
         h5.close()
-        self._file = None
+        self._held.clear()
         self._shutdown_pool()
         commit(self._temp, self.path)
         return [self.path]
@@ -269,13 +274,12 @@ class Hdf5SingleFileWriter:
         except BaseException:
             pass
         if self._file is not None:
-            try:
-                self._file.close()
-            except Exception:
-                pass
+            close_discarded_hdf5(self._file)  # its flush cannot fail on a full disk and crash HDF5
             self._file = None
+        self._datasets.clear()
+        self._held.clear()
         self._shutdown_pool()
-        self._temp.unlink(missing_ok=True)
+        discard(self._temp)
 
     # ------------------------------------------------------------------ internals
     def _open(self) -> h5py.File:

@@ -11,7 +11,7 @@ from ..config.depth_of_field import depth_of_field_from_config
 from ..config.registry import register_module
 from ..config.schema import Param, positive
 from ..errors import ConfigError, InputError, reject_unknown_keys
-from ..render.raster import RasterView
+from ..render.raster.raster_view import RasterView
 from ..run.context import RunContext
 from ..sampling.camera_checks import NoveltyCheck, ProximityChecks
 from ..sampling.camera_sampling import PoseChecks, SamplingReport, sample_camera_poses

@@ -6,9 +6,9 @@ from typing import Any
 from ..config.registry import register_module
 from ..config.schema import Param, positive
 from ..io.renamed_sink import renamed_sinks
-from ..render.mitsuba_variant import choose_variant
+from ..render.pathtrace.mitsuba_variant import choose_variant
 from ..render.passes import color_keys
-from ..render.path_trace import PathTraceSettings
+from ..render.pathtrace.path_trace import PathTraceSettings
 from ..render.render_color import render_color
 from ..run.context import RunContext
 from .base import Module, Role

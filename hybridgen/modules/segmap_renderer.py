@@ -7,9 +7,9 @@ from ..config.registry import register_module
 from ..config.schema import Param
 from ..io.blenderproc_segmap import SegmapSink, apply_default_values, segmap_plan
 from ..io.renamed_sink import renamed_sinks
-from ..render.label_request import parse_map_by
-from ..render.render_labels import render_labels
-from ..render.threaded_labels import auto_render_threads
+from ..render.raster.label_request import parse_map_by
+from ..render.raster.render_labels import render_labels
+from ..render.raster.threaded_labels import auto_render_threads
 from ..run.context import RunContext
 from .base import Module, Role
 from .label_params import label_params, label_request, stored_keys

@@ -11,7 +11,7 @@ are not renormalised: at a silhouette the shorter mixed vector is what the pixel
 
 With ``follow_specular`` and the color's path-trace view, sub-pixels that see sharp glass, mirrors or smooth
 metal get the features of what is seen *through* them, as Cycles' denoising passes do
-(:mod:`hybridgen.render.specular_guides`), before the same filter; all other sub-pixels keep the raster values.
+(:mod:`hybridgen.render.pathtrace.specular_guides`), before the same filter; all other sub-pixels keep the raster values.
 """
 from __future__ import annotations
 
@@ -22,12 +22,12 @@ import numpy as np
 from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
 from .pixel_filter import DEFAULT_WIDTH, filter_supersampled
-from .scene_raster import SceneRaster
-from .specular_guides import SpecularGuideTracer, can_be_specular_like
+from .raster.scene_raster import SceneRaster
+from .pathtrace.specular_guides import SpecularGuideTracer, can_be_specular_like
 
 DEFAULT_FACTOR = 3
 FOLLOW_SPECULAR = False
-"""Whether the guides follow sharp specular surfaces by default (:mod:`hybridgen.render.specular_guides`). Off,
+"""Whether the guides follow sharp specular surfaces by default (:mod:`hybridgen.render.pathtrace.specular_guides`). Off,
 as measured with tools/bench_denoise_guides.py on the materials scene of tools/color_quality.py (160x120, the
 same noisy render denoised both ways, PSNR against two 2048-spp references without their own noise): +0.06 dB
 over 6 seeds (-0.12 .. +0.19), -0.05 dB (-0.94 .. +0.53) after later sampling changes, +0.21 dB with a
@@ -67,8 +67,8 @@ class DenoiseGuides:
 
     def render(self, cam2world: np.ndarray, path_view: Any = None) -> tuple[np.ndarray, np.ndarray]:
         """(albedo, normals) of one keypoint (OpenCV-axes ``cam2world``); with ``path_view`` (the color's
-        :class:`~hybridgen.render.path_trace.PathTraceView`, JIT variants) and ``follow_specular`` they follow
-        sharp specular surfaces (:mod:`hybridgen.render.specular_guides`)."""
+        :class:`~hybridgen.render.pathtrace.path_trace.PathTraceView`, JIT variants) and ``follow_specular`` they follow
+        sharp specular surfaces (:mod:`hybridgen.render.pathtrace.specular_guides`)."""
         tracer = self._tracer_for(path_view)
         fine = self.fine
         albedo = self.raster.albedo.render(cam2world, intrinsics=fine)
@@ -88,7 +88,7 @@ class DenoiseGuides:
             return None
         if not any(can_be_specular_like(o.material) for o in self.raster.scene.objects):
             return None
-        from .mitsuba_variant import is_jit
+        from .pathtrace.mitsuba_variant import is_jit
 
         if not is_jit(path_view.variant):
             return None

@@ -4,10 +4,10 @@ A default color keypoint spends ~70 % of its wall time in Dr.Jit kernels that ke
 rest in phases that use one core: Mitsuba's start and scene load, the raster guides (GL context, upload, the
 supersampled albedo and normals draws and their filter) and the denoiser's setup. Drawn on the path tracer's
 thread, the guides add their whole time to every keypoint. :class:`GuideWorker` gives them a thread of their
-own with its own headless GL context and its own upload of the scene (:class:`~hybridgen.render.scene_raster.
+own with its own headless GL context and its own upload of the scene (:class:`~hybridgen.render.raster.scene_raster.
 SceneRaster`, made on that thread: a GL context is current on one thread): the context and upload are made
 while Mitsuba starts, and each keypoint's guides are drawn while its samples are traced (Dr.Jit releases the
-GIL inside kernels, the raster draws and readbacks release it through :mod:`hybridgen.render.gl_calls`).
+GIL inside kernels, the raster draws and readbacks release it through :mod:`hybridgen.render.raster.gl_calls`).
 The guides are the same values as drawn on the caller's thread: same scene, same camera, same filter.
 
 Used where the color producer would otherwise own a raster view for its guides alone (no labels in the run,
@@ -26,15 +26,15 @@ from concurrent.futures import Future
 import numpy as np
 
 from ..scene.scene import Scene
-from . import denoise
+from .pathtrace import denoise
 from .denoise_guides import DenoiseGuides
-from .gl_worker import DEFAULT_TIMEOUT_S, GLWorker
-from .raster import RasterView
-from .scene_raster import SceneRaster
+from .raster.gl_worker import DEFAULT_TIMEOUT_S, GLWorker
+from .raster.raster_view import RasterView
+from .raster.scene_raster import SceneRaster
 
 
 class GuideWorker:
-    """A :class:`~hybridgen.render.gl_worker.GLWorker` that uploads ``scene`` to its own context (started at
+    """A :class:`~hybridgen.render.raster.gl_worker.GLWorker` that uploads ``scene`` to its own context (started at
     construction, in the background) and draws :class:`~hybridgen.render.denoise_guides.DenoiseGuides` of the
     keypoints handed to :meth:`submit`, in order."""
 
@@ -70,7 +70,7 @@ class GuideWorker:
         return self._worker.submit(draw)
 
     def prepare_denoiser(self) -> Future:
-        """Queues :func:`hybridgen.render.denoise.warm_up` on the worker (before any keypoint's guides), so the
+        """Queues :func:`hybridgen.render.pathtrace.denoise.warm_up` on the worker (before any keypoint's guides), so the
         denoiser's one-time setup overlaps the caller's; a failure there shows again where the denoiser runs."""
         assert self._worker is not None, "prepare_denoiser after release"
         return self._worker.submit(lambda raster: denoise.warm_up())

@@ -1,12 +1,12 @@
 """The pass catalogue: every output key a renderer can write, declared once (docs/conventions.md section 3).
 
 An entry says what the key holds (dtype, per-keypoint shape, units, axes, background), how it is made from
-one keypoint's readback (``compute(frame, key)`` on a :class:`~hybridgen.render.keypoint_frame.KeypointFrame`,
+one keypoint's readback (``compute(frame, key)`` on a :class:`~hybridgen.render.raster.keypoint_frame.KeypointFrame`,
 and which readbacks that needs), how it is asked for (``option``: the renderer parameter, which the renderer
 modules declare from here; :func:`hint`: the line writers print), how each output format stores it (``hdf5``: the compact encoding of ``data.hdf5``; ``blenderproc``:
 BlenderProc's per-keypoint files; ``png``/``exr_channels``: ``hybridgen extract``) and how ``vis`` shows it
 (``show``). Adding a pass = one entry here + its test. The renderer options select keys
-(:class:`~hybridgen.render.label_request.LabelRequest`); readers recognise stored keys with :func:`recognise`
+(:class:`~hybridgen.render.raster.label_request.LabelRequest`); readers recognise stored keys with :func:`recognise`
 (exact name first, then the glob ``pattern`` of renamed or family keys, e.g. ``<attribute>_segmaps``).
 
 How a writer (frame sink) asks for a pass and reads it
@@ -17,7 +17,7 @@ returning their keys. Every renderer that also makes the pass's ``with_keys`` (h
 then computes them, announces them in ``begin`` (``PassLayout`` dtype ``"object"``) and hands them to
 ``write(index, values)`` of the sinks that asked only, in the same ``values`` as ``instance_segmaps``:
 ``values["amodal_masks"][instance_id]`` is the object's (H, W) bool full silhouette inside the image, and so
-on (see :mod:`hybridgen.render.object_passes`). A sink that reads only some objects says which with
+on (see :mod:`hybridgen.render.raster.object_passes`). A sink that reads only some objects says which with
 ``wanted_objects() -> Collection[int] | None`` (instance ids, asked after its ``begin``; None: all): only those
 are drawn alone. In the Python API, ``MemorySink(wanted=[...])`` asks for them.
 :func:`hint` gives the line to print when a key is missing.
@@ -31,13 +31,13 @@ from typing import TYPE_CHECKING, Any, Callable
 import numpy as np
 
 from ..io.frame_sink import PassLayout
-from . import raster_passes as raster
-from .geometry_passes import nocs, optical_flow
-from .object_passes import amodal_masks, object_boxes, visible_fractions
-from .object_records import object_records
+from .raster import raster_passes as raster
+from .raster.geometry_passes import nocs, optical_flow
+from .raster.object_passes import amodal_masks, object_boxes, visible_fractions
+from .raster.object_records import object_records
 
 if TYPE_CHECKING:
-    from .keypoint_frame import KeypointFrame
+    from .raster.keypoint_frame import KeypointFrame
 
 Compute = Callable[["KeypointFrame", str], Any]
 INSTANCE_HINT = "add 'instance' to map_by of the renderer (renderer.SegMapRenderer or renderer.RgbRenderer)"
@@ -157,7 +157,7 @@ _SPECS = (
              lambda frame, key: nocs(frame.raw, frame.intrinsics, frame.cam2world, frame.scene), show="as_stored",
              smooth=True, option="render_nocs", option_doc="write 'nocs': normalized object coordinates in [0, 1]"),
     PassSpec("object_records", "json", None, "per object in view: obj2cam, 3D box, visible and amodal 2D boxes, "
-             "pixel counts, visible fraction (render/object_records.py)", "",
+             "pixel counts, visible fraction (render/raster/object_records.py)", "",
              lambda frame, key: object_records(frame), ("raster", "silhouettes"), option="render_object_records",
              option_doc="write 'object_records' per keypoint: object-to-camera poses, 3D boxes, visible and "
              "amodal 2D boxes, pixel counts, visible fractions"),

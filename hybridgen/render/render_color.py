@@ -7,17 +7,17 @@ import numpy as np
 
 from ..io.frame_sink import FrameSink, PassLayout
 from ..scene.scene import Scene
-from .denoise import denoise as oidn_denoise
-from .denoise import require_oidn
+from .pathtrace.denoise import denoise as oidn_denoise
+from .pathtrace.denoise import require_oidn
 from . import denoise_guides
 from .denoise_guides import DenoiseGuides
 from .guide_worker import GuideWorker
-from .scene_raster import SceneRaster
+from .raster.scene_raster import SceneRaster
 from .keypoint_loop import ProgressFactory, Producer, StereoProducer, run_keypoints
-from .label_request import LabelRequest
+from .raster.label_request import LabelRequest
 from .passes import color_keys, layout
-from .path_trace import PathTraceSettings, PathTraceView
-from .render_labels import LabelProducer
+from .pathtrace.path_trace import PathTraceSettings, PathTraceView
+from .raster.label_producer import LabelProducer
 from .tonemap import to_srgb8
 
 

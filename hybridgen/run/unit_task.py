@@ -42,7 +42,7 @@ def run_unit(path: str, args: Sequence[str], env: Mapping[str, str] | None, unit
     (units run in this process); with ``scenes`` consecutive units of one scene build it once
     (:mod:`hybridgen.run.scene_reuse`); modules' status lines go to ``log`` (default: :func:`log_line`, the
     ``hybridgen`` logger - in a pool worker set up by :func:`start_worker`). Mitsuba takes its thread limit when a color renderer activates it
-    (:func:`hybridgen.render.mitsuba_variant.apply_thread_limit`)."""
+    (:func:`hybridgen.render.pathtrace.mitsuba_variant.apply_thread_limit`)."""
     attributes = {FINGERPRINT_ATTR: fingerprint} if fingerprint is not None else None
     if scenes is not None:
         context = scenes.execute(path, args, env, unit, attributes=attributes, progress=progress,

@@ -7,7 +7,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..render.raster import RasterView
+from ..render.raster.raster_view import RasterView
 from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
 from .camera_checks import NoveltyCheck, ProximityChecks

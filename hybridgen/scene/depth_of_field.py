@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from .camera import Intrinsics
+from .intrinsics import Intrinsics
 
 SENSOR_WIDTH_M = 0.036
 """Blender's default sensor width (36 mm), spanning the larger image side."""

@@ -42,7 +42,7 @@ class Material:
     - ``emission_hidden_from_camera``: the emission lights the scene but the camera does not see it - camera
       rays see the surface's BSDF without emission, every other ray sees the emission alone (a black
       emitter). What BlenderProc's ``make_emissive`` builds (a Light Path "Is Camera Ray" mix), used for
-      3D-FRONT ceilings and lamps (:mod:`hybridgen.render.camera_hidden_emission`).
+      3D-FRONT ceilings and lamps (:mod:`hybridgen.render.pathtrace.camera_hidden_emission`).
     - ``alpha_mode``: "BLEND" - alpha is a fractional opacity in color, labels see the surface (BlenderProc's
       default, segmentation without ``use_alpha``); "CLIP" - alpha >= 0.5 is opaque, below it the surface is
       cut out of color, albedo and every label (Blender's alpha clip, BlenderProc's ``use_alpha``).

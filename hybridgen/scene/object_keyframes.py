@@ -18,13 +18,21 @@ from __future__ import annotations
 
 from bisect import bisect_right
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import Protocol, Sequence
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from .camera import Intrinsics
-    from .scene import Scene
+from .camera import Camera
+from .intrinsics import Intrinsics
+from .mesh_object import MeshObject
+
+
+class Scene(Protocol):
+    """What the keyframes read and move of a :class:`hybridgen.scene.scene.Scene` (which holds them: a protocol
+    here, so that this module does not import the scene's)."""
+
+    objects: Sequence[MeshObject]
+    camera: Camera
 
 
 @dataclass
@@ -34,7 +42,7 @@ class ObjectKeyframes:
     starts: list[int] = field(default_factory=list)
     poses: list[dict[int, np.ndarray]] = field(default_factory=list)
 
-    def record(self, scene: "Scene", start: int | None = None) -> None:
+    def record(self, scene: Scene, start: int | None = None) -> None:
         """Snapshot the scene's object poses for keypoints from ``start`` (default: the next keypoint added)."""
         start = len(scene.camera) if start is None else int(start)
         if self.starts and start < self.starts[-1]:
@@ -54,7 +62,7 @@ class ObjectKeyframes:
         """The ``local2world`` of object ``instance_id`` at keypoint ``index`` (None: not in the snapshot)."""
         return self.poses[self.group(index)].get(instance_id) if self.poses else None
 
-    def apply(self, scene: "Scene", index: int) -> bool:
+    def apply(self, scene: Scene, index: int) -> bool:
         """Move the scene's objects to their poses at keypoint ``index``; True if any pose changed. Objects
         added after the snapshot keep their pose."""
         if not self.poses:
@@ -69,13 +77,13 @@ class ObjectKeyframes:
         return changed
 
 
-def keyframes_of(scene: "Scene") -> ObjectKeyframes | None:
+def keyframes_of(scene: Scene) -> ObjectKeyframes | None:
     """The scene's per-keypoint object poses, or None when every keypoint shows the objects as they are."""
     keyframes = getattr(scene, "object_keyframes", None)
     return keyframes if keyframes is not None and keyframes.poses else None
 
 
-def keypoint_intrinsics(scene: "Scene", index: int) -> "Intrinsics":
+def keypoint_intrinsics(scene: Scene, index: int) -> Intrinsics:
     """The intrinsics keypoint ``index`` renders with (the camera's, unless set per keypoint)."""
     camera = scene.camera
     per_keypoint = camera.intrinsics_per_keypoint
@@ -86,12 +94,12 @@ def keypoint_intrinsics(scene: "Scene", index: int) -> "Intrinsics":
     return own if (own.width, own.height) == size else own.resized(*size)
 
 
-def varies_per_keypoint(scene: "Scene") -> bool:
+def varies_per_keypoint(scene: Scene) -> bool:
     """Whether objects or intrinsics change between this scene's keypoints."""
     return keyframes_of(scene) is not None or bool(scene.camera.intrinsics_per_keypoint)
 
 
-def same_view(scene: "Scene", a: int, b: int) -> bool:
+def same_view(scene: Scene, a: int, b: int) -> bool:
     """Whether keypoints ``a`` and ``b`` show the objects at the same poses through the same intrinsics."""
     keyframes = keyframes_of(scene)
     if keyframes is not None and keyframes.group(a) != keyframes.group(b):
@@ -100,7 +108,7 @@ def same_view(scene: "Scene", a: int, b: int) -> bool:
     return first is second or np.array_equal(first.K, second.K)
 
 
-def apply_keypoint(scene: "Scene", index: int) -> bool:
+def apply_keypoint(scene: Scene, index: int) -> bool:
     """Move the objects to their poses at keypoint ``index`` and give the camera that keypoint's intrinsics;
     True if anything changed (renderers that built the scene then rebuild it)."""
     keyframes = keyframes_of(scene)

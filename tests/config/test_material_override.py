@@ -5,7 +5,7 @@ import numpy as np
 
 import hybridgen as hg
 from hybridgen.config.material_config import apply_material_config
-from hybridgen.render.albedo_pass import AlbedoPass
+from hybridgen.render.raster.albedo_pass import AlbedoPass
 from tests.conftest import REPO
 
 

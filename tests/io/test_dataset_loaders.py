@@ -213,7 +213,7 @@ def test_front3d_house_rooms_furniture_categories_and_poses(tmp_path, front):
                                                                 ((srgb + 0.055) / 1.055) ** 2.4), atol=1e-6)
     assert lamp.material.base_color_texture.endswith("jid-lamp/texture.png")
     # BlenderProc's make_emissive: the lamp's base color (its texture) emits; ceiling and lamp light the room
-    # but show the camera their surface (render/camera_hidden_emission.py)
+    # but show the camera their surface (render/pathtrace/camera_hidden_emission.py)
     assert lamp.material.emission_texture == lamp.material.base_color_texture
     assert ceiling.material.emission_hidden_from_camera and lamp.material.emission_hidden_from_camera
     assert not wall.material.emission_hidden_from_camera

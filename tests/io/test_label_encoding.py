@@ -144,7 +144,7 @@ def test_same_bytes_twice_whatever_the_thread_count(gl_context, tmp_path):
 
 def test_stereo_passes_decode(gl_context, tmp_path):
     from hybridgen.render.keypoint_loop import StereoProducer, run_keypoints
-    from hybridgen.render.render_labels import LabelProducer
+    from hybridgen.render.raster.label_producer import LabelProducer
 
     scene = _scene()
     request = hg.LabelRequest(distance=True, map_by=["class", "instance"])

@@ -3,12 +3,12 @@ from __future__ import annotations
 
 import pytest
 
-from hybridgen.render.mitsuba_variant import choose_variant, is_jit
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant, is_jit
 
 
 @pytest.fixture
 def jit_variant() -> str:
-    """The Mitsuba variant hybridgen picks here, for tests of its own path tracer (render/clamped_path.py), which
+    """The Mitsuba variant hybridgen picks here, for tests of its own path tracer (render/pathtrace/clamped_path.py), which
     runs in the JIT variants only: skips where the choice is ``scalar_rgb``."""
     chosen = choose_variant(None)
     if not is_jit(chosen):

@@ -6,8 +6,8 @@ import pytest
 import trimesh
 
 import hybridgen as hg
-from hybridgen.render.gl_context import shared_context
-from hybridgen.render.raster import software_renderer
+from hybridgen.render.raster.gl_context import shared_context
+from hybridgen.render.raster.raster_view import software_renderer
 from hybridgen.scene.primitives import make_primitive
 from tests.conftest import camera_at
 
@@ -190,7 +190,7 @@ def test_mirrored_object_transform_keeps_labels(gl_context):
 
 
 def test_egl_device_choice(monkeypatch):
-    from hybridgen.render.gl_context import egl_device_for_cuda, egl_device_index
+    from hybridgen.render.raster.gl_context import egl_device_for_cuda, egl_device_index
 
     monkeypatch.setenv("HYBRIDGEN_EGL_DEVICE", "3")
     assert egl_device_index() == 3 and egl_device_index(1) == 1
@@ -207,7 +207,7 @@ def test_context_asks_for_the_gl_version_it_needs(monkeypatch):
     default, on an H100 with driver 580), where Mesa gives its highest; an older context is refused by name."""
     import moderngl
 
-    from hybridgen.render.gl_context import MIN_GL_VERSION, create_context
+    from hybridgen.render.raster.gl_context import MIN_GL_VERSION, create_context
 
     asked: list[dict[str, object]] = []
 

@@ -13,8 +13,8 @@ import pytest
 
 import hybridgen as hg
 from hybridgen.config.notices import set_sink
-from hybridgen.render.mitsuba_variant import choose_variant
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
 RHO, SUN, L = np.array([0.2, 0.4, 0.6]), 2.0, 1.5
 LOOK_UP = np.array([[1.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 1.0], [0, 0, 0, 1]])    # at z = 1 looking up (+z)

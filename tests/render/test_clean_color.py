@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
-from hybridgen.render.adaptive_sampling import SamplingPlan, automatic_min_samples, dilate, pixel_error
-from hybridgen.render.mitsuba_variant import choose_variant, is_jit
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace.adaptive_sampling import SamplingPlan, automatic_min_samples, dilate, pixel_error
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant, is_jit
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 from hybridgen.render.render_color import ColorProducer
 
 
@@ -142,7 +142,7 @@ def test_denoised_flat_plane_stays_within_one_percent_of_the_analytic_radiance(g
     """A Lambertian plane under a constant sky of radiance L has radiance albedo * L everywhere. At 4 spp the
     raw pixels are off by 6 % on average; denoised, the image mean is within 0.5 % and 90 % of the pixels
     within 1 % (OIDN leaves a little more at the image border, so not every pixel). The border ring itself,
-    denoised with the image mirrored outwards (render/denoise.py), is within 0.8 % on average and every
+    denoised with the image mirrored outwards (render/pathtrace/denoise.py), is within 0.8 % on average and every
     pixel within 5 % (unpadded: 1.4 % and 10 %)."""
     pytest.importorskip("pyoidn")
     albedo, radiance = 0.7, 0.5
@@ -211,7 +211,7 @@ def test_indirect_clamp_is_cycles_sum_rule_and_non_finite_values_count_as_zero(v
         pytest.skip("the clamped integrator needs a JIT variant")
     import mitsuba as mi
 
-    from hybridgen.render import clamped_path
+    from hybridgen.render.pathtrace import clamped_path
 
     mi.set_variant(variant)
     clamped_path.register(variant)
@@ -278,8 +278,8 @@ def test_emitters_are_sampled_in_proportion_to_their_power(variant, monkeypatch)
     samples. The image is the same estimate (unbiased) with less noise than uniform selection. (Measured with
     independent random samples: the default stratified sampler splits a 50/50 choice exactly in half, which
     hides the selection's own noise.)"""
-    from hybridgen.render import light_selection, mitsuba_scene, path_trace
-    from hybridgen.render.mitsuba_variant import activate
+    from hybridgen.render.pathtrace import light_selection, mitsuba_scene, path_trace
+    from hybridgen.render.pathtrace.mitsuba_variant import activate
 
     monkeypatch.setattr(path_trace, "SAMPLER", "independent")
     activate(variant)
@@ -313,8 +313,8 @@ def test_constant_world_is_found_by_bsdf_sampling_only(variant, monkeypatch):
     it in every sample (cosine-weighted BSDF samples, MIS weight 1), on top of the lamp's light; sampled as a
     light, the world also takes most light samples from the lamp (it has the larger power) - much noisier.
     Direct light only; independent samples (see above)."""
-    from hybridgen.render import light_selection, mitsuba_scene, path_trace
-    from hybridgen.render.mitsuba_variant import activate
+    from hybridgen.render.pathtrace import light_selection, mitsuba_scene, path_trace
+    from hybridgen.render.pathtrace.mitsuba_variant import activate
 
     monkeypatch.setattr(path_trace, "SAMPLER", "independent")
     activate(variant)
@@ -394,7 +394,7 @@ def test_scalar_variant_samples_adaptively_through_whole_frames(monkeypatch):
     low-discrepancy sampler takes whole (powers of 4), so the samples traced are the samples counted."""
     import mitsuba as mi
 
-    from hybridgen.render import adaptive_sampling
+    from hybridgen.render.pathtrace import adaptive_sampling
 
     scene = _half_lit_scene()
     # the lit floor is bright (R+G+B ~ 6), where Cycles' error is relative to the intensity itself: at 0.01
@@ -422,7 +422,7 @@ def test_stratified_sampler_launches_whole_patterns(variant):
     """The low-discrepancy sampler takes 4^k-point patterns: a count is traced as whole patterns of up to 1024
     points (a rest of 2 or 3 as half of a 4-point pattern), so any fixed spp works, deterministically and
     unbiased."""
-    from hybridgen.render.adaptive_sampling import launch_counts, pattern_size
+    from hybridgen.render.pathtrace.adaptive_sampling import launch_counts, pattern_size
 
     assert launch_counts(100, "LowDiscrepancySampler") == [64, 16, 16, 4]
     assert launch_counts(7, "LowDiscrepancySampler") == [4, 2, 1]
@@ -432,7 +432,7 @@ def test_stratified_sampler_launches_whole_patterns(variant):
     assert [pattern_size(n, "LowDiscrepancySampler") for n in (1, 2, 16, 32, 512, 1024)] == [4, 4, 16, 64, 1024, 1024]
     import mitsuba as mi
 
-    from hybridgen.render.mitsuba_variant import activate
+    from hybridgen.render.pathtrace.mitsuba_variant import activate
 
     activate(variant)
     for n in (1, 2, 4, 8, 16, 32):  # Mitsuba takes each pattern size as it is (no rounding, no warning)
@@ -460,7 +460,7 @@ def test_denoiser_import_does_not_pull_in_torch():
     import sys
 
     code = ("import sys, numpy as np\n"
-            "from hybridgen.render.denoise import denoise, require_oidn\n"
+            "from hybridgen.render.pathtrace.denoise import denoise, require_oidn\n"
             "require_oidn()\n"
             "assert 'torch' not in sys.modules, 'torch was imported'\n"
             "x = np.full((8, 8, 3), 0.5, np.float32)\n"

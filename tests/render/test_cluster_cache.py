@@ -1,4 +1,4 @@
-"""Triangle clusters built once (hybridgen/render/cluster_cache.py): a memo or disk hit gives exactly what a fresh
+"""Triangle clusters built once (hybridgen/render/raster/cluster_cache.py): a memo or disk hit gives exactly what a fresh
 build gives, content decides (an edited mesh is built again), a damaged entry is a miss, raster threads
 uploading one mesh at once build it once, ``HYBRIDGEN_CACHE_DIR=off`` writes nothing, and the clusters of a
 flat mesh's corner vertices (what the raster view uploads) equal those of its own arrays."""
@@ -9,9 +9,9 @@ import threading
 import numpy as np
 import pytest
 
-from hybridgen.render import cluster_cache
-from hybridgen.render.cluster_cache import mesh_clusters
-from hybridgen.render.triangle_clusters import MIN_TRIANGLES, build_clusters
+from hybridgen.render.raster import cluster_cache
+from hybridgen.render.raster.cluster_cache import mesh_clusters
+from hybridgen.render.raster.triangle_clusters import MIN_TRIANGLES, build_clusters
 from tests.render.test_cluster_culling import _grid
 
 

@@ -1,4 +1,4 @@
-"""Cluster culling (hybridgen/render/triangle_clusters.py) leaves out only triangles that make no fragment: every
+"""Cluster culling (hybridgen/render/raster/triangle_clusters.py) leaves out only triangles that make no fragment: every
 label of a view that culls is bit-identical to one that draws everything - dense closed meshes (back-facing
 clusters), a mirrored placement, an open dense grid partly outside the image, the camera inside a closed mesh's
 box (no back-face culling there) - and the test checks that clusters were really left out."""
@@ -8,8 +8,8 @@ import numpy as np
 import trimesh
 
 import hybridgen as hg
-from hybridgen.render.label_targets import packed_targets
-from hybridgen.render.triangle_clusters import (CLUSTER_TRIANGLES, MIN_TRIANGLES, build_clusters, draw_commands,
+from hybridgen.render.raster.label_targets import packed_targets
+from hybridgen.render.raster.triangle_clusters import (CLUSTER_TRIANGLES, MIN_TRIANGLES, build_clusters, draw_commands,
                                                 visible_clusters)
 
 

@@ -7,8 +7,8 @@ import pytest
 import hybridgen as hg
 from hybridgen.io.memory_sink import MemorySink
 from hybridgen.render.keypoint_loop import baseline_shift
-from hybridgen.render.mitsuba_variant import choose_variant, is_jit
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView, mitsuba_pixel_centre_depth
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant, is_jit
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView, mitsuba_pixel_centre_depth
 from hybridgen.render.render_color import ColorProducer, keypoint_seed, render_color
 from hybridgen.render.tonemap import to_srgb8
 from tests.conftest import silhouette as _silhouette
@@ -165,7 +165,7 @@ def test_path_trace_settings_validation(variant):
     with pytest.raises(hg.InputError, match="glossy_bounces"):
         PathTraceSettings(glossy_bounces=-1)
     if is_jit(variant):  # hybridgen's own path tracer honours per-lobe limits
-        from hybridgen.render.mitsuba_variant import activate
+        from hybridgen.render.pathtrace.mitsuba_variant import activate
 
         activate(variant)
         assert PathTraceSettings(max_bounces=8, glossy_bounces=4).integrator_for(variant)["max_glossy"] == 4
@@ -175,7 +175,7 @@ def test_path_trace_settings_validation(variant):
 
 def test_raster_albedo_matches_mitsuba_albedo_aov(gl_context, variant):
     """The denoiser's guide: our raster albedo (textures included) against Mitsuba's own albedo AOV."""
-    from hybridgen.render.albedo_pass import AlbedoPass
+    from hybridgen.render.raster.albedo_pass import AlbedoPass
     from tests.conftest import REPO
 
     scene = _objects_scene(*ALIGNMENT_CAMERAS["centred"])

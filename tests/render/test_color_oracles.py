@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
-from hybridgen.render.mitsuba_variant import choose_variant
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 from hybridgen.render.tonemap import srgb_encode, to_srgb8
 from tests.io.test_extract import decode_png
 
@@ -118,7 +118,7 @@ def test_emitter_seen_directly_is_emission_times_strength_in_every_output(emitte
     assert code == 0, err
     import mitsuba as mi
 
-    from hybridgen.render.mitsuba_variant import activate
+    from hybridgen.render.pathtrace.mitsuba_variant import activate
 
     activate(choose_variant())
     for i in range(2):

@@ -1,5 +1,5 @@
 """Mitsuba's Python AD integrators are not executed by hybridgen's switch to a JIT variant, and still work
-(hybridgen/render/deferred_ad_integrators.py). Fails loudly when a Mitsuba or Python update makes the switch
+(hybridgen/render/pathtrace/deferred_ad_integrators.py). Fails loudly when a Mitsuba or Python update makes the switch
 execute them again, or when a module registers other plugins than the names read from its source."""
 from __future__ import annotations
 
@@ -9,15 +9,15 @@ import sys
 
 import pytest
 
-from hybridgen.render.deferred_ad_integrators import plugin_names
-from hybridgen.render.mitsuba_variant import available_variants, variant_works
+from hybridgen.render.pathtrace.deferred_ad_integrators import plugin_names
+from hybridgen.render.pathtrace.mitsuba_variant import available_variants, variant_works
 from tests.conftest import REPO
 
 CHILD = """
 import json, sys
 import mitsuba as mi
-from hybridgen.render import deferred_ad_integrators as d
-from hybridgen.render.mitsuba_variant import activate
+from hybridgen.render.pathtrace import deferred_ad_integrators as d
+from hybridgen.render.pathtrace.mitsuba_variant import activate
 
 import pkgutil
 package = sys.modules[d.PACKAGE]

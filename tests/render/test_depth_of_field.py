@@ -9,8 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from hybridgen.render.mitsuba_variant import choose_variant, is_jit
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant, is_jit
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 from hybridgen.scene import Intrinsics, Material, MeshObject, Scene
 from hybridgen.scene.depth_of_field import DepthOfField
 

@@ -1,4 +1,4 @@
-"""The exact-depth label shader (render/face_planes.py: z from the triangle's plane at the pixel centre; the
+"""The exact-depth label shader (render/raster/face_planes.py: z from the triangle's plane at the pixel centre; the
 default on GPUs) against rays written from (u, v, K) on any rasterizer, and against the interpolated depth
 that llvmpipe makes exact to float32: through cluster draws (the plane index is the command's base instance +
 gl_PrimitiveID), flat and smooth meshes, a mirrored copy and the packed targets; and, moving every plane by a
@@ -14,10 +14,10 @@ import pytest
 import hybridgen as hg
 from hybridgen.io.label_encoding import OCTAHEDRAL
 from hybridgen.io.front3d_house import placed_copy
-from hybridgen.render.face_planes import AGREEMENT, face_planes
-from hybridgen.render.raster import software_renderer
-from hybridgen.render.label_targets import packed_targets
-from hybridgen.render.triangle_clusters import MIN_TRIANGLES, draw_commands
+from hybridgen.render.raster.face_planes import AGREEMENT, face_planes
+from hybridgen.render.raster.raster_view import software_renderer
+from hybridgen.render.raster.label_targets import packed_targets
+from hybridgen.render.raster.triangle_clusters import MIN_TRIANGLES, draw_commands
 from tests.render.test_cluster_culling import _grid as cluster_grid
 from tests.render.test_label_oracles import _away_from_silhouettes, _oracle
 from tests.render.test_label_oracles import _scene as _oracle_scene
@@ -78,7 +78,7 @@ def _mixed_scene() -> hg.Scene:
 
 @pytest.mark.parametrize("packed", [False, True])
 def test_exact_depth_equals_the_interpolated_depth_of_llvmpipe(gl_context, packed, monkeypatch):
-    import hybridgen.render.raster as raster
+    import hybridgen.render.raster.raster_view as raster
 
     if not software_renderer(gl_context):  # a GPU's interpolated depth is what exact depth corrects
         pytest.skip("interpolated depth is exact to float32 only on a software rasterizer")
@@ -184,7 +184,7 @@ def test_every_program_reads_its_own_triangles_plane(gl_context, packed, monkeyp
     """With the plane of each face moved along its normal by its own step, the depth is that of its moved
     plane - on any rasterizer, through cluster commands, shared buffers, a mirror, a skewed scale and the
     cut-out program."""
-    import hybridgen.render.raster as raster
+    import hybridgen.render.raster.raster_view as raster
 
     def moved(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
         planes = face_planes(vertices, faces).copy()
@@ -246,7 +246,7 @@ def test_edge_on_triangles_keep_the_interpolated_depth(gl_context):
 
 
 def test_planes_are_kept_per_mesh_content():
-    from hybridgen.render.face_planes import mesh_face_planes
+    from hybridgen.render.raster.face_planes import mesh_face_planes
 
     grid = _grid("g", 6, np.eye(4))
     first = mesh_face_planes(grid.vertices, grid.faces)

@@ -1,4 +1,4 @@
-"""The raster view's framebuffer ring (hybridgen/render/framebuffer_ring.py) and the fenced two-deep pipeline of
+"""The raster view's framebuffer ring (hybridgen/render/raster/framebuffer_ring.py) and the fenced two-deep pipeline of
 RasterView.submit/collect: which framebuffer each slot gets, and that the pipelined readback (fences, the next
 keypoint's framebuffer cleared before the read) gives exactly the values of one keypoint at a time."""
 from __future__ import annotations
@@ -9,9 +9,9 @@ import numpy as np
 
 import hybridgen as hg
 from hybridgen.io.label_encoding import OCTAHEDRAL
-from hybridgen.render.framebuffer_ring import RECENT_SHAPES, FramebufferRing
-from hybridgen.render.label_targets import packed_targets
-from hybridgen.render.raster import software_renderer
+from hybridgen.render.raster.framebuffer_ring import RECENT_SHAPES, FramebufferRing
+from hybridgen.render.raster.label_targets import packed_targets
+from hybridgen.render.raster.raster_view import software_renderer
 from tests.conftest import REPO
 
 

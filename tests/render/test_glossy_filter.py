@@ -1,4 +1,4 @@
-"""Filter glossy (Cycles' blur_glossy, render/glossy_filter.py): glossy lobes roughened after rough bounces."""
+"""Filter glossy (Cycles' blur_glossy, render/pathtrace/glossy_filter.py): glossy lobes roughened after rough bounces."""
 from __future__ import annotations
 
 import math
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
-from hybridgen.render import glossy_filter
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace import glossy_filter
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
 
 def test_roughness_floor_is_cycles_blur(jit_variant):

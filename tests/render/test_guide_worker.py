@@ -1,4 +1,4 @@
-"""The denoiser's guides on a thread of their own (render/guide_worker.py, render/gl_worker.py): the same values as
+"""The denoiser's guides on a thread of their own (render/guide_worker.py, render/raster/gl_worker.py): the same values as
 drawn on the caller's thread, the same denoised bytes as a run that shares the labels' raster view, errors raised
 where the guides are waited for, and guides that follow intrinsics changing between keypoints."""
 from __future__ import annotations
@@ -11,7 +11,7 @@ from hybridgen.io.memory_sink import MemorySink
 from hybridgen.render import guide_worker
 from hybridgen.render.denoise_guides import DenoiseGuides
 from hybridgen.render.guide_worker import GuideWorker
-from hybridgen.render.path_trace import PathTraceSettings
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings
 from hybridgen.render.render_color import ColorProducer, render_color
 from hybridgen.scene.object_keyframes import apply_keypoint
 from tests.render.test_color import ALIGNMENT_CAMERAS, _objects_scene
@@ -110,12 +110,12 @@ def test_guides_follow_intrinsics_that_change_between_keypoints(gl_context):
 
 
 def test_the_denoiser_is_prepared_on_the_guide_thread(gl_context, monkeypatch):
-    """Open Image Denoise's one-time setup (render/denoise.py warm_up) runs on the guide thread, so it overlaps
+    """Open Image Denoise's one-time setup (render/pathtrace/denoise.py warm_up) runs on the guide thread, so it overlaps
     Mitsuba's start; the denoised bytes do not depend on it (tests above: same bytes alone and with labels)."""
     pytest.importorskip("pyoidn")
     import threading
 
-    from hybridgen.render import denoise
+    from hybridgen.render.pathtrace import denoise
 
     names: list[str] = []
     real = denoise.warm_up
@@ -139,7 +139,7 @@ def test_a_job_that_outlives_the_timeout_is_an_error_and_close_does_not_wait_for
     import threading
     import time
 
-    from hybridgen.render.gl_worker import GLWorker
+    from hybridgen.render.raster.gl_worker import GLWorker
 
     release = threading.Event()
     worker: GLWorker = GLWorker(lambda ctx: "built", lambda owned: None, "test-gl-worker", timeout=0.5)

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hybridgen.render.keypoint_frame import present_ids
+from hybridgen.render.raster.keypoint_frame import present_ids
 
 
 @pytest.mark.parametrize("dtype", [np.uint8, np.uint16, np.uint32, np.int32])

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
-from hybridgen.render.mitsuba_variant import choose_variant
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
 
 @pytest.fixture(scope="module")
@@ -73,7 +73,7 @@ def test_spot_light_lights_only_its_cone(variant):
 def test_hdri_world_matches_constant_world(variant, tmp_path):
     import mitsuba as mi
 
-    from hybridgen.render.mitsuba_variant import activate
+    from hybridgen.render.pathtrace.mitsuba_variant import activate
 
     activate(variant)
     path = tmp_path / "sky.exr"

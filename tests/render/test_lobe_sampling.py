@@ -1,4 +1,4 @@
-"""Principled BSDFs choose their specular / diffuse lobe by albedo (render/lobe_sampling.py): rates as documented,
+"""Principled BSDFs choose their specular / diffuse lobe by albedo (render/pathtrace/lobe_sampling.py): rates as documented,
 the same image on average, less noise."""
 from __future__ import annotations
 
@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
-from hybridgen.render import lobe_sampling, mitsuba_materials, path_trace
-from hybridgen.render.mitsuba_variant import choose_variant
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace import lobe_sampling, mitsuba_materials, path_trace
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
 
 def _material(**values: float) -> hg.Material:

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
-from hybridgen.render.mitsuba_scene import JIT_ALIGNMENT, jit_buffer, mesh_shape
-from hybridgen.render.mitsuba_variant import activate, choose_variant
+from hybridgen.render.pathtrace.mitsuba_scene import JIT_ALIGNMENT, jit_buffer, mesh_shape
+from hybridgen.render.pathtrace.mitsuba_variant import activate, choose_variant
 from tests.conftest import REPO
 
 

@@ -6,8 +6,8 @@ import subprocess
 
 import pytest
 
-from hybridgen.render import mitsuba_variant
-from hybridgen.render.mitsuba_variant import PROBE_CACHE, choose_variant, is_jit, probe_key, variant_works
+from hybridgen.render.pathtrace import mitsuba_variant
+from hybridgen.render.pathtrace.mitsuba_variant import PROBE_CACHE, choose_variant, is_jit, probe_key, variant_works
 
 
 @pytest.fixture

@@ -96,9 +96,9 @@ def test_every_requested_key_has_a_catalogue_entry_with_a_layout_and_a_hint():
 
 def test_labels_and_denoising_guides_share_one_raster_view(gl_context, monkeypatch):
     pytest.importorskip("pyoidn")
-    from hybridgen.render import raster
+    from hybridgen.render.raster import raster_view as raster
     from hybridgen.render.denoise_guides import DenoiseGuides
-    from hybridgen.render.path_trace import PathTraceSettings
+    from hybridgen.render.pathtrace.path_trace import PathTraceSettings
     from hybridgen.render.render_color import render_color
 
     scene = _half_hidden_cube()
@@ -152,7 +152,7 @@ def test_a_new_catalogue_entry_is_a_renderer_option_and_a_delivered_pass(gl_cont
 
 def test_silhouettes_drawn_in_their_box_region_equal_full_canvas_draws(gl_context):
     """Only the rectangle an object's box projects to is drawn (a scissor); every pixel equals a full draw."""
-    from hybridgen.render.silhouettes import draw_alone, placement, wide_intrinsics
+    from hybridgen.render.raster.silhouettes import draw_alone, placement, wide_intrinsics
 
     rng = np.random.default_rng(5)
     scene = hg.Scene()
@@ -177,7 +177,7 @@ def test_silhouettes_drawn_in_their_box_region_equal_full_canvas_draws(gl_contex
 
 
 def test_only_the_objects_a_sink_reads_are_drawn_alone(gl_context, monkeypatch):
-    from hybridgen.render import silhouettes
+    from hybridgen.render.raster import silhouettes
 
     scene = _half_hidden_cube()
     cube = scene.by_name("cube").instance_id

@@ -1,4 +1,4 @@
-"""hybridgen's shuffled, Owen-scrambled Sobol sampler (hybridgen/render/owen_sobol.py, the default of the Python
+"""hybridgen's shuffled, Owen-scrambled Sobol sampler (hybridgen/render/pathtrace/owen_sobol.py, the default of the Python
 integrators): every power-of-two prefix of a pattern is stratified, dimension sets are uncorrelated across patterns
 (Mitsuba's ldsampler is not: the bias it caused), and a render keeps the expectation of independent random numbers
 and is deterministic."""
@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
-from hybridgen.render import adaptive_sampling, owen_sobol, path_trace
-from hybridgen.render.mitsuba_variant import activate, choose_variant
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace import adaptive_sampling, owen_sobol, path_trace
+from hybridgen.render.pathtrace.mitsuba_variant import activate, choose_variant
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
 
 def _jit_variant() -> str:
@@ -133,7 +133,7 @@ def test_every_jit_render_draws_owen_sobol_samples_also_without_clamp_and_filter
     """With clamp and filter glossy off the JIT path still runs hybridgen's integrator (Mitsuba's own ``path``
     would draw from the biased ldsampler)."""
     variant = _jit_variant()
-    from hybridgen.render import clamped_path
+    from hybridgen.render.pathtrace import clamped_path
     from tests.render.test_world_guide import _box
 
     settings = PathTraceSettings(samples=4, clamp_indirect=0.0, filter_glossy=0.0)

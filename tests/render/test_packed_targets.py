@@ -1,4 +1,4 @@
-"""Packed label targets (hybridgen/render/label_targets.py): the raster pass writes depth (background filled),
+"""Packed label targets (hybridgen/render/raster/label_targets.py): the raster pass writes depth (background filled),
 octahedral normal codes and narrowed ids itself. Each must equal what the default draw + the CPU encoders give:
 depth and ids bit for bit, normal codes identical to encode_octahedral of the float normals (so the stated
 octahedral bound holds unchanged) - in camera and world axes, with flat (-0.0 components), smooth, cut-out and
@@ -13,8 +13,8 @@ import hybridgen as hg
 from hybridgen.io.label_encoding import NARROWED, OCTAHEDRAL, EncodedArray, encode_octahedral, storage_tag
 from hybridgen.io.memory_sink import MemorySink
 from hybridgen.render.keypoint_loop import _accepted_encodings
-from hybridgen.render.label_targets import LabelTargets, packed_targets, unsigned_target_dtype
-from hybridgen.render.raster import software_renderer
+from hybridgen.render.raster.label_targets import LabelTargets, packed_targets, unsigned_target_dtype
+from hybridgen.render.raster.raster_view import software_renderer
 from tests.conftest import REPO
 
 

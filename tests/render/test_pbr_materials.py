@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
-from hybridgen.render.mitsuba_materials import bsdf_dict
-from hybridgen.render.mitsuba_variant import choose_variant
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace.mitsuba_materials import bsdf_dict
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
 ALBEDO, SUN = 0.5, 3.0
 
@@ -81,7 +81,7 @@ def test_roughness_and_metallic_values_and_maps_become_principled_parameters(var
     valued = bsdf_dict(hg.Material(roughness=0.25, metallic=0.75, specular=0.4), "o")
     principled = valued["material"]
     assert principled["type"] == "principled"
-    # roughness is wrapped for Cycles' filter glossy in the JIT variants (render/glossy_filter.py)
+    # roughness is wrapped for Cycles' filter glossy in the JIT variants (render/pathtrace/glossy_filter.py)
     wrapped = isinstance(principled["roughness"], dict)
     roughness = principled["roughness"]["value"] if wrapped else principled["roughness"]
     assert (roughness, principled["metallic"], principled["specular"]) == (0.25, 0.75, 0.4)

@@ -6,8 +6,8 @@ import pytest
 
 import hybridgen as hg
 from hybridgen.render import pixel_filter
-from hybridgen.render.mitsuba_variant import choose_variant, is_jit
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant, is_jit
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
 
 def test_blackman_harris_window_has_cycles_support_and_shape():

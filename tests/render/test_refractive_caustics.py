@@ -1,10 +1,10 @@
-"""``caustics_refractive`` (Cycles' option; render/clamped_path.py): refraction dropped where a diffuse bounce led."""
+"""``caustics_refractive`` (Cycles' option; render/pathtrace/clamped_path.py): refraction dropped where a diffuse bounce led."""
 from __future__ import annotations
 
 import numpy as np
 
 import hybridgen as hg
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
 
 def _lamp_in_glass() -> hg.Scene:

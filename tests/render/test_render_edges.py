@@ -11,7 +11,7 @@ import pytest
 
 import hybridgen as hg
 from hybridgen.errors import InputError
-from hybridgen.render.projection import near_plane_corner_distance
+from hybridgen.render.raster.projection import near_plane_corner_distance
 
 
 @pytest.mark.parametrize("cx, cy", [(10.0, 25.0), (55.0, 3.0)])
@@ -53,8 +53,8 @@ def _small_scene() -> hg.Scene:
 
 
 def test_stereo_files_have_a_leading_eye_axis_and_a_positive_baseline(gl_context, tmp_path):
-    from hybridgen.render.mitsuba_variant import choose_variant
-    from hybridgen.render.path_trace import PathTraceSettings
+    from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
+    from hybridgen.render.pathtrace.path_trace import PathTraceSettings
     from hybridgen.render.render_color import render_color
 
     scene = _small_scene()
@@ -91,7 +91,7 @@ def test_object_records_reach_the_hdf5_file(gl_context, tmp_path):
 def test_albedo_of_an_in_memory_rgb_texture(gl_context):
     """An (H, W, 3) uint8 texture array is sampled like the same texture with alpha: four colored quadrants on
     a quad filling the view, each quarter of the image showing its quadrant's linear (sRGB-decoded) color."""
-    from hybridgen.render.albedo_pass import AlbedoPass
+    from hybridgen.render.raster.albedo_pass import AlbedoPass
 
     colors = np.array([[[255, 0, 0], [0, 255, 0]], [[0, 0, 255], [255, 255, 255]]], np.uint8)
     texels = np.repeat(np.repeat(colors, 4, axis=0), 4, axis=1)  # 8 x 8: quadrants constant under bilinear
@@ -115,7 +115,7 @@ def test_albedo_of_an_in_memory_rgb_texture(gl_context):
 
 
 def test_albedo_pass_follows_a_change_of_image_size(gl_context):
-    from hybridgen.render.albedo_pass import AlbedoPass
+    from hybridgen.render.raster.albedo_pass import AlbedoPass
 
     scene = _small_scene()
     view = hg.RasterView(scene)

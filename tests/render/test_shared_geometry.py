@@ -9,9 +9,9 @@ import numpy as np
 import hybridgen as hg
 from hybridgen.io.front3d_house import placed_copy
 from hybridgen.render import shared_geometry
-from hybridgen.render.mitsuba_scene import scene_dict
-from hybridgen.render.mitsuba_variant import choose_variant
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace.mitsuba_scene import scene_dict
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
 
 def _scene() -> hg.Scene:
@@ -61,7 +61,7 @@ def test_equal_materials_share_one_bsdf_and_read_textures_once(monkeypatch):
     """Six walls with one ambientCG-like material: its maps are turned into Mitsuba textures once."""
     import mitsuba as mi
 
-    from hybridgen.render import mitsuba_materials
+    from hybridgen.render.pathtrace import mitsuba_materials
 
     mi.set_variant(choose_variant())
 

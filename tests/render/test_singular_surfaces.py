@@ -1,4 +1,4 @@
-"""Singular surfaces as in Cycles (render/clamped_path.py): principled lobes of roughness <= 0.00376 get no
+"""Singular surfaces as in Cycles (render/pathtrace/clamped_path.py): principled lobes of roughness <= 0.00376 get no
 next-event estimation, and light they reflect is found by BSDF sampling at full weight."""
 from __future__ import annotations
 
@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
-from hybridgen.render import clamped_path
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace import clamped_path
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 from hybridgen.scene.material import Material
 
 LOOK_DOWN = np.array([[1.0, 0, 0, 0], [0, -1, 0, 0], [0, 0, -1, 1.0], [0, 0, 0, 1]])  # at z = 1 looking down
@@ -27,7 +27,7 @@ def test_singular_lanes_of_hybridgen_bsdfs(jit_variant):
     import mitsuba as mi
 
     mi.set_variant(jit_variant)
-    from hybridgen.render.mitsuba_materials import bsdf_dict
+    from hybridgen.render.pathtrace.mitsuba_materials import bsdf_dict
 
     materials = [Material(metallic=1.0, roughness=0.0), Material(metallic=1.0, roughness=0.0037),
                  Material(metallic=1.0, roughness=0.004), Material(roughness=0.2, specular=0.5),
@@ -101,7 +101,7 @@ def test_may_be_singular_holds_wherever_a_lane_is_singular(jit_variant):
     import mitsuba as mi
 
     mi.set_variant(jit_variant)
-    from hybridgen.render.mitsuba_materials import bsdf_dict
+    from hybridgen.render.pathtrace.mitsuba_materials import bsdf_dict
 
     materials = _grid_of_materials()
     shapes = {f"s{i}": {"type": "sphere", "center": [3.0 * i, 0, 0], "radius": 1.0, "bsdf": bsdf_dict(m, f"s{i}")}

@@ -14,10 +14,10 @@ import pytest
 
 import hybridgen as hg
 from hybridgen.config.material_config import apply_material_config
-from hybridgen.render.material_emission import srgb_decode
-from hybridgen.render.mitsuba_materials import specular_levels
-from hybridgen.render.mitsuba_variant import choose_variant
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace.material_emission import srgb_decode
+from hybridgen.render.pathtrace.mitsuba_materials import specular_levels
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
 WIDTH, HEIGHT, FOCAL, DISTANCE = 32, 12, 40.0, 3.0
 BLOCK_TEXELS = 4

@@ -1,4 +1,4 @@
-"""Denoising guides through sharp glass and mirrors (hybridgen/render/specular_guides.py), against analytic
+"""Denoising guides through sharp glass and mirrors (hybridgen/render/pathtrace/specular_guides.py), against analytic
 Fresnel values: behind a smooth glass slab or a smooth metal mirror the guide albedo is the plane behind times
 the specular throughput, and the guide normal is that plane's; rough surfaces keep the raster guides bit for bit."""
 from __future__ import annotations
@@ -11,9 +11,9 @@ import pytest
 import hybridgen as hg
 from hybridgen.render.denoise_guides import DEFAULT_FACTOR, DenoiseGuides
 from hybridgen.render.pixel_filter import DEFAULT_WIDTH, filter_supersampled
-from hybridgen.render.mitsuba_variant import choose_variant, is_jit
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
-from hybridgen.render.specular_guides import (SurfaceLobes, can_be_specular_like, dielectric_fresnel, schlick,
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant, is_jit
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace.specular_guides import (SurfaceLobes, can_be_specular_like, dielectric_fresnel, schlick,
                                               split_surface)
 
 TARGET = (0.2, 0.5, 0.7)

@@ -1,5 +1,5 @@
-"""Label keypoints on several raster threads (render/threaded_labels.py) and the GIL-free GL calls
-(render/gl_calls.py): a threaded run gives the sinks the same values, in the same order, as one thread - the
+"""Label keypoints on several raster threads (render/raster/threaded_labels.py) and the GIL-free GL calls
+(render/raster/gl_calls.py): a threaded run gives the sinks the same values, in the same order, as one thread - the
 HDF5 file byte for byte - and a failure on a worker thread surfaces as the same exception, without hanging."""
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ import pytest
 import hybridgen as hg
 from hybridgen.errors import InputError
 from hybridgen.io.memory_sink import MemorySink
-from hybridgen.render.render_labels import LabelProducer, render_labels
-from hybridgen.render.threaded_labels import ThreadedLabelProducer
+from hybridgen.render.raster.render_labels import LabelProducer, render_labels
+from hybridgen.render.raster.threaded_labels import ThreadedLabelProducer
 from tests.render.test_packed_targets import _scene
 
 
@@ -136,7 +136,7 @@ def test_segmap_renderer_render_threads_writes_the_same_datasets(run_cli, tmp_pa
 
 def test_gil_free_calls_give_the_same_readback_as_moderngl(gl_context):
     from hybridgen.io.label_encoding import OCTAHEDRAL
-    from hybridgen.render.label_targets import packed_targets
+    from hybridgen.render.raster.label_targets import packed_targets
 
     scene = _scene()
     free, held = hg.RasterView(scene, ctx=gl_context), hg.RasterView(scene, ctx=gl_context, gil_free=False)
@@ -159,7 +159,7 @@ def test_gil_free_calls_give_the_same_readback_as_moderngl(gl_context):
 
 
 def test_auto_render_threads_rule(monkeypatch):
-    from hybridgen.render.threaded_labels import (AUTO_THREADS_KEYPOINTS, AUTO_THREADS_TRIANGLES,
+    from hybridgen.render.raster.threaded_labels import (AUTO_THREADS_KEYPOINTS, AUTO_THREADS_TRIANGLES,
                                                   auto_render_threads, process_cores)
 
     many, big = AUTO_THREADS_KEYPOINTS, AUTO_THREADS_TRIANGLES
@@ -177,7 +177,7 @@ def test_auto_render_threads_rule(monkeypatch):
 
 def test_segmap_renderer_render_threads_auto_follows_the_triangle_count(run_cli, tmp_path, monkeypatch):
     import hybridgen.modules.segmap_renderer as module
-    import hybridgen.render.threaded_labels as threaded_labels
+    import hybridgen.render.raster.threaded_labels as threaded_labels
     from tests.conftest import REPO
 
     seen: list[int] = []

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
-from hybridgen.render.mitsuba_variant import choose_variant
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
 RHO, SUN = 0.5, 2.0
 LIT = RHO * SUN / math.pi

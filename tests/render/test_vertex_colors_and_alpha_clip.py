@@ -14,9 +14,9 @@ import pytest
 import trimesh
 
 import hybridgen as hg
-from hybridgen.render.albedo_pass import AlbedoPass
-from hybridgen.render.mitsuba_variant import choose_variant
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.raster.albedo_pass import AlbedoPass
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
 RED, BLUE = np.array([0.8, 0.05, 0.05]), np.array([0.05, 0.1, 0.7])
 SUN = 2.0

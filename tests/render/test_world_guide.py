@@ -1,4 +1,4 @@
-"""Light samples of a constant world seen through openings (hybridgen/render/world_guide.py, off by default).
+"""Light samples of a constant world seen through openings (hybridgen/render/pathtrace/world_guide.py, off by default).
 
 A 2 x 2 x 2 m box with a 0.8 x 0.8 m hole in one wall, lit by a point lamp inside and a constant sky outside:
 with the guide on, the image keeps its expectation (independent random numbers, so only the estimator is
@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
-from hybridgen.render import path_trace, world_guide
-from hybridgen.render.mitsuba_variant import choose_variant
-from hybridgen.render.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace import path_trace, world_guide
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
+from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
 
 def _jit_variant() -> str:

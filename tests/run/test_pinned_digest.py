@@ -92,7 +92,7 @@ def _cpu_flags() -> list[str]:
 
 def environment() -> dict[str, object]:
     """What the digests depend on besides hybridgen's own code."""
-    from hybridgen.render.gl_context import shared_context
+    from hybridgen.render.raster.gl_context import shared_context
 
     ctx = shared_context()
     versions = {name: metadata.version(name) for name in

@@ -108,7 +108,7 @@ def test_displaced_plane_depth_and_normals_match_the_height_field(gl_context, di
 def test_trimesh_and_mitsuba_meet_the_displaced_surface_where_the_labels_do(gl_context, displaced):
     import trimesh
 
-    from hybridgen.render.path_trace import PathTraceView, mitsuba_pixel_centre_depth
+    from hybridgen.render.pathtrace.path_trace import PathTraceView, mitsuba_pixel_centre_depth
 
     scene = _scene(displaced)
     depth = hg.RasterView(scene).render(CAM2WORLD, ["depth"])["depth"].astype(np.float64)

@@ -72,11 +72,11 @@ def test_module_closure_follows_relative_lazy_and_parent_imports(tmp_path: Path)
 
 
 def test_estimator_closure_is_the_path_tracer_not_the_rasterizer() -> None:
-    found = module_closure(["hybridgen.render.path_trace", "hybridgen.render.tonemap"])
-    for needed in ("hybridgen.render.path_trace", "hybridgen.render.mitsuba_scene",
-                   "hybridgen.render.adaptive_sampling", "hybridgen.render.tonemap", "hybridgen.scene.material"):
+    found = module_closure(["hybridgen.render.pathtrace.path_trace", "hybridgen.render.tonemap"])
+    for needed in ("hybridgen.render.pathtrace.path_trace", "hybridgen.render.pathtrace.mitsuba_scene",
+                   "hybridgen.render.pathtrace.adaptive_sampling", "hybridgen.render.tonemap", "hybridgen.scene.material"):
         assert needed in found
-    assert "hybridgen.render.raster" not in found and "hybridgen.io.hdf5_single" not in found
+    assert "hybridgen.render.raster.raster_view" not in found and "hybridgen.io.hdf5_single" not in found
     assert estimator_digest() == estimator_digest()
 
 

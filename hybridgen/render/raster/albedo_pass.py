@@ -1,0 +1,144 @@
+"""Diffuse albedo of every pixel centre from the raster view (linear RGB, float32 H x W x 3).
+
+The guide image for denoising, and a label of its own: the material's base color, or its base-color
+texture (decoded from sRGB, bilinear, repeating, as Mitsuba samples it) or the interpolated per-vertex
+colors at the surface point seen through the pixel centre; surfaces of alpha-clipped materials are cut out
+where their alpha is below 0.5. Background pixels get ``background`` (by default the world color).
+Textures and UVs are uploaded on first use only.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ...scene.camera import Intrinsics
+from ...scene.mesh_object import MeshObject
+from .gl_context import compile_program
+from ..material_textures import alpha_coverage
+from .projection import projection_from_K
+from .raster_view import RasterView
+from .shader_source import shader_source
+
+GL_SRGB8_ALPHA8 = 0x8C43
+
+
+def _texture_image(obj: MeshObject) -> np.ndarray | None:
+    texture = obj.material.base_color_texture
+    if texture is None or obj.uvs is None:
+        return None
+    if isinstance(texture, (str,)):
+        from PIL import Image
+
+        from ...io.image_check import check_image_file
+
+        check_image_file(texture, f"object '{obj.name}': texture file")
+        texture = np.asarray(Image.open(texture).convert("RGBA"))
+    image = np.asarray(texture)
+    if image.shape[-1] == 3:
+        image = np.concatenate([image, np.full(image.shape[:2] + (1,), 255, np.uint8)], axis=-1)
+    return np.ascontiguousarray(image[::-1])  # GL rows run bottom-up, like UV v
+
+
+def _alpha_image(obj: MeshObject) -> np.ndarray | None:
+    """The bottom-up uint8 alpha map of a CLIP material (None otherwise, or without UVs)."""
+    material = obj.material
+    if material.alpha_mode != "CLIP" or material.alpha_texture is None or obj.uvs is None:
+        return None
+    return alpha_coverage(material.alpha_texture, obj.name)
+
+
+class AlbedoPass:
+    """Draws the albedo of ``view``'s scene; shares its GL context and vertex buffers."""
+
+    def __init__(self, view: RasterView) -> None:
+        self.view = view
+        ctx = view.ctx
+        self.program = compile_program(ctx, vertex_shader=shader_source("albedo.vert"),
+                                       fragment_shader=shader_source("albedo.frag"))
+        self._draws: list[tuple[Any, Any, Any, MeshObject]] = []
+        self._resources: list[Any] = []
+        for gpu, obj in zip(view.gpu_objects, view.scene.objects):
+            image = _texture_image(obj)
+            texture = alpha = None
+            content = [(gpu.positions, "3f", "in_position")]
+
+            def per_vertex(values: np.ndarray, layout: str, name: str) -> None:
+                buffer = ctx.buffer(np.ascontiguousarray(
+                    values if gpu.vertex_order is None else values[gpu.vertex_order], dtype=np.float32).tobytes())
+                content.append((buffer, layout, name))
+                self._resources.append(buffer)
+
+            alpha_image = _alpha_image(obj)
+            if (image is not None or alpha_image is not None) and obj.uvs is not None:
+                per_vertex(np.asarray(obj.uvs), "2f", "in_uv")
+            if image is not None:
+                texture = ctx.texture((image.shape[1], image.shape[0]), 4, image.tobytes(),
+                                      internal_format=GL_SRGB8_ALPHA8)
+                texture.repeat_x = texture.repeat_y = True
+                self._resources.append(texture)
+            if alpha_image is not None:
+                alpha = ctx.texture((alpha_image.shape[1], alpha_image.shape[0]), 1, alpha_image.tobytes())
+                alpha.repeat_x = alpha.repeat_y = True
+                self._resources.append(alpha)
+            if obj.vertex_colors is not None and obj.material.base_color_from_vertices:
+                per_vertex(obj.vertex_colors, "3f", "in_color")
+            vao = ctx.vertex_array(self.program, content, index_buffer=gpu.indices, index_element_size=4)
+            self._resources.append(vao)
+            self._draws.append((vao, texture, alpha, obj))
+        self._fbos: dict[tuple[int, int], Any] = {}  # one per image size (labels, supersampled guides)
+
+    def render(self, cam2world: np.ndarray, background: tuple[float, float, float] | None = None,
+               intrinsics: Intrinsics | None = None) -> np.ndarray:
+        """(H, W, 3) float32 linear albedo of one keypoint (OpenCV-axes ``cam2world``) with ``intrinsics``
+        (default: the scene camera's)."""
+        import moderngl
+
+        intr = intrinsics or self.view.scene.camera.intrinsics
+        ctx = self.view.ctx
+        size = (intr.width, intr.height)
+        if size not in self._fbos:
+            self._fbos[size] = ctx.framebuffer(color_attachments=[ctx.renderbuffer(size, 4, dtype="f4")],
+                                               depth_attachment=ctx.depth_renderbuffer(size))
+        fbo = self._fbos[size]
+        bg = background if background is not None else self.view.scene.world.color
+        fbo.use()
+        fbo.clear(float(bg[0]), float(bg[1]), float(bg[2]), 1.0, depth=1.0)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.disable(moderngl.CULL_FACE)
+        world2cam = np.linalg.inv(cam2world)
+        self.program["u_projection"].write(projection_from_K(intr.K, intr.width, intr.height, intr.clip_start,
+                                                             intr.clip_end).T.astype(np.float32).tobytes())
+        for vao, texture, alpha, obj in self._draws:
+            material = obj.material
+            self.program["u_modelview"].write((world2cam @ obj.local2world).T.astype(np.float32).tobytes())
+            self.program["u_base_color"].value = tuple(float(c) for c in material.base_color)
+            self.program["u_textured"].value = texture is not None
+            self.program["u_vertex_colored"].value = obj.vertex_colors is not None and \
+                material.base_color_from_vertices
+            self.program["u_alpha_clip"].value = material.alpha_mode == "CLIP"
+            self.program["u_alpha_mapped"].value = alpha is not None
+            self.program["u_alpha"].value = float(material.alpha)
+            if texture is not None:
+                texture.use(0)
+                self.program["u_texture"].value = 0
+            if alpha is not None:
+                alpha.use(1)
+                self.program["u_alpha_texture"].value = 1
+            vao.render()
+        out = np.empty((intr.height, intr.width, 4), dtype=np.float32)
+        fbo.read_into(out, components=4, dtype="f4")
+        return np.ascontiguousarray(out[..., :3])
+
+    def release(self) -> None:
+        for resource in self._resources:
+            resource.release()
+        self._resources = []
+        if self.program is not None:
+            self.program.release()
+            self.program = None
+        for fbo in self._fbos.values():
+            for attachment in (*fbo.color_attachments, fbo.depth_attachment):
+                attachment.release()
+            fbo.release()
+        self._fbos.clear()

@@ -1,0 +1,34 @@
+"""Python API: the label passes of every keypoint, from the raster view, into frame sinks."""
+from __future__ import annotations
+
+from typing import Any, Iterable, Sequence
+
+from ...io.frame_sink import FrameSink
+from ...scene.scene import Scene
+from ..keypoint_loop import ProgressFactory, run_keypoints
+from .label_producer import LabelProducer
+from .label_request import LabelRequest
+from .raster_view import RasterView
+
+__all__ = ["LabelProducer", "render_labels"]  # LabelProducer lives in label_producer; kept importable here
+
+
+def render_labels(scene: Scene, sinks: Iterable[FrameSink], request: LabelRequest | None = None, *,
+                  default_category_id: int | None = None, view: RasterView | None = None,
+                  progress: ProgressFactory | None = None, indices: Sequence[int] | None = None,
+                  render_threads: int = 1) -> int:
+    """Render the label passes of the keypoints ``indices`` (default: all) of ``scene.camera`` into ``sinks``
+    (plus the on-request passes they ask for); returns how many. ``render_threads`` > 1: that many raster
+    threads, each with its own GL context (render/raster/threaded_labels.py; same values, same order; ``view``
+    then unused)."""
+    sinks = list(sinks)
+    request = (request or LabelRequest()).with_sinks(sinks)
+    producer: Any
+    if render_threads > 1:
+        from .threaded_labels import ThreadedLabelProducer
+
+        producer = ThreadedLabelProducer(scene, request, render_threads, producer_class=LabelProducer,
+                                         default_category_id=default_category_id)
+    else:
+        producer = LabelProducer(scene, request, default_category_id=default_category_id, view=view)
+    return run_keypoints(scene, sinks, [producer], progress=progress, what="labels", indices=indices)
