@@ -72,73 +72,17 @@ from __future__ import annotations
 from functools import lru_cache
 from typing import Any
 
-import numpy as np
+from .lobe_tests import SINGULAR_ROUGHNESS, is_singular, may_be_singular, refracts, transmission
+from .path_vertex import LOOP_STATE, loop_state, path_vertex
 
-from ...scene.material import Material
-from . import glossy_filter, transparent_shadows, world_guide
+__all__ = ["CYCLES_CLAMP_SCALE", "PLUGIN_NAME", "SINGULAR_ROUGHNESS", "is_singular", "may_be_singular", "refracts",
+           "register", "transmission"]
 
 PLUGIN_NAME = "hybridgen_clamped_path"
 CYCLES_CLAMP_SCALE = 3.0
 """The clamp is compared with the sum of a contribution's RGB components after multiplying it by this (Cycles'
 ``Integrator::device_update``: ``sample_clamp_indirect * 3.0f``), so a grey contribution is clamped per channel
 at ``clamp_indirect`` itself."""
-SINGULAR_ROUGHNESS = 2e-10 ** 0.25
-"""Principled roughness (Blender's; alpha = roughness^2) at or below which a lobe is singular, as in Cycles:
-``alpha_x alpha_y <= BSDF_ROUGHNESS_SQ_THRESH = 2e-10``, i.e. roughness <= 0.00376."""
-LOOP_STATE = ("active", "bsdf_ctx", "bsdf_delta_prev", "bsdf_pdf_prev", "depth", "diffuse_prev", "eta",
-              "filter_glossy", "guide", "guided_prev", "hidden", "last_segment", "max_depth", "max_diffuse",
-              "max_glossy", "max_transmission", "min_ray_pdf", "mis_weight", "n_diffuse", "n_glossy",
-              "n_transmission", "n_transparent", "radiance", "ray", "rr_depth", "sampler", "scene", "self", "si_prev",
-              "throughput", "transparent", "world_radiance")
-"""The path loop's state (``dr.while_loop`` labels), in the order the body takes and returns it: every name the
-loop reads or writes, sorted, as ``@dr.syntax`` derived it from the former ``while`` loop (``diffuse_prev`` came
-later, for ``caustics_refractive``), so the traced kernels were the ones that loop traced; the explicit loop only saves
-re-parsing this file's source in every process (~0.01 s CPU measured; most of the 0.15 s once blamed on
-``dr.syntax`` was Mitsuba's own AD integrators, see :mod:`hybridgen.render.pathtrace.deferred_ad_integrators`)."""
-
-
-def is_singular(bsdf: Any, si: Any, active: Any = True) -> Any:
-    """Per lane: ``bsdf`` (a Mitsuba BSDF pointer array) is a principled BSDF (also inside ``twosided``) with
-    no diffuse lobe (``metallic`` or ``spec_trans`` 1: metal, glass) and a ``roughness`` of at most
-    :data:`SINGULAR_ROUGHNESS` at ``si``, after the glossy filter's floor in ``si.time``. A principled BSDF with
-    a diffuse lobe keeps next-event estimation (Cycles would evaluate its diffuse closure only; Mitsuba's
-    principled evaluates all lobes together); other BSDFs (diffuse, blends of specular maps) are never
-    singular here."""
-    principled = bsdf.has_attribute("roughness", active) & bsdf.has_attribute("metallic", active)
-    no_diffuse = (bsdf.eval_attribute_1("metallic", si, active) >= 1.0) | \
-        (bsdf.eval_attribute_1("spec_trans", si, active) >= 1.0)
-    return principled & no_diffuse & (bsdf.eval_attribute_1("roughness", si, active) <= SINGULAR_ROUGHNESS)
-
-
-def may_be_singular(material: Material) -> bool:
-    """Whether any point of a surface with ``material`` can be singular (:func:`is_singular`: no diffuse lobe,
-    roughness at most :data:`SINGULAR_ROUGHNESS`): fully metallic or transmissive somewhere (a value of 1 or a
-    metallic map) and that smooth somewhere (a roughness at or below the threshold, or a roughness map). False
-    guarantees that :func:`is_singular` is false on every lane the material's BSDF is hit; True may be
-    conservative. Values are compared as the BSDF holds and the kernel compares them, in float32 (1 - 1e-9 is 1
-    there)."""
-    f32 = np.float32
-    metal_or_glass = f32(material.metallic) >= 1 or material.metallic_texture is not None or \
-        f32(material.transmission) >= 1
-    smooth = f32(material.roughness) <= f32(SINGULAR_ROUGHNESS) or material.roughness_texture is not None
-    return bool(metal_or_glass and smooth)
-
-
-def transmission(flags: Any) -> Any:
-    """Per lane: Mitsuba BSDF ``flags`` (of a BSDF, or of a sample's lobe) include a glossy or sharp transmission
-    lobe - a refraction, which Cycles' transmission bounces count."""
-    import mitsuba as mi
-
-    return mi.has_flag(flags, mi.BSDFFlags.GlossyTransmission) | mi.has_flag(flags, mi.BSDFFlags.DeltaTransmission)
-
-
-def refracts(bsdf: Any, si: Any, wo: Any) -> Any:
-    """Per lane: ``bsdf`` has a glossy or sharp transmission lobe (principled ``spec_trans`` > 0) and the local
-    direction ``wo`` lies on the other side of the surface than ``si.wi``, i.e. light along ``wo`` reaches
-    ``si.wi`` only by refraction."""
-    import mitsuba as mi
-
-    return transmission(bsdf.flags()) & (mi.Frame3f.cos_theta(si.wi) * mi.Frame3f.cos_theta(wo) < 0.0)
 
 
 @lru_cache(maxsize=None)
@@ -196,7 +140,6 @@ def register(variant: str) -> None:
             ifs decided while tracing - there is no branch on a Dr.Jit value, all per-lane choices are masks."""
             mis_weight = self._mis_weight
             transparent = self.transparent_shadows
-            has_hidden = len(self.hidden_shapes) > 0
             hidden = mi.Bool(False)
             n_transparent = mi.UInt32(0)
             bsdf_ctx = mi.BSDFContext()
@@ -210,7 +153,6 @@ def register(variant: str) -> None:
             bsdf_pdf_prev = mi.Float(1.0)
             bsdf_delta_prev = mi.Bool(True)
             diffuse_prev = mi.Bool(False)  # this vertex was reached by a diffuse BSDF sample (Cycles' PATH_RAY_DIFFUSE)
-            no_refractive_caustics = not self.caustics_refractive
             max_depth, rr_depth = mi.UInt32(self.max_depth), mi.UInt32(self.rr_depth)
             big = 2 ** 30
             max_diffuse, max_glossy, max_transmission = (mi.UInt32(big if v < 0 else v) for v in self.limits)
@@ -222,125 +164,8 @@ def register(variant: str) -> None:
             world_radiance = guide.radiance if guide is not None else None
             guided_prev = mi.Bool(False)  # the previous vertex took a guided world sample (MIS for world hits)
 
-            def bounce(active: Any, bsdf_ctx: Any, bsdf_delta_prev: Any, bsdf_pdf_prev: Any, depth: Any,
-                       diffuse_prev: Any, eta: Any, filter_glossy: Any, guide: Any, guided_prev: Any, hidden: Any,
-                       last_segment: Any, max_depth: Any, max_diffuse: Any, max_glossy: Any, max_transmission: Any,
-                       min_ray_pdf: Any, mis_weight: Any, n_diffuse: Any, n_glossy: Any, n_transmission: Any,
-                       n_transparent: Any, radiance: Any, ray: Any, rr_depth: Any, sampler: Any, scene: Any, self: Any,
-                       si_prev: Any,
-                       throughput: Any, transparent: Any, world_radiance: Any) -> tuple[Any, ...]:
-                """One path vertex. Takes and returns the loop state (:data:`LOOP_STATE`, in that order)."""
-                si = scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=depth == 0, active=active)
-                if filter_glossy > 0:  # roughness floor for the wrapped principled roughness (glossy_filter.py)
-                    si.time = glossy_filter.roughness_floor(filter_glossy, min_ray_pdf)
-                bsdf = si.bsdf(ray)
-
-                # Emission found by the previous BSDF sample (or seen directly), MIS-weighted against NEE.
-                ds = mi.DirectionSample3f(scene, si=si, ref=si_prev)
-                em_pdf = scene.pdf_emitter_direction(si_prev, ds, ~bsdf_delta_prev)
-                if guide is not None:  # a world hit: the previous vertex's guided world sample could find it too
-                    em_pdf = dr.select(guided_prev & ~si.is_valid(),
-                                       world_guide.pdf(guide, si_prev.p, ray.d, active), em_pdf)
-                mis_bsdf = dr.select(depth == 0, 1.0, mis_weight(bsdf_pdf_prev, em_pdf))
-                emitted = throughput * mis_bsdf * ds.emitter.eval(si, active)
-                if has_hidden:  # camera rays see such an emitter's BSDF only, other rays its emission only
-                    hidden = self._camera_hidden(si)
-                    emitted = dr.select(hidden & (depth == 0), 0.0, emitted)
-                radiance += self._clamped(emitted, depth >= 2)
-
-                active_next = active & (depth + 1 < max_depth) & si.is_valid() & ~last_segment
-                if has_hidden:
-                    active_next &= ~(hidden & (depth > 0))
-
-                # Singular surfaces (roughness <= SINGULAR_ROUGHNESS after the glossy filter's floor): no NEE.
-                singular = is_singular(bsdf, si, active) if self.singular_surfaces else mi.Bool(False)
-
-                # Next-event estimation: one emitter sample, MIS-weighted against BSDF sampling.
-                active_em = active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth) & ~singular
-                ds_em, em_weight = scene.sample_emitter_direction(si, sampler.next_2d(), False, active_em)
-                active_em &= ds_em.pdf != 0.0
-                wo = si.to_local(ds_em.d)
-                if no_refractive_caustics:  # no light through a refracting surface reached by a diffuse bounce
-                    active_em &= ~(diffuse_prev & refracts(bsdf, si, wo))
-                bsdf_val, bsdf_pdf = bsdf.eval_pdf(bsdf_ctx, si, wo, active_em)
-                # The shadow ray only where the light sample can contribute (module docstring: same values)
-                needs_shadow_ray = active_em & (dr.max(mi.unpolarized_spectrum(bsdf_val)) > 0) & \
-                    (dr.max(mi.unpolarized_spectrum(em_weight)) > 0)
-                if transparent:
-                    em_weight *= transparent_shadows.shadow_transmittance(scene, si, ds_em, needs_shadow_ray)
-                else:
-                    blocked = scene.ray_test(si.spawn_ray_to(ds_em.p), needs_shadow_ray)
-                    em_weight = dr.select(blocked, 0.0, em_weight)
-                mis_em = dr.select(ds_em.delta, 1.0, mis_weight(ds_em.pdf, bsdf_pdf))
-                lit = dr.select(active_em, throughput * bsdf_val * em_weight * mis_em, 0.0)
-                radiance += self._clamped(lit, depth >= 1)
-                if guide is not None:  # one more light sample: the world, in directions learned for this place
-                    active_world = active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth) & ~singular
-                    d_world, pdf_world = world_guide.sample(guide, si.p, sampler.next_1d(), sampler.next_2d(),
-                                                            active_world)
-                    active_world &= ~scene.ray_test(si.spawn_ray(d_world), active_world)
-                    wo_world = si.to_local(d_world)
-                    if no_refractive_caustics:
-                        active_world &= ~(diffuse_prev & refracts(bsdf, si, wo_world))
-                    val_world, pdf_bsdf_world = bsdf.eval_pdf(bsdf_ctx, si, wo_world, active_world)
-                    sky = throughput * val_world * world_radiance * \
-                        (mis_weight(pdf_world, pdf_bsdf_world) / dr.maximum(pdf_world, 1e-20))
-                    radiance += self._clamped(dr.select(active_world, sky, 0.0), depth >= 1)
-                    guided_prev = mi.Bool(active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth) & ~singular)
-
-                # BSDF sampling: the next segment.
-                bsdf_sample, bsdf_weight = bsdf.sample(bsdf_ctx, si, sampler.next_1d(), sampler.next_2d(),
-                                                       active_next)
-                sampled = bsdf_sample.sampled_type
-                transmits = transmission(sampled)
-                glossy = mi.has_flag(sampled, mi.BSDFFlags.GlossyReflection) | \
-                    mi.has_flag(sampled, mi.BSDFFlags.DeltaReflection)
-                diffuse = mi.has_flag(sampled, mi.BSDFFlags.Diffuse)
-                n_diffuse[active_next & diffuse] += 1
-                n_glossy[active_next & glossy] += 1
-                n_transmission[active_next & transmits] += 1
-                last_segment = ((n_diffuse > max_diffuse) | (n_glossy > max_glossy)
-                                | (n_transmission > max_transmission))
-                if no_refractive_caustics:  # a refraction sampled there ends the path, finding nothing
-                    active_next &= ~(diffuse_prev & transmits)
-                ray = si.spawn_ray(si.to_world(bsdf_sample.wo))
-                throughput *= bsdf_weight
-                eta *= bsdf_sample.eta
-                # a null pass (through a transparent texel) keeps the last real vertex's MIS state and bounces
-                null_pass = mi.has_flag(sampled, mi.BSDFFlags.Null) & transparent & si.is_valid()
-                n_transparent[null_pass] += 1
-                last_segment |= n_transparent > transparent_shadows.MAX_TRANSPARENT
-                si_prev = dr.select(null_pass, si_prev, si)
-                diffuse_prev = dr.select(null_pass, diffuse_prev, diffuse)
-                bsdf_pdf_prev = dr.select(null_pass, bsdf_pdf_prev, bsdf_sample.pdf)
-                bsdf_delta_prev = dr.select(null_pass, bsdf_delta_prev,
-                                            mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta) | singular)
-                depth[si.is_valid() & ~null_pass] += 1
-                if filter_glossy > 0:
-                    rough = active_next & ~null_pass & ~mi.has_flag(sampled, mi.BSDFFlags.Delta)
-                    min_ray_pdf = dr.select(rough, dr.minimum(min_ray_pdf, bsdf_sample.pdf), min_ray_pdf)
-
-                # Russian roulette from rr_depth on (survivors are reweighted: unbiased), with Cycles' gentler
-                # continuation probability sqrt(max throughput) (Mitsuba's path: min(throughput eta^2, 0.95)).
-                throughput_max = dr.max(mi.unpolarized_spectrum(throughput))
-                rr_prob = dr.minimum(dr.sqrt(throughput_max), 1.0)
-                rr_active = depth >= rr_depth
-                throughput[rr_active] *= dr.rcp(rr_prob)
-                rr_continue = sampler.next_1d() < rr_prob
-                active = active_next & (~rr_active | rr_continue) & (throughput_max != 0.0)
-                return (active, bsdf_ctx, bsdf_delta_prev, bsdf_pdf_prev, depth, diffuse_prev, eta, filter_glossy,
-                        guide, guided_prev, hidden, last_segment, max_depth, max_diffuse, max_glossy, max_transmission,
-                        min_ray_pdf, mis_weight, n_diffuse, n_glossy, n_transmission, n_transparent, radiance, ray,
-                        rr_depth, sampler, scene, self, si_prev, throughput, transparent, world_radiance)
-
-            assert bounce.__code__.co_varnames[:bounce.__code__.co_argcount] == LOOP_STATE
-            state = dr.while_loop(
-                (active, bsdf_ctx, bsdf_delta_prev, bsdf_pdf_prev, depth, diffuse_prev, eta, filter_glossy, guide,
-                 guided_prev, hidden, last_segment, max_depth, max_diffuse, max_glossy, max_transmission, min_ray_pdf,
-                 mis_weight, n_diffuse, n_glossy, n_transmission, n_transparent, radiance, ray, rr_depth, sampler,
-                 scene, self, si_prev, throughput, transparent, world_radiance),
-                lambda active, *rest: active, bounce, labels=LOOP_STATE, max_iterations=-1,
-                label="hybridgen clamped path")
+            state = dr.while_loop(loop_state(locals()), lambda active, *rest: active, path_vertex,
+                                  labels=LOOP_STATE, max_iterations=-1, label="hybridgen clamped path")
             return state[LOOP_STATE.index("radiance")], mi.Bool(True), []
 
         def aov_names(self) -> list[str]:
