@@ -58,14 +58,18 @@ class BlenderProcHdf5Writer:
 
     def __init__(self, directory: str | Path, options: Hdf5Options | None = None, *, append: bool = False,
                  versions: dict[str, str] | None = None, untrimmed: tuple[str, ...] = (),
-                 stereo_separate_keys: bool = False, dtypes: dict[str, str] | None = None) -> None:
+                 stereo_separate_keys: bool = False, dtypes: dict[str, str] | None = None,
+                 encoded: bool = False) -> None:
         """``options``: compression and level as for ``data.hdf5`` (its ``encoding`` does not apply: this layout
         stores BlenderProc's encodings). BlenderProc 1.x's writer also gives: ``versions`` - a ``<key>_version``
         dataset (a one-element byte-string array) beside each pass, ``versions[key]`` or ``versions["*"]``;
         ``untrimmed`` - keys of single-channel float passes (depth, distance) stored H x W x 3, three equal
         channels, as 1.x stores an EXR pass no ``postprocessing.TrimRedundantChannels`` trimmed;
         ``stereo_separate_keys`` - a stereo pass as ``<key>_0`` (left) and ``<key>_1`` instead of one array
-        with a leading axis of 2; ``dtypes`` - keys stored as another NumPy dtype (1.x's segmap: float64)."""
+        with a leading axis of 2; ``dtypes`` - keys stored as another NumPy dtype (1.x's segmap: float64).
+        ``encoded``: the values are in BlenderProc's encodings already (``bproc.writer.write_hdf5``'s data dict:
+        normals in Blender camera axes, 0.5 n + 0.5) and are stored as given."""
+        self.encoded = encoded
         self.dtypes = {key: np.dtype(name) for key, name in (dtypes or {}).items()}
         self.versions = dict(versions or {})
         self.untrimmed = frozenset(untrimmed)
@@ -114,7 +118,7 @@ class BlenderProcHdf5Writer:
         array = np.asarray(value)
         entry = exact(key)
         renamed_normals = entry is None and layout is not None and layout.frame in ("camera", "world")
-        if renamed_normals or (entry is not None and entry.blenderproc == "blender_half_unit"):
+        if not self.encoded and (renamed_normals or (entry is not None and entry.blenderproc == "blender_half_unit")):
             cam2world = self._records["cam2world"][index]
             frame = layout.frame if layout is not None and layout.frame else "camera"
             array = encode_normals(array, cam2world, frame)
