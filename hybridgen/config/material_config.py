@@ -84,4 +84,5 @@ def apply_material_config(material: Material, config: dict[str, Any]) -> Materia
         values["emission_strength"] = 1.0  # Blender's Emission Strength default, so a given map emits
     if "base_color" in values or values.get("base_color_texture") is not None:
         values["base_color_from_vertices"] = False
+        values["missing_files"] = ()  # the mesh's own base-color files are no longer used
     return dataclasses.replace(material, **values)

@@ -31,7 +31,8 @@ from ..errors import InputError
 from ..scene.frames import Y_UP_TO_Z_UP
 from ..scene.material import Material
 from ..scene.mesh_object import MeshObject
-from .mesh_references import check_references, is_lenient
+from .mesh_references import is_lenient
+from .texture_needs import check_libraries, mark_missing_textures
 
 LOADERS: dict[str, tuple[str, str]] = {
     ".obj": ("obj", "Y"),
@@ -175,7 +176,7 @@ def load_objects(path: str | Path, *, name: str | None = None, category_id: int 
     up = native_up if up_axis == "auto" else str(up_axis).upper()
     if up not in ("Y", "Z"):
         raise InputError(f"up_axis must be 'auto', 'Y' or 'Z', got {up_axis!r}")
-    problem = check_references(file) if file_type == "obj" else None
+    problem = check_libraries(file) if file_type == "obj" else None  # missing textures: texture_needs
     if problem is not None:
         if not is_lenient():
             raise InputError(f"{problem} (hybridgen run --lenient renders it anyway)")
@@ -241,6 +242,8 @@ def load_objects(path: str | Path, *, name: str | None = None, category_id: int 
         except InputError as exc:
             raise InputError(f"mesh '{file}': {exc}") from None
         objects.append(obj)
+    if file_type == "obj":
+        mark_missing_textures(objects, file)  # checked when an output shows base color
     return objects
 
 

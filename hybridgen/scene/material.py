@@ -46,6 +46,9 @@ class Material:
     - ``alpha_mode``: "BLEND" - alpha is a fractional opacity in color, labels see the surface (BlenderProc's
       default, segmentation without ``use_alpha``); "CLIP" - alpha >= 0.5 is opaque, below it the surface is
       cut out of color, albedo and every label (Blender's alpha clip, BlenderProc's ``use_alpha``).
+    - ``missing_files``: the diffuse textures (MTL ``map_Kd``) the mesh file names for this material that do not
+      exist. Only outputs that show base color need them (:mod:`hybridgen.io.texture_needs`); setting
+      ``base_color`` or ``base_color_texture`` through a config clears them.
     """
 
     name: str = "default"
@@ -71,6 +74,7 @@ class Material:
     specular_texture: Any = None
     emission_texture: Any = None  # path or HxWx{3,4} uint8 array, sRGB encoded, like base_color_texture
     emission_hidden_from_camera: bool = False
+    missing_files: tuple[str, ...] = ()  # base-color files the mesh names that do not exist (texture_needs)
     extra: dict[str, Any] = field(default_factory=dict)
 
     @property

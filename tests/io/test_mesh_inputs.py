@@ -1,5 +1,5 @@
 """Silently degraded mesh input made explicit: zero normals recomputed (a notice), missing MTL/texture files
-an error or, with --lenient, a notice."""
+an error (textures: when base color is shown) or, with --lenient, a notice."""
 from __future__ import annotations
 
 import numpy as np
@@ -8,6 +8,7 @@ import pytest
 from hybridgen.errors import InputError
 from hybridgen.io.mesh_loader import load_objects
 from hybridgen.io.mesh_references import LENIENT_ENV
+from hybridgen.io.texture_needs import require_base_colors
 
 
 def test_zero_vertex_normals_are_recomputed_from_faces(tmp_path, notice_lines):
@@ -25,8 +26,11 @@ def test_missing_texture_named_by_an_mtl(tmp_path, notice_lines, monkeypatch):
     (tmp_path / "skin.mtl").write_text("newmtl skin\nKd 1 1 1\nmap_Kd -s 1 1 1 textures/skin.png\n")
     mesh = tmp_path / "thing.obj"
     mesh.write_text("mtllib skin.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl skin\nf 1/1 2/2 3/3\n")
-    with pytest.raises(InputError, match=r"missing file\(s\) it names: '.*textures/skin.png'"):
-        load_objects(mesh)
+    # the mesh loads (labels do not need its texture); showing its base color stops (texture_needs)
+    objects = load_objects(mesh)
+    assert [o.material.missing_files for o in objects] == [(str(tmp_path / "textures/skin.png"),)]
+    with pytest.raises(InputError, match=r"missing file\(s\) it names: '.*textures/skin.png'.*--lenient"):
+        require_base_colors(objects)
     monkeypatch.setenv(LENIENT_ENV, "1")
-    assert len(load_objects(mesh)) == 1
+    require_base_colors(objects)
     assert any("textures/skin.png" in line for line in notice_lines)
