@@ -78,7 +78,29 @@ def _parse_shard(text: str | None) -> tuple[int, int] | None:
     return index, count
 
 
+def _script_arguments(argv: list[str]) -> list[str] | None:
+    """For ``run SCRIPT.py ARGS...``: take everything after the script out of ``argv`` and return it (the script's
+    own arguments, options included, as ``blenderproc run`` passes them); None for any other command line."""
+    commands = [i for i, arg in enumerate(argv) if not arg.startswith("-")]
+    if not commands or argv[commands[0]] != "run" or len(commands) < 2 or not argv[commands[1]].endswith(".py"):
+        return None
+    tail = argv[commands[1] + 1:]
+    del argv[commands[1] + 1:]
+    return tail
+
+
+def _run_script(ns: argparse.Namespace) -> dict[str, Any]:
+    """A BlenderProc 2 script: :func:`hybridgen.bproc.script.run_script` (its own errors: traceback, status 1)."""
+    from .bproc.script import run_script
+
+    seconds = run_script(ns.config, ns.args)
+    _say(ns, f"{ns.config} ran in {seconds:.2f} s")
+    return {"script": str(ns.config), "args": list(ns.args), "seconds": round(seconds, 3)}
+
+
 def _cmd_run(ns: argparse.Namespace) -> dict[str, Any]:
+    if str(ns.config).endswith(".py"):
+        return _run_script(ns)
     from .config.notices import set_strict
     from .io.mesh_references import LENIENT_ENV
     from .run.pipeline import run_config
@@ -204,10 +226,12 @@ def build_parser() -> argparse.ArgumentParser:
     _add_global_options(parser, in_command=False)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    run = _command(sub, "run", _cmd_run, "run a config and write its outputs",
+    run = _command(sub, "run", _cmd_run, "run a config (or a BlenderProc 2 script) and write its outputs",
                    "Run CONFIG; the values after it fill <args:0>, <args:1>, ... in the config.\n"
-                   "Rerunning the same command resumes: complete work units are verified and kept.")
-    run.add_argument("config", help="YAML config file")
+                   "Rerunning the same command resumes: complete work units are verified and kept.\n"
+                   "A .py CONFIG is a BlenderProc 2 script, run as 'blenderproc run main.py ARGS...' runs it:\n"
+                   "everything after it is the script's sys.argv[1:] (docs/blenderproc.md).")
+    run.add_argument("config", help="YAML config file, or a BlenderProc 2 script (.py)")
     run.add_argument("args", nargs="*", help="values for <args:0>, <args:1>, ... (e.g. the output folder)")
     run.add_argument("--lenient", action="store_true", help="render meshes whose MTL or texture files are "
                      "missing (a notice) instead of stopping with an error")
@@ -268,7 +292,11 @@ def _json_line(ns: argparse.Namespace, status: str, started: float, **fields: An
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ns = build_parser().parse_args(list(sys.argv[1:] if argv is None else argv))
+    arguments = list(sys.argv[1:] if argv is None else argv)
+    script_arguments = _script_arguments(arguments)
+    ns = build_parser().parse_args(arguments)
+    if script_arguments is not None:
+        ns.args = script_arguments
     configure(level_for(ns.verbose, ns.quiet))
     started = time.perf_counter()
     try:

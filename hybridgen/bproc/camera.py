@@ -1,0 +1,135 @@
+"""``bproc.camera``: camera poses per frame and intrinsics (BlenderProc's CameraUtility).
+
+Poses are Blender-axes ``cam2world`` 4x4 matrices (x right, y up, looking along -z; metres), keyed per frame
+as BlenderProc keys them: ``add_camera_pose(M)`` without a frame appends one at ``frame_end`` and extends the
+rendered range. Intrinsics are Blender's lens, sensor, resolution, pixel aspect, shift and clip range
+(:mod:`hybridgen.bproc.blender_camera`)."""
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..errors import InputError
+from ..scene.frames import forward_to_rotation_blender
+from .session import SESSION
+from .types.entity import matrix4
+from .types.unsupported import module_getattr
+
+
+def add_camera_pose(cam2world_matrix: Any, frame: int | None = None) -> int:
+    """Key the camera's Blender-axes cam2world at ``frame`` (default: ``frame_end``, a new frame); returns the
+    frame."""
+    pose = matrix4(cam2world_matrix, "cam2world_matrix")
+    if frame is None:
+        frame = SESSION.frame_end
+    frame = int(frame)
+    SESSION.frame_end = max(SESSION.frame_end, frame + 1)
+    SESSION.camera.pose.set(pose, frame)
+    return frame
+
+
+def get_camera_pose(frame: int | None = None) -> np.ndarray:
+    """The Blender-axes cam2world at ``frame`` (None: the current pose)."""
+    return np.array(SESSION.camera.pose.at(frame))
+
+
+def rotation_from_forward_vec(forward_vec: Sequence[float], up_axis: str = "Y",
+                              inplane_rot: float | None = None) -> np.ndarray:
+    """The 3x3 camera rotation (Blender axes) looking along ``forward_vec``, its image up as close to world
+    +Z as possible (Blender's ``to_track_quat('-Z', 'Y')``), then turned by ``inplane_rot`` rad about the view
+    axis."""
+    if str(up_axis).upper() != "Y":
+        raise InputError(f"bproc.camera.rotation_from_forward_vec(up_axis={up_axis!r}) is not supported by "
+                         "hybridgen yet (only 'Y')")
+    forward = np.asarray(forward_vec, dtype=np.float64).reshape(3)
+    if not np.all(np.isfinite(forward)) or not np.any(forward):
+        raise InputError(f"forward_vec must be a finite non-zero 3-vector, got {forward.tolist()}")
+    return forward_to_rotation_blender(forward, float(inplane_rot or 0.0))
+
+
+def set_resolution(image_width: int | None = None, image_height: int | None = None) -> None:
+    """The render resolution in pixels (the lens is kept)."""
+    set_intrinsics_from_blender_params(None, image_width, image_height)
+
+
+def set_intrinsics_from_blender_params(lens: float | None = None, image_width: int | None = None,
+                                       image_height: int | None = None, clip_start: float | None = None,
+                                       clip_end: float | None = None, pixel_aspect_x: float | None = None,
+                                       pixel_aspect_y: float | None = None, shift_x: float | None = None,
+                                       shift_y: float | None = None, lens_unit: str | None = None) -> None:
+    """Blender's camera parameters; ``lens`` is a focal length in mm (``lens_unit`` ``MILLIMETERS``) or a
+    field of view in rad (``FOV``, BlenderProc's default unit)."""
+    camera = SESSION.camera.blender
+    unit = str(lens_unit or camera.lens_unit).upper()
+    if unit not in ("FOV", "MILLIMETERS"):
+        raise InputError(f"no such lens unit: {lens_unit!r} (FOV or MILLIMETERS)")
+    camera.lens_unit = unit
+    if lens is not None:
+        if unit == "MILLIMETERS":
+            if lens < 1:
+                raise InputError(f"the focal length is smaller than 1 mm, which Blender does not allow: {lens}")
+            camera.lens = float(lens)
+        else:
+            camera.set_fov(float(lens))
+    for name, value in (("resolution_x", image_width), ("resolution_y", image_height)):
+        if value is not None:
+            setattr(camera, name, int(value))
+    for name, value in (("clip_start", clip_start), ("clip_end", clip_end), ("pixel_aspect_x", pixel_aspect_x),
+                        ("pixel_aspect_y", pixel_aspect_y), ("shift_x", shift_x), ("shift_y", shift_y)):
+        if value is not None:
+            setattr(camera, name, float(value))
+    camera.intrinsics()  # one line now for values no camera can have
+
+
+def set_intrinsics_from_K_matrix(K: Any, image_width: int, image_height: int, clip_start: float | None = None,
+                                 clip_end: float | None = None) -> None:  # noqa: N802 - BlenderProc's name
+    """Intrinsics from a 3x3 K (px); fx != fy becomes Blender's pixel aspect."""
+    camera = SESSION.camera.blender
+    camera.set_K(np.asarray(K, dtype=np.float64), int(image_width), int(image_height))
+    camera.lens_unit = "MILLIMETERS"
+    set_intrinsics_from_blender_params(clip_start=clip_start, clip_end=clip_end)
+
+
+def get_intrinsics_as_K_matrix() -> np.ndarray:  # noqa: N802
+    """The current 3x3 K (px)."""
+    return SESSION.camera.blender.K()
+
+
+def get_fov() -> tuple[float, float]:
+    """(horizontal, vertical) field of view, rad."""
+    return SESSION.camera.blender.fov()
+
+
+def get_sensor_size(cam: Any = None) -> float:
+    """The sensor side the lens is measured against (mm)."""
+    return SESSION.camera.blender.sensor_size()
+
+
+def get_view_fac_in_px(cam: Any = None, pixel_aspect_x: float | None = None, pixel_aspect_y: float | None = None,
+                       resolution_x_in_px: int | None = None, resolution_y_in_px: int | None = None) -> float:
+    """Pixels the sensor size spans (Blender's sensor fit) for the given or current values."""
+    import copy
+
+    camera = copy.copy(SESSION.camera.blender)
+    for name, value in (("pixel_aspect_x", pixel_aspect_x), ("pixel_aspect_y", pixel_aspect_y),
+                        ("resolution_x", resolution_x_in_px), ("resolution_y", resolution_y_in_px)):
+        if value is not None:
+            setattr(camera, name, value)
+    return camera.view_factor()
+
+
+def set_stereo_parameters(convergence_mode: str, convergence_distance: float, interocular_distance: float) -> None:
+    """Stereo pair settings: ``PARALLEL`` cameras ``interocular_distance`` m apart (the only mode hybridgen
+    renders; BlenderProc's default)."""
+    if str(convergence_mode).upper() != "PARALLEL":
+        raise InputError(f"bproc.camera.set_stereo_parameters(convergence_mode={convergence_mode!r}) is not "
+                         "supported by hybridgen yet (PARALLEL only)")
+    SESSION.camera.interocular_distance = float(interocular_distance)
+
+
+__getattr__ = module_getattr("camera", [
+    "add_depth_of_field", "get_camera_frustum", "get_camera_frustum_as_object", "is_point_inside_camera_frustum",
+    "perform_obstacle_in_view_check", "visible_objects", "scene_coverage_score", "decrease_interest_score",
+    "check_novel_pose", "set_lens_distortion", "set_camera_parameters_from_config_file", "depth_via_raytracing",
+    "depth_at_points_via_raytracing", "pointcloud_from_depth", "project_points", "unproject_points"])

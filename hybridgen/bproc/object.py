@@ -1,0 +1,94 @@
+"""``bproc.object``: the scene's mesh objects, primitives, empties and points of interest (BlenderProc's
+MeshObjectUtility / EntityUtility).
+
+``create_primitive`` makes Blender's primitives with Blender's default sizes (``CUBE``/``PLANE`` ``size`` 2 m,
+``SPHERE`` ``radius`` 1 m, ``CYLINDER``/``CONE`` ``radius`` 1 m and ``depth`` 2 m), flat-shaded and without a
+material slot, as ``bpy.ops.mesh.primitive_*_add`` does. The sphere is hybridgen's icosphere where Blender's
+is a UV sphere (same radius, different facets)."""
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..errors import InputError
+from ..scene.primitives import make_primitive
+from .session import SESSION
+from .types import Entity, MeshObject
+from .types.unsupported import fail, module_getattr
+
+SHAPES = {"CUBE": ("cube", "Cube"), "PLANE": ("plane", "Plane"), "SPHERE": ("sphere", "Sphere"),
+          "CYLINDER": ("cylinder", "Cylinder"), "CONE": ("cone", "Cone")}
+"""BlenderProc shape -> (hybridgen primitive, Blender's object name)."""
+POSE_KEYS = ("location", "rotation", "scale")
+
+
+def create_primitive(shape: str, **kwargs: Any) -> MeshObject:
+    """A new primitive mesh object (see the module documentation); ``location``, ``rotation`` (XYZ Euler, rad)
+    and ``scale`` set its pose."""
+    upper = str(shape).upper()
+    if upper not in SHAPES:
+        fail(f"bproc.object.create_primitive({shape!r})", f"shapes: {', '.join(SHAPES)}")
+    unknown = set(kwargs) - {"size", "radius", "depth", *POSE_KEYS}
+    if unknown:
+        fail(f"bproc.object.create_primitive({upper}, {', '.join(sorted(unknown))}=...)")
+    kind, name = SHAPES[upper]
+    if kind in ("cube", "plane"):
+        size = float(kwargs.get("size", 2.0))
+        part = make_primitive(kind, size)
+    else:
+        radius = float(kwargs.get("radius", 1.0))
+        part = make_primitive(kind, 2 * radius)
+        if kind != "sphere" and "depth" in kwargs:
+            part.vertices = part.vertices * np.array([1.0, 1.0, float(kwargs["depth"]) / (2 * radius)])
+    part.vertex_normals = None  # Blender's primitives are flat-shaded
+    part.__dict__.pop("face_normals", None)
+    obj = MeshObject(name, [part])
+    if "location" in kwargs:
+        obj.set_location(kwargs["location"])
+    if "rotation" in kwargs:
+        obj.set_rotation_euler(kwargs["rotation"])
+    if "scale" in kwargs:
+        obj.set_scale(kwargs["scale"])
+    return obj
+
+
+def get_all_mesh_objects() -> list[MeshObject]:
+    """Every mesh object of the scene, in creation order."""
+    return [e for e in SESSION.entities if isinstance(e, MeshObject)]
+
+
+def convert_to_meshes(blender_objects: Sequence[Any]) -> list[MeshObject]:
+    """The mesh objects among ``blender_objects`` (they already are hybridgen's)."""
+    return [obj for obj in blender_objects if isinstance(obj, MeshObject)]
+
+
+def convert_to_entities(blender_objects: Sequence[Any], convert_to_subclasses: bool = False) -> list[Entity]:
+    return [obj for obj in blender_objects if isinstance(obj, Entity)]
+
+
+def create_empty(entity_name: str, empty_type: str = "plain_axes") -> Entity:
+    """An empty: a named pose without geometry (e.g. a focus point)."""
+    return Entity(entity_name)
+
+
+def delete_multiple(entities: Sequence[Entity], remove_all_offspring: bool = False) -> None:
+    for entity in entities:
+        if entity.is_valid():
+            entity.delete(remove_all_offspring)
+
+
+def compute_poi(objects: Sequence[MeshObject]) -> np.ndarray:
+    """BlenderProc's point of interest (world, m): of the objects' world bound box centres, the one closest to
+    their mean."""
+    if not objects:
+        raise InputError("compute_poi needs at least one object")
+    centres = np.array([obj.get_bound_box().mean(axis=0) for obj in objects])
+    return centres[np.argmin(np.linalg.norm(centres - centres.mean(axis=0), axis=1))]
+
+
+__getattr__ = module_getattr("object", [
+    "extract_floor", "slice_faces_with_normals", "sample_poses", "merge_objects", "replace_objects",
+    "sample_poses_on_surface", "simulate_physics_and_fix_final_poses", "simulate_physics",
+    "create_from_blender_mesh", "create_with_empty_mesh", "disable_all_rigid_bodies",
+    "create_bvh_tree_multi_objects", "scene_ray_cast", "create_from_point_cloud"])

@@ -1,0 +1,179 @@
+"""``bproc.renderer.render()``: every frame of the session rendered through hybridgen's Python API, returned as
+BlenderProc's data dict.
+
+Frames ``frame_start .. frame_end - 1`` are rendered with the camera, object and light values keyed for each
+(:mod:`hybridgen.bproc.session`). Frames whose lights and world agree render as the keypoints of one hybridgen
+scene (objects that move between them through :class:`~hybridgen.scene.object_keyframes.ObjectKeyframes`);
+color with :func:`hybridgen.render_color`, labels alone with :func:`hybridgen.render_labels`.
+
+The result is ``{key: [one value per frame]}`` with BlenderProc's keys, dtypes, axes and encodings, in the order
+the outputs were enabled and ``colors`` (the ``output_key``) last:
+
+- ``colors``: uint8 (H, W, 3), sRGB (hybridgen's Standard view; BlenderProc 2.8's default is Filmic).
+- ``depth``: float32 (H, W), m along the optical axis; background 1e10 (Cycles' Z pass), or with antialiasing
+  the mist range (10000 m) as depth.
+- ``distance``: float32 (H, W), m from the camera centre; background the mist range, or 1e10 as distance.
+- ``normals``: float32 (H, W, 3), Blender camera axes (x right, y up, z backwards), ``0.5 n + 0.5``; 0.5 on the
+  background.
+- ``diffuse``: uint8 (H, W, 3), sRGB diffuse color.
+- segmentation (:mod:`hybridgen.bproc.segmentation`): ``instance_segmaps`` int64, ``<entry>_segmaps``,
+  ``instance_attribute_maps``.
+
+Labels are sampled at pixel centres (no antialiasing), where Cycles' passes average a pixel's samples.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from ..scene.frames import blender_to_opencv
+from ..scene.object_keyframes import ObjectKeyframes
+from .segmentation import map_frame
+from .session import SESSION, current_intrinsics
+from .types import Light, MeshObject
+
+BACKGROUND_DEPTH = 1e10
+"""Cycles' Z pass where a pixel sees no surface (m)."""
+DEFAULT_LOAD_KEYS = {"colors", "distance", "normals", "diffuse", "depth", "segmap"}
+
+
+def _light_state(frame: int) -> tuple[Any, ...]:
+    """What the lights and world show at ``frame`` (frames with equal states share one scene)."""
+    lights = [e for e in SESSION.entities if isinstance(e, Light) and not e.is_hidden()]
+    return tuple((l.get_type(frame), l.get_energy(frame), tuple(l.get_color(frame)), l.get_radius(frame),
+                  l.world_matrix(frame).tobytes()) for l in lights)
+
+
+def _groups(frames: list[int]) -> list[list[int]]:
+    """Runs of consecutive frames with the same light state."""
+    groups: list[list[int]] = []
+    previous = None
+    for frame in frames:
+        state = _light_state(frame)
+        if groups and state == previous:
+            groups[-1].append(frame)
+        else:
+            groups.append([frame])
+        previous = state
+    return groups
+
+
+def _label_request(outputs: dict[str, Any]) -> Any:
+    import hybridgen as hg
+
+    if not outputs:
+        return None
+    return hg.LabelRequest(depth="depth" in outputs or "distance" in outputs, distance="distance" in outputs,
+                           normals="normals" in outputs, map_by=["instance"], albedo="diffuse" in outputs)
+
+
+def _scene(frames: list[int], meshes: list[MeshObject]) -> tuple[Any, np.ndarray]:
+    """The hybridgen scene of ``frames`` (one keypoint per frame) and the instance id -> pass index table."""
+    import hybridgen as hg
+
+    scene = hg.Scene()
+    pairs = []
+    for index, obj in enumerate(meshes):
+        if obj.is_hidden():
+            continue
+        parts = obj.scene_parts(frames[0])
+        pairs.append((obj, parts, [scene.add(part).instance_id for part in parts], index + 1))
+    table = np.zeros(scene._next_id, dtype=np.int64)
+    for _, _, ids, pass_index in pairs:
+        table[ids] = pass_index
+    for light in (e for e in SESSION.entities if isinstance(e, Light) and not e.is_hidden()):
+        scene.add_light(light.scene_light(frames[0]))
+    world = SESSION.world
+    scene.world = hg.World(color=world.color, strength=world.strength, hdri_path=world.hdri_path,
+                           hdri_rotation=world.hdri_rotation)
+    scene.camera.intrinsics = current_intrinsics()
+    for frame in frames:
+        scene.camera.add_keypoint(blender_to_opencv(SESSION.camera.pose.at(frame)))
+    poses = [[obj.world_matrix(frame) for obj, *_ in pairs] for frame in frames]
+    if any(not np.array_equal(a, b) for later in poses[1:] for a, b in zip(poses[0], later)):
+        keyframes = ObjectKeyframes()
+        for keypoint, frame_poses in enumerate(poses):
+            for (_, parts, _, _), pose in zip(pairs, frame_poses):
+                for part in parts:
+                    part.local2world = pose
+            keyframes.record(scene, keypoint)
+        keyframes.apply(scene, 0)
+        scene.object_keyframes = keyframes
+    return scene, table
+
+
+def _render_group(frames: list[int], meshes: list[MeshObject], color: bool) -> list[tuple[dict[str, Any], np.ndarray]]:
+    import hybridgen as hg
+
+    settings = SESSION.renderer
+    request = _label_request(settings.outputs)
+    scene, table = _scene(frames, meshes)
+    sink = hg.MemorySink()
+    if color:
+        trace = hg.PathTraceSettings(samples=settings.samples, noise_threshold=settings.noise_threshold,
+                                     max_bounces=settings.max_bounces, diffuse_bounces=settings.diffuse_bounces,
+                                     glossy_bounces=settings.glossy_bounces,
+                                     transmission_bounces=settings.transmission_bounces)
+        hg.render_color(scene, [sink], trace, labels=request, seed=0, denoise=settings.denoiser is not None)
+    else:
+        hg.render_labels(scene, [sink], request)
+    return [(values, table) for values in sink.frames]
+
+
+def _convert(values: dict[str, Any], table: np.ndarray, cam2world: np.ndarray, meshes: list[MeshObject],
+             ray_lengths: np.ndarray) -> dict[str, Any]:
+    """One frame's hybridgen values -> BlenderProc's keys (by output kind)."""
+    from ..io.hdf5_blenderproc import encode_normals
+    from ..render.tonemap import to_srgb8
+
+    outputs = SESSION.renderer.outputs
+    converted: dict[str, Any] = {}
+    instances = table[np.asarray(values["instance_segmaps"])] if outputs else None
+    background = instances == 0 if instances is not None else None
+    for kind, options in outputs.items():
+        if kind in ("depth", "distance"):
+            image = np.array(values[kind], dtype=np.float32)
+            far = options["distance_max"] if options["antialiasing"] else BACKGROUND_DEPTH
+            far_depth = far / ray_lengths if options["antialiasing"] else np.full_like(ray_lengths, far)
+            image[background] = (far_depth if kind == "depth" else far_depth * ray_lengths)[background]
+            converted[kind] = image
+        elif kind == "normals":
+            normals = encode_normals(values["normals"], blender_to_opencv(cam2world), "camera")
+            normals[background] = 0.5
+            converted[kind] = normals
+        elif kind == "diffuse":
+            converted[kind] = to_srgb8(np.asarray(values["albedo"])[..., :3])
+        elif kind == "segmentation":
+            converted[kind] = map_frame(instances, options["map_by"], options["default_values"], meshes)
+    if "colors" in values:
+        converted["colors"] = np.asarray(values["colors"], dtype=np.uint8)[..., :3]
+    return converted
+
+
+def render_frames(output_key: str | None, load_keys: set[str] | None, return_data: bool) -> dict[str, list[Any]]:
+    """See the module documentation."""
+    frames = list(range(SESSION.frame_start, SESSION.frame_end))
+    if not frames:
+        raise InputError("No camera poses have been registered, therefore nothing can be rendered. A camera pose "
+                         "can be registered via bproc.camera.add_camera_pose().")
+    meshes = [e for e in SESSION.entities if isinstance(e, MeshObject)]
+    if not meshes:
+        raise InputError("There are no mesh-objects to render, please load an object before invoking the renderer.")
+    keys = set(DEFAULT_LOAD_KEYS if load_keys is None else load_keys) | ({output_key} if output_key else set())
+    rendered = [pair for group in _groups(frames) for pair in _render_group(group, meshes, output_key is not None)]
+    ray_lengths = current_intrinsics().pixel_ray_lengths()
+    data: dict[str, list[Any]] = {}
+    for frame, (values, table) in zip(frames, rendered):
+        converted = _convert(values, table, SESSION.camera.pose.at(frame), meshes, ray_lengths)
+        for kind, options in SESSION.renderer.outputs.items():
+            if kind == "segmentation":
+                if "segmap" in keys:
+                    for key, value in converted[kind].items():
+                        data.setdefault(key, []).append(value)
+            elif options["output_key"] in keys:
+                data.setdefault(options["output_key"], []).append(converted[kind])
+        if output_key is not None:
+            data.setdefault(output_key, []).append(converted["colors"])
+    return data if return_data else {}

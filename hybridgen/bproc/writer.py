@@ -1,0 +1,64 @@
+"""``bproc.writer``: BlenderProc's output files from the data dict ``render()`` returns.
+
+``write_hdf5`` writes one ``<output_dir>/<i>.hdf5`` per frame (``i`` = frame, or continuing after the highest
+number already there with ``append_to_existing_output``), each key's value of that frame as a dataset: arrays
+as they are (gzip-compressed, as hybridgen's BlenderProc-layout writer stores them), anything else (dicts,
+lists, numbers) as a JSON byte string, as BlenderProc does (plus hybridgen's ``hybridgen_version``). The files are
+written and renamed by :class:`hybridgen.io.hdf5_blenderproc.BlenderProcHdf5Writer`, so a file exists under
+its final name only when it is complete.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .._version import __version__
+from ..errors import InputError
+from .session import SESSION
+from .types.unsupported import module_getattr
+
+def _json_ready(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, (np.integer, np.floating, np.bool_)):
+        return value.item()
+    if isinstance(value, dict):
+        return {str(k): _json_ready(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_ready(v) for v in value]
+    return value
+
+
+def write_hdf5(output_dir_path: str, output_data_dict: dict[str, Any], append_to_existing_output: bool = False,
+               stereo_separate_keys: bool = False) -> None:
+    """Write ``output_data_dict`` (``{key: [value per frame]}``) as BlenderProc's per-frame HDF5 files."""
+    from ..io.frame_sink import PassLayout
+    from ..io.hdf5_blenderproc import BlenderProcHdf5Writer
+
+    if stereo_separate_keys:
+        raise InputError("bproc.writer.write_hdf5(stereo_separate_keys=True) is not supported by hybridgen yet")
+    count = max((len(v) for v in output_data_dict.values() if isinstance(v, list)), default=0)
+    frames = SESSION.frame_end - SESSION.frame_start
+    if count != frames:
+        raise InputError(f"The amount of images stored in the output_data_dict ({count}) does not correspond with "
+                         f"the amount of images specified by frame_start to frame_end ({frames}).")
+    for key, block in output_data_dict.items():
+        if len(block) < count:
+            raise InputError(f"There are more frames {count} then there are blocks of information {len(block)} in "
+                             f"the given list for key {key}.")
+    json_keys = {key for key, block in output_data_dict.items() if not isinstance(block[0], np.ndarray)}
+    writer = BlenderProcHdf5Writer(output_dir_path, append=append_to_existing_output, encoded=True)
+    writer.offset += SESSION.frame_start
+    try:
+        writer.begin(count, [PassLayout(key, "json", ()) for key in json_keys], {}, {"hybridgen_version": __version__})
+        for index in range(count):
+            writer.write(index, {key: _json_ready(block[index]) if key in json_keys else np.asarray(block[index])
+                                 for key, block in output_data_dict.items()})
+        writer.finalize()
+    except BaseException:
+        writer.abort()
+        raise
+
+
+__getattr__ = module_getattr("writer", ["write_bop", "write_coco_annotations", "write_gif_animation"])
