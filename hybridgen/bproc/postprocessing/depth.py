@@ -30,7 +30,7 @@ def trim_redundant_channels(image: Any) -> Any:
     return image
 
 
-def _is_many(images: Any) -> bool:
+def is_image_list(images: Any) -> bool:
     """Whether ``images`` is a list or a stack (more than two axes) of H x W images."""
     return isinstance(images, list) or (hasattr(images, "shape") and len(images.shape) > 2)
 
@@ -52,7 +52,7 @@ def dist2depth(dist: Any, points_2d: Optional[np.ndarray] = None, *, K: Optional
     ``K`` (hybridgen's addition) defaults to the current camera's intrinsics, as BlenderProc reads them.
     """
     dist = trim_redundant_channels(dist)
-    if _is_many(dist):
+    if is_image_list(dist):
         return [dist2depth(image, K=K) for image in dist]
     if points_2d is None:
         xs, ys = np.meshgrid(np.arange(dist.shape[1]), np.arange(dist.shape[0]))
@@ -66,7 +66,7 @@ def depth2dist(depth: Any, *, K: Optional[Any] = None) -> Any:
     """Distance (m) from depth (m): one H x W image (H x W x 3 copies are trimmed first), or a list or stack of
     them (a list back). ``K`` (hybridgen's addition) defaults to the current camera's intrinsics."""
     depth = trim_redundant_channels(depth)
-    if _is_many(depth):
+    if is_image_list(depth):
         return [depth2dist(image, K=K) for image in depth]
     xs, ys = np.meshgrid(np.arange(depth.shape[1]), np.arange(depth.shape[0]))
     fx, ray = _ray_length_terms(camera_K(K), xs, ys)

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-from .depth import trim_redundant_channels
+from .depth import is_image_list, trim_redundant_channels
 from .opencv import require_cv2
 
 __all__ = ["oil_paint_filter"]
@@ -64,7 +64,7 @@ def oil_paint_filter(image: Any, filter_size: int = 5, edges_only: bool = True, 
             return [oil_paint_filter(element, filter_size, edges_only, rgb) for element in image]
         return _filter_rgb(np.asarray(image), filter_size, edges_only)
     image = trim_redundant_channels(image)
-    if isinstance(image, list) or (hasattr(image, "shape") and len(image.shape) > 2):
+    if is_image_list(image):
         return [oil_paint_filter(element, filter_size, edges_only, rgb) for element in image]
     filtered = stats.mode(np.dstack(_neighbourhood(image, filter_size)), axis=2, keepdims=False).mode
     if not edges_only:

@@ -13,14 +13,12 @@ from typing import Any, Optional
 import numpy as np
 from scipy import ndimage
 
+from .depth import is_image_list
+
 __all__ = ["add_gaussian_shifts", "add_kinect_azure_noise"]
 
 _SUBPIXELS = 32
 """OpenCV 4.10's remap rounds sample positions to 1/32 pixel (``INTER_TAB_SIZE``)."""
-
-
-def _is_many(images: Any) -> bool:
-    return isinstance(images, list) or (hasattr(images, "shape") and len(images.shape) > 2)
 
 
 def _pixels(image: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
@@ -50,7 +48,7 @@ def add_gaussian_shifts(image: Any, std: float = 0.5) -> Any:
     """The H x W depth image(s) resampled at positions shifted by normal noise of ``std`` pixels per axis: one
     ``np.random.normal(0, std, (H, W, 2))`` draw per image (column shift, row shift), positions clamped to
     ``[0, W]`` x ``[0, H]``, bilinear with zeros outside (:func:`remap_linear`). A list or stack gives a list."""
-    if _is_many(image):
+    if is_image_list(image):
         return [add_gaussian_shifts(element, std=std) for element in image]
     rows, cols = image.shape
     shifts = np.random.normal(0, std, size=(rows, cols, 2)).astype(np.float32)
@@ -79,7 +77,7 @@ def add_kinect_azure_noise(depth: Any, color: Optional[Any] = None, missing_dept
     spans more than 0.8 m; and 0 where the RGB ``color`` image is darker than ``missing_depth_darkness_thres``
     (grey value, uint8 scale). A list or stack of depth images (with as many colors) gives a list.
     """
-    if _is_many(depth):
+    if is_image_list(depth):
         colors = [None] * len(depth) if color is None else color
         if len(colors) != len(depth):
             raise ValueError(f"add_kinect_azure_noise: {len(depth)} depth images but {len(colors)} color images")
