@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.hybridgen-installed
 STAMP_TEST := $(VENV)/.hybridgen-test-installed
 PIP    := $(BIN)/python -m pip --disable-pip-version-check
 
-.PHONY: setup setup-test system demo test bench mutate clean
+.PHONY: setup setup-test system demo test bench mutate clean bpy-venv
 
 # `make demo` needs the core dependencies only; `make test` adds the test extras (pytest, Ray, BlenderProc,
 # pycocotools, ... about 1.4 GB).
@@ -54,6 +54,14 @@ mutate: setup-test
 	@test -x $(MUTVENV)/bin/python || $(PYTHON) -m venv $(MUTVENV)
 	$(MUTVENV)/bin/python -m pip --disable-pip-version-check install -q -r tools/mutation/requirements.txt
 	nice -n 15 $(MUTVENV)/bin/python tools/mutation/run_mutation.py --python $(BIN)/python $(MUTATE_ARGS)
+
+# .blend files (loader.BlendLoader, hybridgen.io.blend_loader) are read by Blender's bpy 4.2 in a venv of its own:
+# it needs Python 3.11 and NumPy < 2 (about 1 GB; never a `make test` dependency). HYBRIDGEN_BPY_PYTHON names
+# another Python that has bpy.
+BPY_PYTHON ?= python3.11
+bpy-venv:
+	$(BPY_PYTHON) -m venv .venv-bpy
+	.venv-bpy/bin/python -m pip --disable-pip-version-check install -q bpy==4.2.0 'numpy<2'
 
 clean:
 	rm -rf output .pytest_cache
