@@ -66,10 +66,25 @@ def test_stereo_defaults_read_the_session(monkeypatch: pytest.MonkeyPatch) -> No
     monkeypatch.setitem(sys.modules, "hybridgen.bproc.session", session)
     assert scene_state.stereo_baseline() == 0.2
     assert scene_state.distance_range_end() == 30.0  # Blender's mist default: 5 + 25 m
-    session.SESSION.renderer.outputs["depth"] = {"antialiasing": True, "antialiasing_distance_max": None}
+    session.SESSION.renderer.outputs["depth"] = {"antialiasing": True, "distance_max": None}
     assert scene_state.distance_range_end() == 10000.0
-    session.SESSION.renderer.outputs["distance"] = {"antialiasing": True, "antialiasing_distance_max": 12.5}
+    session.SESSION.renderer.outputs["distance"] = {"antialiasing": True, "distance_max": 12.5}
     assert scene_state.distance_range_end() == 12.5
+
+
+def test_scene_defaults_agree_with_the_bproc_layer() -> None:
+    bproc = pytest.importorskip("hybridgen.bproc")
+    if not hasattr(bproc, "renderer") or not hasattr(bproc, "camera"):
+        pytest.skip("hybridgen.bproc has no renderer/camera module yet")
+    bproc.init()
+    try:
+        bproc.camera.set_intrinsics_from_K_matrix(K, SHAPE[1], SHAPE[0])
+        bproc.camera.set_stereo_parameters("PARALLEL", 0.0, 0.3)
+        bproc.renderer.enable_distance_output(True, antialiasing_distance_max=42.0)
+        np.testing.assert_allclose(pp.dist2depth(_plane_distance(K, 4.0)), 4.0, rtol=1e-9)
+        assert scene_state.stereo_baseline() == 0.3 and scene_state.distance_range_end() == 42.0
+    finally:
+        bproc.init()  # the next test starts from BlenderProc's defaults again
 
 
 def test_trim_redundant_channels_shapes() -> None:

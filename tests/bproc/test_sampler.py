@@ -37,11 +37,13 @@ def test_shape_samplers_draw_what_blenderproc_draws(seed: int) -> None:
         (lambda: sampler.sphere([0, 0, 0], 0.5, "INTERIOR"), lambda: sphere.sphere([0, 0, 0], 0.5, "INTERIOR")),
         (lambda: sampler.part_sphere([0, 0, 1], 3, "SURFACE", dist_above_center=2.5, part_sphere_dir_vector=[1, 1, 0]),
          lambda: part.part_sphere([0, 0, 1], 3, "SURFACE", dist_above_center=2.5, part_sphere_dir_vector=[1, 1, 0])),
-        (lambda: sampler.shell([0, 0, 0], 1, 4, 10, 80, -45, 90), lambda: shell.shell([0, 0, 0], 1, 4, 10, 80, -45, 90)),
+        (lambda: sampler.shell([0, 0, 0], 1, 4, 10, 80, -45, 90),
+         lambda: shell.shell([0, 0, 0], 1, 4, 10, 80, -45, 90)),
         (lambda: sampler.shell([1, 0, 0], 1, 4, 60, 80, 0, 30, uniform_volume=True),
          lambda: shell.shell([1, 0, 0], 1, 4, 60, 80, 0, 30, uniform_volume=True)),
         (lambda: sampler.disk([0, 0, 4], 7, [0.3, 0.2, 0.1]), lambda: disk.disk([0, 0, 4], 7, [0.3, 0.2, 0.1])),
-        (lambda: sampler.disk([0, 0, 4], 7, sample_from="circle"), lambda: disk.disk([0, 0, 4], 7, sample_from="circle")),
+        (lambda: sampler.disk([0, 0, 4], 7, sample_from="circle"),
+         lambda: disk.disk([0, 0, 4], 7, sample_from="circle")),
         (lambda: sampler.disk([0, 0, 0], 2, None, "sector", 100, 130),
          lambda: disk.disk([0, 0, 0], 2, None, "sector", 100, 130)),
         (lambda: sampler.disk([0, 0, 0], 2, [0, 1, 0], "arc", -30, 10),
@@ -204,7 +206,8 @@ def test_room_samplers_are_blenderprocs(tmp_path: Any) -> None:
     heights = tmp_path / "heights.txt"
     heights.write_text("[0.0, 2.5]")
     replica = bproc_reference.sampler("ReplicaPointInRoomSampler")
-    box, floors = {"min": [0, 0, 0], "max": [6, 6, 5]}, [_floor("f", [0, 0, 0], [3, 6, 0]), _floor("g", [3, 0, 0], [4, 6, 0])]
+    box = {"min": [0, 0, 0], "max": [6, 6, 5]}
+    floors = [_floor("f", [0, 0, 0], [3, 6, 0]), _floor("g", [3, 0, 0], [4, 6, 0])]
     ours, theirs = (module.ReplicaPointInRoomSampler(box, floors, str(heights)) for module in (sampler, replica))
     mine, reference = _same_draws(lambda: ours.sample(1.0), lambda: theirs.sample(1.0), 6)
     np.testing.assert_array_equal(mine, reference)

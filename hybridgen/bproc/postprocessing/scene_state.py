@@ -44,12 +44,13 @@ def stereo_baseline() -> float:
 
 def distance_range_end() -> float:
     """Where the distance pass's range ends (m), Blender's ``mist_settings.start + depth``: the
-    ``antialiasing_distance_max`` of an antialiased distance (or depth) output, else Blender's default 30."""
+    ``antialiasing_distance_max`` of an antialiased distance (or depth) output (``hybridgen.bproc.renderer``
+    keeps it as the output's ``distance_max``), else Blender's default 30."""
     from ..session import SESSION
 
     for kind in ("distance", "depth"):
         options = SESSION.renderer.outputs.get(kind) or {}
         if options.get("antialiasing"):
-            value = options.get("antialiasing_distance_max")
+            value = options.get("distance_max")
             return DEFAULT_DISTANCE_MAX if value is None else float(value)
     return BLENDER_MIST_END
