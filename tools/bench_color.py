@@ -2,7 +2,8 @@
 
 Run: .venv/bin/python tools/bench_color.py [--res 640x480] [--spp 64] [--bounces 6] [--no-cycles] [--quick]
      .venv/bin/python tools/bench_color.py --quality [--res 320x240] [--reference-spp 4096] [--scenes a,b]
-         (defaults vs Cycles at BlenderProc's defaults, the issue's settings; see color_quality.py)
+         (defaults vs Cycles at BlenderProc's defaults, the issue's settings: runs tools/bench_color_quality.py
+         with the other options)
 
 Scene: a closed 6 x 6 x 3 m room (floor, four walls, emissive ceiling), 20 primitives and a 100,000-triangle
 torus knot; 8 camera poses inside the room (everything seeded).
@@ -28,13 +29,10 @@ from __future__ import annotations
 import argparse
 import cProfile
 import io
-import json
 import math
 import os
 import pstats
-import shutil
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -43,7 +41,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from default_color_process import LOBES
+from cycles_export import export_for_cycles
+from cycles_worker import CyclesWorker, ensure_bpy_venv
+from harness import Stopwatch, Table, accumulating, alternating, load_average, paired_ratio, rss_mib
 
 REPO = Path(__file__).resolve().parents[1]
 VARIANT = "llvm_ad_rgb"  # hybridgen's automatic choice on a machine without CUDA (checked at run time)
@@ -131,16 +131,6 @@ def bench_scene(width: int, height: int, keypoints: int = 8, seed: int = 7) -> A
 
 
 # ----------------------------------------------------------------------------------------- measuring
-def rss_mib() -> tuple[float, float]:
-    """(current, peak) resident set size of this process, MiB."""
-    values = {}
-    with open("/proc/self/status") as status:
-        for line in status:
-            if line.startswith(("VmRSS:", "VmHWM:")):
-                values[line.split(":")[0]] = int(line.split()[1]) / 1024
-    return values["VmRSS"], values["VmHWM"]
-
-
 class Kernels:
     """Dr.Jit's kernel history between two calls of :meth:`take`: launches, compilations, seconds."""
 
@@ -159,16 +149,6 @@ class Kernels:
                 compiled += 1
                 compile_s += (kernel.get("codegen_time", 0.0) + kernel.get("backend_time", 0.0)) / 1000
         return {"launched": launched, "compiled": compiled, "compile_s": compile_s, "execute_s": execute_s}
-
-
-class Stopwatch:
-    """Wall and CPU seconds of this process (CPU / wall = cores this process got)."""
-
-    def __init__(self) -> None:
-        self.wall, self.cpu = time.perf_counter(), time.process_time()
-
-    def read(self) -> tuple[float, float]:
-        return time.perf_counter() - self.wall, time.process_time() - self.cpu
 
 
 def srgb8(linear: np.ndarray) -> np.ndarray:
@@ -231,121 +211,6 @@ class BareMitsuba:
         return np.array(mi.render(self.scene, spp=self.spp, seed=seed), dtype=np.float32)
 
 
-# -------------------------------------------------------------------------------------------- Cycles
-def ensure_bpy_venv(venv: Path) -> Path | None:
-    """The Python of ``venv`` with bpy; creates the venv (python3 -m venv; pip install bpy 'numpy<2')."""
-    python = venv / "bin" / "python"
-    probe = [str(python), "-c", "import bpy"]
-    if python.exists() and subprocess.run(probe, capture_output=True, check=False).returncode == 0:
-        return python
-    print(f"Cycles: creating {venv} with bpy and numpy<2 (one-off, about 1 GB) ...", flush=True)
-    start = time.perf_counter()
-    interpreter = "python3.11" if shutil.which("python3.11") else "python3"
-    steps = [[interpreter, "-m", "venv", str(venv)],
-             [str(python), "-m", "pip", "install", "-q", "--disable-pip-version-check", "bpy", "numpy<2"]]
-    for step in steps:
-        try:
-            done = subprocess.run(step, capture_output=True, text=True, check=False)
-        except OSError as exc:
-            print(f"Cycles skipped: {' '.join(step[:3])} failed: {exc}")
-            return None
-        if done.returncode != 0:
-            tail = (done.stderr or done.stdout).strip().splitlines()[-3:]
-            print(f"Cycles skipped: `{' '.join(step)}` failed (bpy from PyPI needs Python 3.11):", *tail, sep="\n  ")
-            return None
-    size = subprocess.run(["du", "-sm", str(venv)], capture_output=True, text=True, check=False).stdout.split()[0]
-    print(f"  installed in {time.perf_counter() - start:.0f} s, {size} MiB on disk", flush=True)
-    return python
-
-
-def export_for_cycles(scene: Any, path: Path, spp: int, bounces: int, min_bounces: int,
-                      threads: int | None = None) -> None:
-    """Meshes in world coordinates (with the world-space vertex normals hybridgen gives Mitsuba), materials
-    (base-color textures and UVs included), lights, world (color or HDRI), camera and poses, for
-    tools/cycles_render.py, which renders with ``threads`` CPU threads (default: every core)."""
-    from hybridgen.render.pathtrace.mitsuba_scene import emitted_radiance
-
-    arrays: dict[str, np.ndarray] = {}
-    objects = []
-    for i, obj in enumerate(scene.objects):
-        arrays[f"v{i}"] = obj.world_vertices().astype(np.float32)
-        arrays[f"f{i}"] = obj.faces.astype(np.int32)
-        if obj.vertex_normals is not None:
-            normals = obj.vertex_normals @ np.linalg.inv(obj.local2world[:3, :3])
-            arrays[f"n{i}"] = (normals / np.linalg.norm(normals, axis=1, keepdims=True)).astype(np.float32)
-        m = obj.material
-        if m.base_color_texture is not None and obj.uvs is not None:
-            texture = m.base_color_texture
-            if isinstance(texture, (str, Path)):
-                from PIL import Image
-
-                texture = np.asarray(Image.open(texture).convert("RGB"))
-            arrays[f"tex{i}"] = np.ascontiguousarray(np.asarray(texture)[..., :3], dtype=np.uint8)
-            arrays[f"uv{i}"] = np.asarray(obj.uvs, dtype=np.float32)
-        diffuse = m.specular == 0 and m.metallic == 0 and m.transmission == 0  # as mitsuba_scene.bsdf_dict
-        objects.append({"name": obj.name, "kind": "diffuse" if diffuse else "principled",
-                        "color": [float(c) for c in m.base_color[:3]], "roughness": float(m.roughness),
-                        "metallic": float(m.metallic), "specular": float(m.specular),
-                        "transmission": float(m.transmission), "ior": float(m.ior),
-                        "emission": emitted_radiance(obj).tolist()})
-    lights = [{"type": light.type, "energy": float(light.energy), "color": [float(c) for c in light.color],
-               "radius": float(light.radius), "local2world": np.asarray(light.local2world).tolist()}
-              for light in scene.lights if light.type in ("POINT", "SUN")]
-    world = scene.world
-    intr = scene.camera.intrinsics
-    meta = {"objects": objects, "world": (np.asarray(world.color)[:3] * world.strength).tolist(), "lights": lights,
-            # "rotation": the Z angle of Blender's Mapping node between the world's Generated coordinates and the
-            # Environment Texture (BlenderProc's set_world_background_hdr_img wiring). The node turns the lookup
-            # direction, so the map turns the other way: hybridgen's hdri_rotation (the map turned counter-clockwise
-            # about +Z, README) is the node's minus that angle.
-            "hdri": {"path": str(world.hdri_path), "strength": float(world.strength),
-                     "rotation": -float(world.hdri_rotation)} if world.hdri_path else None,
-            "resolution": [intr.width, intr.height], "K": intr.K.tolist(), "clip": [intr.clip_start, intr.clip_end],
-            "spp": spp, "max_bounces": bounces, "min_bounces": min_bounces, "threads": threads or os.cpu_count() or 2}
-    np.savez(path, meta=np.array(json.dumps(meta)), poses=np.stack(scene.camera.keypoints), **arrays)
-
-
-class CyclesWorker:
-    """tools/cycles_render.py in the bpy venv, rendering one keypoint per request."""
-
-    def __init__(self, python: Path, scene_path: Path) -> None:
-        self.log = scene_path.with_suffix(".log")
-        with open(self.log, "w") as log:  # Blender's own output
-            self.process = subprocess.Popen([str(python), str(REPO / "tools" / "cycles_render.py"), str(scene_path)],
-                                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=log, text=True,
-                                            bufsize=1)
-        self.hello = self._answer()
-        self.peak_rss_mib: float | None = None
-
-    def _answer(self) -> dict[str, Any]:
-        assert self.process.stdout is not None
-        line = self.process.stdout.readline()
-        if not line:
-            tail = self.log.read_text(errors="replace").strip().splitlines()[-5:]
-            raise RuntimeError(f"the Cycles worker stopped (exit code {self.process.wait()}):\n  " + "\n  ".join(tail))
-        return json.loads(line)
-
-    def render(self, index: int, light_tree: bool, seed: int, save: Path | None = None,
-               **extra: Any) -> dict[str, Any]:
-        """``extra``: ``mode`` ("blenderproc" / "reference") and ``spp``, see tools/cycles_render.py."""
-        assert self.process.stdin is not None
-        request = {"index": index, "light_tree": light_tree, "seed": seed, "save": str(save) if save else None,
-                   **extra}
-        self.process.stdin.write(json.dumps(request) + "\n")
-        self.process.stdin.flush()
-        return self._answer()
-
-    def close(self) -> None:
-        if self.process.poll() is None and self.process.stdin is not None:
-            self.process.stdin.write(json.dumps({"quit": True}) + "\n")
-            self.process.stdin.flush()
-            try:
-                self.peak_rss_mib = self._answer().get("peak_rss_mib")
-            except (RuntimeError, ValueError):
-                pass
-            self.process.wait(timeout=60)
-
-
 # ------------------------------------------------------------------------------------ the interleaving
 class TimingSink:
     """A MemorySink that times hybridgen's keypoints and runs the competitors between them.
@@ -399,7 +264,7 @@ def profile_fixed_cost(scene: Any, args: argparse.Namespace, bare_settings: Any)
     Kernels.take()
     for rep in range(3):
         for i, pose in enumerate(poses):
-            for who in ((0, 1) if (rep + i) % 2 == 0 else (1, 0)):
+            for who in alternating((0, 1), rep + i):
                 watch = Stopwatch()
                 if who == 0:
                     producer.produce(i, pose)
@@ -445,40 +310,12 @@ def main() -> None:
     parser.add_argument("--warm-cache", action="store_true",
                         help="use ~/.drjit's kernel cache (default: a fresh one, so keypoint 1 shows compilation)")
     parser.add_argument("--no-profile", action="store_true", help="skip the 1-spp fixed-cost run and profile")
-    parser.add_argument("--quality", action="store_true", help="quality mode (tools/color_quality.py): defaults "
-                        "vs Cycles at BlenderProc's defaults, PSNR against each engine's own reference")
-    parser.add_argument("--reference-spp", type=int, default=4096, help="quality mode: reference spp")
-    parser.add_argument("--hg-threshold", type=float, default=None, help="quality mode: hybridgen's noise "
-                        "threshold (default: its default)")
-    parser.add_argument("--hg-max-samples", type=int, default=None, help="quality mode: hybridgen's maximum "
-                        "samples per pixel, adaptive at its threshold (default: its default)")
-    parser.add_argument("--try-thresholds", type=lambda v: [float(x) for x in v.split(",")], default=[],
-                        help="quality mode: also time hybridgen at these noise thresholds (tuning)")
-    parser.add_argument("--blenderproc-lobes", action="store_true", help="quality mode: hybridgen with "
-                        "BlenderProc's glossy_bounces 0 / transmission_bounces 0, the light paths Cycles renders")
-    parser.add_argument("--lobes", choices=sorted(LOBES), default=None,
-                        help="quality mode: hybridgen's light paths (tools/default_color_process.py LOBES; "
-                        "--blenderproc-lobes is --lobes blenderproc)")
-    parser.add_argument("--scenes", default="", help="quality mode: comma-separated scene names (default all)")
-    parser.add_argument("--out", default=str(REPO / "output" / "bench_color_quality"),
-                        help="quality mode: folder for side-by-side PNGs and the rows (JSON)")
-    parser.add_argument("--threads", type=int, default=2, help="quality mode: CPU threads of both engines "
-                        "(hybridgen: $HYBRIDGEN_THREADS; default 2, the issue's)")
-    parser.add_argument("--warm-runs", type=int, default=1, help="quality mode: timed (warm-cache) hybridgen "
-                        "processes per scene, median (after one cold run)")
-    parser.add_argument("--reference-cache", default=None, help="quality mode: folder of the reference cache "
-                        "(default $HYBRIDGEN_BENCH_CACHE or ~/.cache/hybridgen/bench_color; 'off': none)")
-    parser.add_argument("--precompute", choices=("cycles", "hybridgen", "all"), default=None,
-                        help="quality mode: only render the missing references of these engines into the cache")
+    parser.add_argument("--quality", action="store_true", help="quality mode: runs tools/bench_color_quality.py "
+                        "with the other options (defaults vs Cycles at BlenderProc's defaults; see its --help)")
+    if "--quality" in sys.argv[1:]:  # the quality benchmark is its own tool; this flag keeps its old command
+        rest = [arg for arg in sys.argv[1:] if arg != "--quality"]
+        os.execv(sys.executable, [sys.executable, str(REPO / "tools" / "bench_color_quality.py"), *rest])
     args = parser.parse_args()
-    if args.quality:
-        import color_quality
-
-        python = None if args.no_cycles else ensure_bpy_venv(args.bpy_venv)
-        res = args.res if args.res != "640x480" else "320x240"
-        args.res = res
-        color_quality.print_table(color_quality.run_quality(args, python), args.reference_spp)
-        return
     if args.quick:
         args.res, args.spp, args.no_cycles = "160x120", 8, True
     width, height = (int(v) for v in args.res.lower().split("x"))
@@ -493,14 +330,14 @@ def main() -> None:
     from hybridgen.render.pathtrace.path_trace import PathTraceSettings
     from hybridgen.render.render_color import keypoint_seed, render_color
 
-    load_before = os.getloadavg()
+    load_before = load_average()
     scene = bench_scene(width, height, args.keypoints, seed=7)
     settings = PathTraceSettings(samples=args.spp, max_bounces=args.bounces)
     n = len(scene.camera)
     print(f"scene: room (6 planes) + {len(scene.objects) - 7} primitives + knot ({len(scene.by_name('knot').faces):,} "
           f"triangles): {len(scene.objects)} meshes, {scene.triangle_count:,} triangles; {width}x{height}, {args.spp} spp, "
           f"max_bounces {args.bounces} (Mitsuba max_depth {args.bounces + 2}), {n} keypoints; {os.cpu_count()} cores, "
-          f"load average {load_before[0]:.2f} at start")
+          f"load average {load_before:.2f} at start")
     print(f"Dr.Jit kernel cache: {'~/.drjit (warm)' if args.warm_cache else 'fresh (cold), ' + os.environ['DRJIT_CACHE_DIR']}")
 
     # (b) set up first, so that its venv creation and scene sync do not overlap any timing.
@@ -537,7 +374,7 @@ def main() -> None:
         bare_rows[i] = {"wall": wall, "cpu": cpu, "kernels": Kernels.take(), "rss": rss_mib()}
         if i == 0:
             images["bare"] = srgb8(linear)
-        for tree in (tree_modes if i % 2 == 0 else tree_modes[::-1]):
+        for tree in alternating(tree_modes, i):
             if cycles is not None:
                 save = tmp / "cycles0.png" if i == 0 and tree == tree_modes[0] else None
                 cycles_rows[(i, tree)] = cycles.render(i, tree, keypoint_seed(args.seed, i), save)
@@ -551,17 +388,8 @@ def main() -> None:
     # Time the setup parts hybridgen's render_color goes through (wrappers only; nothing else changes).
     setup_parts = {"variant probe": 0.0, "scene_dict": 0.0}
 
-    def timed(name: str, function: Callable) -> Callable:
-        def wrapper(*a: Any, **k: Any) -> Any:
-            start = time.perf_counter()
-            try:
-                return function(*a, **k)
-            finally:
-                setup_parts[name] += time.perf_counter() - start
-        return wrapper
-
-    mitsuba_variant.variant_works = timed("variant probe", mitsuba_variant.variant_works)
-    path_trace.scene_dict = timed("scene_dict", path_trace.scene_dict)
+    mitsuba_variant.variant_works = accumulating(setup_parts, "variant probe", mitsuba_variant.variant_works)
+    path_trace.scene_dict = accumulating(setup_parts, "scene_dict", path_trace.scene_dict)
     sink = TimingSink(competitors)
     called = time.perf_counter()
     render_color(scene, [sink], settings, seed=args.seed)  # variant: hybridgen's automatic choice
@@ -569,7 +397,7 @@ def main() -> None:
     variant = sink.memory.attributes.get("mitsuba_variant")
     if cycles is not None:
         cycles.close()
-    load_after = os.getloadavg()
+    load_after = load_average()
 
     # ------------------------------------------------------------------------------------ report (a)
     ours_setup = sink.begin_at - called
@@ -582,17 +410,20 @@ def main() -> None:
           f"{sink.setup_kernels['compiled']} kernels compiled), bare {bare.setup_s:.2f} s (scene_dict "
           f"{bare.dict_s:.2f} s, load_dict {bare.setup_s - bare.dict_s:.2f} s; {bare_setup_kernels['compiled']} "
           "kernels compiled, run first)")
-    print(" kp | hybridgen s  cpu/wall  kernels(compiled, compile s)  RSS MiB | bare s  cpu/wall  kernels(compiled, "
-          "compile s)  RSS MiB | ratio")
+    engine_columns = [("s", ">9.3f"), ("cpu/wall", ">8.2f"), ("kernels (compiled, compile s)", ">29"),
+                      ("RSS MiB", ">7.0f")]
+    table = Table([("kp", ">3d"), *[(f"hybridgen {t}", f) for t, f in engine_columns],
+                   *[(f"bare {t}", f) for t, f in engine_columns], ("ratio", ">6.3f")])
+    table.header()
     for i in range(n):
-        o, b = sink.rows[i], bare_rows[i]
-        ko, kb = o["kernels"], b["kernels"]
-        print(f" {i:2d} | {o['wall']:9.3f}   {o['cpu'] / o['wall']:5.2f}     {ko['launched']:2d} ({ko['compiled']}, "
-              f"{ko['compile_s']:5.2f})            {o['rss'][0]:7.0f} | {b['wall']:6.3f}  {b['cpu'] / b['wall']:5.2f}     "
-              f"{kb['launched']:2d} ({kb['compiled']}, {kb['compile_s']:5.2f})            {b['rss'][0]:7.0f} | "
-              f"{o['wall'] / b['wall']:.3f}")
+        cells = []
+        for row in (sink.rows[i], bare_rows[i]):
+            k = row["kernels"]
+            cells += [row["wall"], row["cpu"] / row["wall"], f"{k['launched']:2d} ({k['compiled']}, {k['compile_s']:5.2f})",
+                      row["rss"][0]]
+        table.row(i, *cells, sink.rows[i]["wall"] / bare_rows[i]["wall"])
     steady_ours, steady_bare = statistics.median(ours[1:]), statistics.median(theirs[1:])
-    paired = statistics.median(o / b for o, b in zip(ours[1:], theirs[1:]))
+    paired = paired_ratio(ours[1:], theirs[1:])
     exec_ours = statistics.median(row["kernels"]["execute_s"] for row in sink.rows[1:])
     exec_bare = statistics.median(bare_rows[i]["kernels"]["execute_s"] for i in range(1, n))
     overhead = 100 * (sum(ours) / sum(theirs) - 1)
@@ -622,22 +453,24 @@ def main() -> None:
     if cycles is not None and cycles_rows:
         print(f"\n(b) Blender Cycles {cycles.hello['blender']} on the CPU ({os.cpu_count()} threads, max_bounces "
               f"{args.bounces}, {args.spp} spp, no adaptive sampling, no denoising, persistent data)")
-        header = " kp | hybridgen s | " + " | ".join(f"Cycles light tree {'on ' if t else 'off'} s  cpu/wall  "
-                                                     "hybridgen/Cycles" for t in tree_modes)
-        print(header)
+        table = Table([("kp", ">3d"), ("hybridgen s", ">11.3f"),
+                       *[column for t in tree_modes for column in
+                         ((f"Cycles light tree {'on' if t else 'off'} s", ">22.3f"), ("cpu/wall", ">8.2f"),
+                          ("hybridgen/Cycles", ">16.3f"))]])
+        table.header()
         for i in range(n):
             cells = []
             for tree in tree_modes:
                 row = cycles_rows[(i, tree)]
-                cells.append(f"{row['seconds']:20.3f}  {row['cpu_s'] / row['seconds']:8.2f}  {ours[i] / row['seconds']:16.3f}")
-            print(f" {i:2d} | {ours[i]:11.3f} | " + " | ".join(cells))
+                cells += [row["seconds"], row["cpu_s"] / row["seconds"], ours[i] / row["seconds"]]
+            table.row(i, ours[i], *cells)
         for tree in tree_modes:
             times = [cycles_rows[(i, tree)]["seconds"] for i in range(n)]
             steady = statistics.median(times[1:])
-            per_kp = statistics.median(ours[i] / times[i] for i in range(1, n))
+            per_kp = paired_ratio(ours[1:], times[1:])
             print(f"light tree {'on ' if tree else 'off'}: first {times[0]:.2f} s, steady {steady:.3f} s (median); "
                   f"Mitsuba (hybridgen) / Cycles per keypoint = {per_kp:.2f} (median of keypoints 1..{n - 1}), "
-                  f"bare Mitsuba / Cycles = {statistics.median(theirs[i] / times[i] for i in range(1, n)):.2f}")
+                  f"bare Mitsuba / Cycles = {paired_ratio(theirs[1:], times[1:]):.2f}")
         if cycles.peak_rss_mib:
             print(f"Cycles worker peak RSS {cycles.peak_rss_mib:.0f} MiB")
         if (tmp / "cycles0.png").exists():
@@ -650,7 +483,7 @@ def main() -> None:
 
     if not args.no_profile:
         profile_fixed_cost(scene, args, settings)
-    print(f"\nload average {load_before[0]:.2f} at start, {load_after[0]:.2f} after the timed part (2 cores: above "
+    print(f"\nload average {load_before:.2f} at start, {load_after:.2f} after the timed part (2 cores: above "
           "~2 means other processes competed; see cpu/wall per keypoint)")
 
 

@@ -15,19 +15,15 @@ Run: .venv/bin/python tools/bench_denoise_guides.py [--res 160x120] [--reference
 from __future__ import annotations
 
 import argparse
-import sys
 import tempfile
-import time
 from pathlib import Path
 
+import color_quality as cq
 import numpy as np
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+from harness import Stopwatch
 
 
 def main() -> None:
-    import color_quality as cq
-
     from hybridgen.render.pathtrace.denoise import denoise
     from hybridgen.render.denoise_guides import DenoiseGuides
     from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
@@ -49,7 +45,7 @@ def main() -> None:
             if args.checker_floor:
                 floor = next(obj for obj in scene.objects if obj.name == "floor")
                 floor.material.base_color_texture = cq.checker(256, 16)
-                cq._planar_uvs(floor, 1.0)
+                cq.planar_uvs(floor, 1.0)
             cam = scene.camera.keypoints[0]
             view = PathTraceView(scene, PathTraceSettings())
             references = [to_srgb8(view.render(cam, seed=s, spp=args.reference_spp)).astype(np.float64)
@@ -65,9 +61,9 @@ def main() -> None:
             for seed in range(args.seeds):
                 linear = view.render(cam, seed=seed + 1)
                 for kind, through in (("raster", None), ("traced", view)):
-                    start = time.process_time()
+                    watch = Stopwatch()
                     albedo, normals = guides.render(cam, through)
-                    seconds[kind] += time.process_time() - start
+                    seconds[kind] += watch.read()[1]
                     image = to_srgb8(denoise(linear, albedo, normals)).astype(np.float64)
                     each[kind].append([float(((image - r) ** 2).mean()) for r in references])
                     squared = ((image - reference) ** 2).sum(axis=2)

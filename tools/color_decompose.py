@@ -15,15 +15,17 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
-import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from color_quality import SCENES, build
+from cycles_export import export_for_cycles
+from cycles_worker import CyclesWorker, ensure_bpy_venv
+from harness import Stopwatch
+from image_scores import psnr
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "tools"))
 
 VARIANTS: dict[str, dict[str, Any]] = {
     "default": {},
@@ -45,8 +47,6 @@ def srgb8(linear: np.ndarray) -> np.ndarray:
 
 
 def scores(image: np.ndarray, reference: np.ndarray) -> dict[str, float]:
-    from color_quality import psnr
-
     rel = float(np.mean((image - reference) ** 2 / (reference ** 2 + 1e-2)))
     return {"psnr": round(psnr(srgb8(image), srgb8(reference)), 2), "relmse": rel}
 
@@ -54,10 +54,10 @@ def scores(image: np.ndarray, reference: np.ndarray) -> dict[str, float]:
 def hybridgen_linear(scene: Any, spp: int, seed: int, **settings: Any) -> tuple[np.ndarray, float]:
     from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 
-    cpu = time.process_time()
+    watch = Stopwatch()
     view = PathTraceView(scene, PathTraceSettings(samples=spp, **settings))
     image = view.render(scene.camera.keypoints[0], seed=seed)
-    return image.astype(np.float64), time.process_time() - cpu
+    return image.astype(np.float64), watch.read()[1]
 
 
 def read_exr(path: Path) -> np.ndarray:
@@ -77,15 +77,12 @@ def main() -> None:
     parser.add_argument("--out", default=str(REPO / "output" / "color_decompose"))
     args = parser.parse_args()
 
-    import color_quality
-    from bench_color import CyclesWorker, ensure_bpy_venv, export_for_cycles
-
     width, height = (int(v) for v in args.res.split("x"))
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     python = None if args.no_cycles else ensure_bpy_venv(REPO / ".venv-bpy")
-    for name in args.scenes.split(",") if args.scenes else color_quality.SCENES:
-        scene = color_quality.build(name, width, height, out)
+    for name in args.scenes.split(",") if args.scenes else SCENES:
+        scene = build(name, width, height, out)
         row: dict[str, Any] = {"scene": name, "spp": args.spp}
         for variant in args.variants.split(","):
             settings = VARIANTS[variant]

@@ -16,16 +16,15 @@ The machine's load average is printed at start and end; on a shared machine comp
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import shlex
-import statistics
-import subprocess
 import sys
-import tempfile
 import time
+import tempfile
 from pathlib import Path
 from typing import Any, Sequence
+
+from harness import alternating, load_average, medians, run_process
 
 PHASES = ("wall", "cpu", "start", "build", "render", "after")
 """Per run (s): spawn to exit, CPU (user + system of the child), spawn to ``import hybridgen`` done, the scene
@@ -43,19 +42,13 @@ def run_once(tree: Path, caches: Path, scene: str, resolution: str, png: Path,
     command = [sys.executable, str(tree / "tools" / "default_color_process.py"), scene, resolution, str(png),
                str(caches / "work"), *extra]
     (caches / "work").mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryFile() as output:
-        spawned, start = time.time(), time.perf_counter()
-        child = subprocess.Popen(command, stdout=output, stderr=subprocess.STDOUT, env=env)
-        _, status, usage = os.wait4(child.pid, 0)
-        wall = time.perf_counter() - start
-        output.seek(0)
-        lines = output.read().decode(errors="replace").splitlines()
-    if os.waitstatus_to_exitcode(status) != 0:
-        raise RuntimeError(f"{' '.join(command)} failed:\n" + "\n".join(lines[-8:]))
-    marks = json.loads(next(line for line in reversed(lines) if line.startswith("{")))
-    return {"wall": wall, "cpu": usage.ru_utime + usage.ru_stime, "start": marks["imported"] - spawned,
+    spawned = time.time()
+    finished = run_process(command, env)
+    marks = finished.report
+    assert marks is not None, f"{command[1]} printed no report"
+    return {"wall": finished.wall, "cpu": finished.cpu, "start": marks["imported"] - spawned,
             "build": marks["built"] - marks["imported"], "render": marks["rendered"] - marks["built"],
-            "after": spawned + wall - marks["rendered"]}
+            "after": spawned + finished.wall - marks["rendered"]}
 
 
 def kernel_count(caches: Path) -> int:
@@ -74,15 +67,14 @@ def compare(trees: dict[str, Path], scene: str, resolution: str, runs: int, root
     before = {name: kernel_count(caches[name]) for name in trees}
     timed: dict[str, list[dict[str, float]]] = {name: [] for name in trees}
     for index in range(runs):
-        for name in (list(trees) if index % 2 == 0 else list(trees)[::-1]):
+        for name in alternating(list(trees), index):
             row = run_once(trees[name], caches[name], scene, resolution, pngs[name], extra[name])
             timed[name].append(row)
             print(f"{scene} {name}: " + " ".join(f"{key} {row[key]:.2f}" for key in PHASES), flush=True)
-    medians = {name: {key: statistics.median(row[key] for row in rows) for key in PHASES}
-               for name, rows in timed.items()}
-    return {"scene": scene, "medians": medians,
-            "ratio_wall": medians["new"]["wall"] / medians["base"]["wall"],
-            "ratio_cpu": medians["new"]["cpu"] / medians["base"]["cpu"],
+    middle = {name: medians(rows) for name, rows in timed.items()}
+    return {"scene": scene, "medians": middle,
+            "ratio_wall": middle["new"]["wall"] / middle["base"]["wall"],
+            "ratio_cpu": middle["new"]["cpu"] / middle["base"]["cpu"],
             "same_bytes": pngs["base"].read_bytes() == pngs["new"].read_bytes(),
             "kernels_compiled_in_timed_runs": {name: kernel_count(caches[name]) - before[name] for name in trees}}
 
@@ -99,7 +91,7 @@ def main() -> None:
     args = parser.parse_args()
     extra = {"base": shlex.split(args.base_args), "new": shlex.split(args.new_args)}
     trees = {"base": args.base.resolve(), "new": args.new.resolve()}
-    print(f"load average {os.getloadavg()[0]:.2f} at start; {os.cpu_count()} cores", flush=True)
+    print(f"load average {load_average():.2f} at start; {os.cpu_count()} cores", flush=True)
     with tempfile.TemporaryDirectory(prefix="color_process_ab_") as root:
         for scene in args.scenes.split(","):
             result = compare(trees, scene, args.res, args.runs, Path(root) / scene, extra)
@@ -108,7 +100,7 @@ def main() -> None:
             print(f"{scene} medians of {args.runs}: {line} | new/base wall {result['ratio_wall']:.3f} cpu "
                   f"{result['ratio_cpu']:.3f} | same bytes {result['same_bytes']} | kernels compiled in timed runs "
                   f"{result['kernels_compiled_in_timed_runs']}", flush=True)
-    print(f"load average {os.getloadavg()[0]:.2f} at the end", flush=True)
+    print(f"load average {load_average():.2f} at the end", flush=True)
 
 
 if __name__ == "__main__":

@@ -24,25 +24,23 @@ Numbers are CPU seconds of this process (user + system, both Dr.Jit threads); th
 from __future__ import annotations
 
 import argparse
-import resource
-import sys
 import tempfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-
-REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "tools"))
+from color_lobes import LOBES
+from color_quality import build
+from color_references import CLAMP, SECOND_SEED, References
+from cycles_export import export_for_cycles
+from default_color import default_render
+from harness import Table, cpu_seconds
+from image_scores import db, mse
+from reference_cache import ReferenceCache, cache_root, scene_digest
 
 PATH_CLASSES = {"all paths": {}, "direct only": {"max_bounces": 0}, "no glossy bounce": {"glossy_bounces": 0},
                 "no transmission bounce": {"transmission_bounces": 0}}
 """``--paths``: settings that remove one class of light paths each (PathTraceSettings keywords)."""
-
-
-def cpu_seconds() -> float:
-    usage = resource.getrusage(resource.RUSAGE_SELF)
-    return usage.ru_utime + usage.ru_stime
 
 
 def object_map(scene: Any) -> tuple[np.ndarray, dict[int, str]]:
@@ -62,30 +60,6 @@ def srgb_float(linear: np.ndarray) -> np.ndarray:
     from hybridgen.render.tonemap import srgb_encode
 
     return srgb_encode(linear).astype(np.float64) * 255.0
-
-
-def default_render(scene: Any, settings: Any) -> dict[str, Any]:
-    """The default pipeline's raw and denoised sRGB frames, samples per pixel, sampling and denoising CPU s,
-    and the path-trace view (for further tracing)."""
-    from hybridgen.render.pathtrace.denoise import denoise
-    from hybridgen.render.denoise_guides import DenoiseGuides
-    from hybridgen.render.pathtrace.path_trace import PathTraceView
-    from hybridgen.render.render_color import keypoint_seed
-    from hybridgen.render.tonemap import to_srgb8
-
-    view = PathTraceView(scene, settings)
-    guides = DenoiseGuides(scene, filter_width=view.filter_width)
-    pose = scene.camera.keypoints[0]
-    try:
-        start = cpu_seconds()
-        linear, counts = view.render_with_counts(pose, keypoint_seed(1, 0))
-        traced = cpu_seconds()
-        denoised = denoise(linear, *guides.render(pose, view))
-        done = cpu_seconds()
-    finally:
-        guides.release()
-    return {"raw": to_srgb8(linear), "denoised": to_srgb8(denoised), "counts": counts, "view": view,
-            "trace_cpu": traced - start, "denoise_cpu": done - traced}
 
 
 def sample_cost(view: Any, pixels: np.ndarray, spp: int = 64) -> float:
@@ -109,8 +83,6 @@ def path_variances(scene: Any, base: dict[str, Any], ids: np.ndarray, spp: int) 
 
 
 def main() -> None:
-    from default_color_process import LOBES
-
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenes", default="materials", help="comma-separated scene names of color_quality.py")
     parser.add_argument("--res", default="320x240")
@@ -121,47 +93,43 @@ def main() -> None:
     parser.add_argument("--reference-cache", default=None, help="folder of the reference cache (or 'off')")
     args = parser.parse_args()
 
-    import color_quality as cq
-    import reference_noise as rn
-    from bench_color import export_for_cycles
-    from reference_cache import ReferenceCache, cache_root, scene_digest
-
     from hybridgen.render.pathtrace.path_trace import PathTraceSettings
 
     width, height = (int(v) for v in args.res.lower().split("x"))
     resolution = f"{width}x{height}"
     workdir = Path(tempfile.mkdtemp(prefix="color_regions_"))
-    refs = cq.References(ReferenceCache(cache_root(args.reference_cache)), args.reference_spp, resolution, args.lobes,
+    refs = References(ReferenceCache(cache_root(args.reference_cache)), args.reference_spp, resolution, args.lobes,
                          None, workdir)
     base = {"noise_threshold": args.threshold, **LOBES[args.lobes]}
     for name in args.scenes.split(","):
-        scene = cq.build(name, width, height, workdir)
+        scene = build(name, width, height, workdir)
         npz = workdir / f"{name}.npz"
         export_for_cycles(scene, npz, 1024, 3, 0)
         content = scene_digest(npz)
-        ref1, _ = refs.hybridgen(name, scene, content, cq.CLAMP)
-        ref2 = rn.second_reference(refs, name, scene, content)
+        ref1, _ = refs.hybridgen(name, scene, content, CLAMP)
+        ref2, _ = refs.hybridgen(name, scene, content, CLAMP, seed=SECOND_SEED)
         ids, names = object_map(scene)
         run = default_render(scene, PathTraceSettings(**base))
         counts = run["counts"].ravel()
         ref_noise = ((ref1.astype(np.float64) - ref2) ** 2).mean(axis=2) / 2
-        total = rn.mse(run["denoised"], ref1)
+        total = mse(run["denoised"], ref1)
         print(f"\n{name} {resolution}, lobes {args.lobes}, threshold {args.threshold or 'default'}: "
-              f"{rn.db(total):.2f} dB against the reference ({rn.db(rn.mse(run['denoised'], ref2)):.2f} against the "
+              f"{db(total):.2f} dB against the reference ({db(mse(run['denoised'], ref2)):.2f} against the "
               f"second), image MSE {total:.3f} of which the references' own noise {ref_noise.mean():.3f}; mean spp "
               f"{counts.mean():.0f}, sampling CPU {run['trace_cpu']:.2f} s, guides + denoising "
               f"{run['denoise_cpu']:.2f} s")
-        print("| object | pixels | mean spp | CPU ns/sample | sampling CPU share | own share (raw) | ref share |")
-        print("|---|---|---|---|---|---|---|")
+        table = Table([("object", ""), ("pixels", ".1%"), ("mean spp", ".0f"), ("CPU ns/sample", ".0f"),
+                       ("sampling CPU share", ".0%"), ("own share (raw)", ""), ("ref share", ".0%")], markdown=True)
+        table.header()
         errors = {key: ((run[key].astype(np.float64) - ref1) ** 2).mean(axis=2) for key in ("denoised", "raw")}
         cost = {int(i): sample_cost(run["view"], np.flatnonzero(ids.ravel() == i)) for i in np.unique(ids)}
         spent = {i: cost[i] * counts[ids.ravel() == i].sum() for i in cost}
         for i in np.unique(ids):
             mask = ids == i
             own = {key: float((e - ref_noise)[mask].sum() / e.size) / total for key, e in errors.items()}
-            print(f"| {names.get(int(i), i)} | {mask.mean():.1%} | {counts[mask.ravel()].mean():.0f} | "
-                  f"{cost[int(i)] * 1e9:.0f} | {spent[int(i)] / sum(spent.values()):.0%} | {own['denoised']:.0%} "
-                  f"({own['raw']:.0%}) | {ref_noise[mask].sum() / ref_noise.size / total:.0%} |", flush=True)
+            table.row(str(names.get(int(i), i)), mask.mean(), counts[mask.ravel()].mean(), cost[int(i)] * 1e9,
+                      spent[int(i)] / sum(spent.values()), f"{own['denoised']:.0%} ({own['raw']:.0%})",
+                      ref_noise[mask].sum() / ref_noise.size / total)
         if args.paths:
             table = path_variances(scene, base, ids, args.paths)
             print(f"\nper-pixel variance of raw sRGB values (0..255, two seeds at {args.paths} spp):")

@@ -1,6 +1,6 @@
 """One scene of tools/color_quality.py rendered with hybridgen's default color, as a whole user process.
 
-Run by color_quality.py (``.venv/bin/python tools/default_color_process.py SCENE WxH OUT.png WORKDIR``), which
+Run by tools/bench_color_quality.py and tools/color_process_ab.py (``.venv/bin/python tools/default_color_process.py SCENE WxH OUT.png WORKDIR``), which
 times this process from spawn to exit, wall clock and CPU (its rusage, children included): Python's start,
 ``import hybridgen``, building the scene (meshes read through hybridgen's loaders), Mitsuba's start and the
 variant probe, kernels (from the Dr.Jit cache the parent points ``DRJIT_CACHE_DIR`` at), raster guides, the
@@ -23,16 +23,10 @@ STARTED = time.time()
 
 import argparse  # noqa: E402
 import json  # noqa: E402
-import sys  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
-LOBES: dict[str, dict[str, int | bool]] = {
-    "default": {}, "blenderproc": {"glossy_bounces": 0, "transmission_bounces": 0},
-    "no-refractive-caustics": {"caustics_refractive": False}}
-"""``--lobes``: hybridgen's default light paths; BlenderProc's (glossy and transmission bounces 0: the light
-paths Cycles renders at BlenderProc's defaults); or hybridgen's without refraction after a diffuse bounce
-(``caustics_refractive: false``)."""
+from color_lobes import LOBES  # noqa: E402  (imports nothing: the startup phase stays Python's own)
 
 
 def main() -> None:
@@ -54,7 +48,6 @@ def main() -> None:
     import hybridgen as hg
 
     marks["imported"] = time.time()
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
     import color_quality
 
     width, height = (int(v) for v in args.res.lower().split("x"))

@@ -135,7 +135,7 @@ def estimator_digest() -> str:
 
 
 def scene_digest(npz: Path) -> str:
-    """Digest of a scene exported for Cycles (bench_color.export_for_cycles): every array, and the metadata
+    """Digest of a scene exported for Cycles (tools/cycles_export.py): every array, and the metadata
     with the HDRI's path replaced by its bytes' digest and the worker's thread count and default spp left
     out (neither changes a reference image)."""
     data = np.load(npz, allow_pickle=False)

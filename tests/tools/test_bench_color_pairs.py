@@ -1,4 +1,4 @@
-"""tools/color_quality.py's timing: Cycles' timed renders interleave with hybridgen's warm runs (ABBA) and the
+"""tools/bench_color_quality.py's timing: Cycles' timed renders interleave with hybridgen's warm runs (ABBA) and the
 reported ratios are the medians of the pairs' ratios, each pair's hybridgen run divided by its own Cycles render."""
 from __future__ import annotations
 
@@ -14,11 +14,10 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture
-def color_quality(monkeypatch: pytest.MonkeyPatch) -> Any:
-    monkeypatch.syspath_prepend(str(REPO / "tools"))  # the tools import each other as top-level modules
-    import color_quality
+def color_quality() -> Any:
+    import bench_color_quality  # tools/ is on sys.path (tests/tools/conftest.py)
 
-    return color_quality
+    return bench_color_quality
 
 
 def _png(path: Path, value: int) -> None:

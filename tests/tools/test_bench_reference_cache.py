@@ -81,7 +81,7 @@ def test_estimator_closure_is_the_path_tracer_not_the_rasterizer() -> None:
 
 
 def _export(folder: Path, vertices: np.ndarray, threads: int) -> Path:
-    """A minimal export in bench_color.export_for_cycles' layout, with an HDRI file in ``folder``."""
+    """A minimal export in cycles_export.export_for_cycles' layout, with an HDRI file in ``folder``."""
     folder.mkdir()
     (folder / "sky.exr").write_bytes(b"sky pixels")
     meta = {"objects": [{"name": "floor"}], "hdri": {"path": str(folder / "sky.exr"), "strength": 1.0},
@@ -139,13 +139,14 @@ def test_disabled_cache_always_renders(tmp_path: Path, monkeypatch: pytest.Monke
 
 
 def test_whole_process_timing_counts_the_child_and_its_children() -> None:
-    """color_quality.run_timed: CPU from the child's own rusage includes a grandchild's busy loop (a process
-    that spawns helpers, as hybridgen's variant probe does), and the child's last JSON line is its report."""
+    """harness.run_process (how the color quality benchmark times a process): CPU from the child's own rusage
+    includes a grandchild's busy loop (a process that spawns helpers, as hybridgen's variant probe does), and the
+    child's last JSON line is its report."""
     burn = "import time\nend = time.process_time() + 0.3\nwhile time.process_time() < end: pass\n"
     script = (f"import subprocess, sys\nsubprocess.run([sys.executable, '-c', {burn!r}], check=True)\n"
               "print('noise')\nprint('{\"done\": 1}')\n")
-    code = ("import sys; sys.path.insert(0, 'tools'); import json, color_quality as q\n"
-            f"r = q.run_timed([sys.executable, '-c', {script!r}], dict(__import__('os').environ))\n"
+    code = ("import sys; sys.path.insert(0, 'tools'); import json, harness as q\n"
+            f"r = q.run_process([sys.executable, '-c', {script!r}], dict(__import__('os').environ))\n"
             "print(json.dumps({'report': r.report, 'wall': r.wall, 'cpu': r.cpu}))")
     done = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, check=True)
     result = json.loads(done.stdout.strip().splitlines()[-1])
@@ -166,11 +167,7 @@ def test_default_color_process_renders_what_render_color_renders(tmp_path: Path)
     report = json.loads(done.stdout.strip().splitlines()[-1])
     marks = [report[key] for key in ("started", "imported", "built", "rendered", "written")]
     assert marks == sorted(marks) and report["mean_spp"] >= 1
-    sys.path.insert(0, str(REPO / "tools"))
-    try:
-        import color_quality
-    finally:
-        sys.path.remove(str(REPO / "tools"))
+    import color_quality  # tools/ is on sys.path (tests/tools/conftest.py)
     sink = hg.MemorySink()
     hg.render_color(color_quality.build("materials", 40, 30, tmp_path), [sink], hg.PathTraceSettings(), seed=1,
                     denoise=True, sample_counts=True)
