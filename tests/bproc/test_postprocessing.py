@@ -76,6 +76,9 @@ def test_scene_defaults_agree_with_the_bproc_layer() -> None:
     bproc = pytest.importorskip("hybridgen.bproc")
     if not hasattr(bproc, "renderer") or not hasattr(bproc, "camera"):
         pytest.skip("hybridgen.bproc has no renderer/camera module yet")
+    from hybridgen.bproc.session import reset
+
+    reset(keep_initialized=False)  # whatever an earlier test left: init() may run once per session
     bproc.init()
     try:
         bproc.camera.set_intrinsics_from_K_matrix(K, SHAPE[1], SHAPE[0])
@@ -84,7 +87,7 @@ def test_scene_defaults_agree_with_the_bproc_layer() -> None:
         np.testing.assert_allclose(pp.dist2depth(_plane_distance(K, 4.0)), 4.0, rtol=1e-9)
         assert scene_state.stereo_baseline() == 0.3 and scene_state.distance_range_end() == 42.0
     finally:
-        bproc.init()  # the next test starts from BlenderProc's defaults again
+        reset(keep_initialized=False)  # the next test's init() sets BlenderProc's renderer defaults again
 
 
 def test_trim_redundant_channels_shapes() -> None:
