@@ -197,7 +197,9 @@ def test_every_program_reads_its_own_triangles_plane(gl_context, packed, monkeyp
         commands.append(draw_commands(*args))
         return commands[-1]
 
-    monkeypatch.setattr(raster, "mesh_face_planes", moved)
+    import hybridgen.render.raster.gpu_objects as gpu_objects
+
+    monkeypatch.setattr(gpu_objects, "mesh_face_planes", moved)
     monkeypatch.setattr(raster, "draw_commands", recorded)
     scene = _shifted_plane_scene()
     view = hg.RasterView(scene, ctx=gl_context, exact_depth=True)

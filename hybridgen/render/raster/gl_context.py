@@ -111,3 +111,12 @@ def shared_context(device_index: int | None = None) -> Any:
 def renderer_name(ctx: Any) -> str:
     """The GL renderer string, e.g. 'llvmpipe (LLVM 15.0.6, 256 bits)'."""
     return str(ctx.info.get("GL_RENDERER", "unknown"))
+
+
+SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swr", "software")
+
+
+def software_renderer(ctx: Any) -> bool:
+    """True when ``ctx`` rasterizes on the CPU (Mesa llvmpipe and kin), False on a GPU driver."""
+    renderer = str(ctx.info.get("GL_RENDERER", "")).lower()
+    return any(name in renderer for name in SOFTWARE_RENDERERS)

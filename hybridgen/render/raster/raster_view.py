@@ -1,18 +1,18 @@
 """The raster view: exact per-pixel-centre labels of a scene with moderngl (one MRT pass per keypoint).
 
+Over 300 lines: one class owns the view's GL state from upload through draw to readback and release.
+
 Geometry is uploaded once when the view is built; each keypoint only changes uniforms. Back faces are
 culled for an object only where that cannot change a label: the mesh is a closed, outward-wound volume and
 the camera (with its near plane) is outside its bounding box, so the first surface every ray meets is a
 front face.
 
-Why one file of ~320 lines: every GL object (programs, buffers, vertex arrays, framebuffers) is created and
-released by :class:`RasterView` itself, so that ``release()`` frees exactly what the view made; upload, draw
-and readback share that ownership and stay together.
+Per-object GL resources are uploaded by :mod:`.gpu_objects` and the per-object matrices of a draw computed by
+:mod:`.object_poses`; every GL object (programs, buffers, vertex arrays, framebuffers) is released by
+:class:`RasterView` itself, so that ``release()`` frees exactly what the view made.
 """
 from __future__ import annotations
 
-import dataclasses
-from dataclasses import dataclass
 from functools import partial
 from typing import Any, Iterable
 
@@ -21,51 +21,26 @@ import numpy as np
 from ...errors import InputError
 from ...scene.camera import Intrinsics
 from ...scene.scene import Scene
-from .alpha_cutout import Cutout, set_cutout_uniforms, upload_cutout
-from .framebuffer_ring import FramebufferRing, Shape
+from .alpha_cutout import set_cutout_uniforms
+from .face_planes import AGREEMENT, pixel_to_ray
+from .framebuffer_ring import FramebufferRing
 from .gl_calls import gl_calls
-from .gl_context import compile_program, shared_context
+from .gl_context import compile_program, shared_context, software_renderer
+from .gpu_objects import GpuObject, upload_objects
+from .label_framebuffers import attachments, clear_framebuffer, create_framebuffer, destroy_framebuffer
 from .label_targets import LabelTargets
-from ..shared_geometry import geometry_key
+from .object_poses import ObjectPoses
+from .projection import near_plane_corner_distance, projection_from_K
 from .raster_passes import RASTER_PASSES
 from .readback import RasterOutput
-from .projection import near_plane_corner_distance, projection_from_K
 from .shader_source import shader_source
-from .cluster_cache import mesh_clusters
-from .face_planes import AGREEMENT, mesh_face_planes, pixel_to_ray
-from .triangle_clusters import TriangleClusters, draw_commands, visible_clusters
+from .triangle_clusters import draw_commands, visible_clusters
 
 NORMAL_SPACES = ("camera", "world")
 READBACKS = ("direct", "pbo")
-DEFAULT_ATTACHMENTS = [("normal_depth", 4, "f4"), ("instance", 1, "u4")]
-"""(name, components, moderngl dtype) of the default label targets."""
-SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swr", "software")
 
+__all__ = ["NORMAL_SPACES", "READBACKS", "RasterView", "software_renderer"]
 
-def software_renderer(ctx: Any) -> bool:
-    """True when ``ctx`` rasterizes on the CPU (Mesa llvmpipe and kin), False on a GPU driver."""
-    renderer = str(ctx.info.get("GL_RENDERER", "")).lower()
-    return any(name in renderer for name in SOFTWARE_RENDERERS)
-
-
-@dataclass
-class GpuObject:
-    """GL resources of one scene object (vertex positions and indices are shared with other passes)."""
-
-    instance_id: int
-    vao: Any  # drawn by the default label program (or its cut-out variant)
-    content: list[tuple[Any, str, str]]  # (buffer, format, attribute) of every vertex attribute
-    positions: Any
-    indices: Any
-    buffers: list[Any]
-    vertex_order: np.ndarray | None  # mesh vertex of each GPU vertex (flat meshes), None: the same order
-    closed: bool
-    bounds: np.ndarray  # (2, 3) local box
-    cutout: Cutout | None = None  # alpha cut-out of a CLIP material (render/raster/alpha_cutout.py)
-    packed_vaos: dict[Any, Any] = dataclasses.field(default_factory=dict)  # (LabelTargets, cutout) -> vao
-    clusters: TriangleClusters | None = None  # large meshes: culled per keypoint (render/raster/triangle_clusters.py)
-    indirect: Any = None  # the draw-command buffer of the kept clusters
-    planes: Any = None  # storage buffer of the triangles' planes (exact depth: render/raster/face_planes.py)
 
 
 class RasterView:
@@ -116,19 +91,19 @@ class RasterView:
         # exact depth: 0, 1, 2, ... read per draw at its base instance (its first triangle), one for all objects
         self._triangle_bases = self.ctx.buffer(np.arange(max([len(obj.faces) for obj in scene.objects] + [1]),
                                                          dtype=np.uint32).tobytes()) if self.exact_depth else None
-        self.gpu_objects = self._upload_all(scene.objects)
+        self.gpu_objects = upload_objects(self.ctx, scene.objects, self._object_program, self._triangle_bases,
+                                          cull_clusters)
+        self._poses = ObjectPoses(scene.objects)
         try:  # instance id -> category_id, for the category_id_segmaps pass (0 where an object has none)
             self._class_lut = self.category_lut()
         except InputError:
             self._class_lut = np.zeros(len(scene.objects) + 1, dtype=np.int32)
         # slot -> framebuffer (and its pixel-pack buffers): a ring per image shape (render/raster/framebuffer_ring.py)
-        self._framebuffers = FramebufferRing(self._create_framebuffer, self._destroy_framebuffer)
+        self._framebuffers = FramebufferRing(partial(create_framebuffer, self.ctx, self.readback), destroy_framebuffer)
         self._submitted: dict[Any, tuple[Intrinsics, LabelTargets | None, bool]] = {}
         self._fences: dict[Any, int] = {}  # slot -> fence after its draws (direct GIL-free readback)
         self._ray_lengths: np.ndarray | None = None
         self._ray_key: Any = None
-        self._cached_pose_key: bytes | None = None
-        self._cached_pose: dict[str, Any] = {}
 
     # ----------------------------------------------------------------- resources
     def _label_program(self, cutout: bool, targets: LabelTargets | None = None) -> Any:
@@ -144,6 +119,14 @@ class RasterView:
         if targets is not None:
             fragment = fragment.replace("\n", f"\n{targets.defines()}\n", 1)
         return compile_program(self.ctx, vertex_shader=vertex, fragment_shader=fragment)
+
+    def _object_program(self, cutout: bool) -> Any:
+        """The default label program, or its cut-out variant (built on first use)."""
+        if not cutout:
+            return self.program
+        if self._cutout_program is None:
+            self._cutout_program = self._label_program(cutout=True)
+        return self._cutout_program
 
     def _programs(self) -> list[Any]:
         return [p for p in (self.program, self._cutout_program, *self._packed_programs.values()) if p is not None]
@@ -164,106 +147,11 @@ class RasterView:
                                                          index_element_size=4)
         return program, gpu.packed_vaos[key]
 
-    def _upload_all(self, objects: list[Any]) -> list[GpuObject]:
-        """GPU objects of ``objects``; placements of shared geometry (render/shared_geometry.py) draw from the
-        buffers of its first placement."""
-        uploaded: list[GpuObject] = []
-        first: dict[Any, GpuObject] = {}
-        for obj in objects:
-            key = geometry_key(obj)
-            if key in first:  # shares the first placement's vertex arrays (packed ones included)
-                uploaded.append(dataclasses.replace(first[key], instance_id=obj.instance_id, buffers=[],
-                                                    packed_vaos=first[key].packed_vaos))
-                continue
-            uploaded.append(self._upload(obj))
-            if key is not None:
-                first[key] = uploaded[-1]
-        return uploaded
-
-    def _upload(self, obj: Any) -> GpuObject:
-        """GPU buffers of ``obj``: smooth meshes as they are; flat ones with a vertex per face corner that
-        carries the face normal (``vertex_order`` maps GPU vertices back to mesh vertices)."""
-        ctx = self.ctx
-        if obj.vertex_normals is not None:
-            vertex_order = None
-            vertices, normals, faces = obj.vertices, obj.vertex_normals, obj.faces
-        else:
-            vertex_order = obj.faces.ravel()
-            vertices = obj.vertices[vertex_order]
-            normals = np.repeat(obj.face_normals, 3, axis=0)
-            faces = np.arange(len(vertex_order)).reshape(-1, 3)
-        positions = ctx.buffer(vertices.astype(np.float32).tobytes())
-        normal_buffer = ctx.buffer(normals.astype(np.float32).tobytes())
-        indices = ctx.buffer(faces.astype(np.uint32).tobytes())
-        cutout = upload_cutout(ctx, obj, vertex_order)
-        content = [(positions, "3f", "in_position"), (normal_buffer, "3f", "in_normal")]
-        planes = None
-        if self._triangle_bases is not None:  # each triangle's plane, indexed from the draw's first triangle
-            planes = ctx.buffer(mesh_face_planes(obj.vertices, obj.faces).tobytes())
-            content.append((self._triangle_bases, "1u/i", "in_triangle_base"))
-        program = self.program
-        if cutout is not None:
-            if self._cutout_program is None:
-                self._cutout_program = self._label_program(cutout=True)
-            program = self._cutout_program
-            if cutout.uv_buffer is not None:
-                content.append((cutout.uv_buffer, "2f", "in_uv"))
-        vao = ctx.vertex_array(program, content, index_buffer=indices, index_element_size=4)
-        extra = cutout.resources() if cutout is not None else []
-        if planes is not None:
-            extra.append(planes)
-        # the clusters of obj's triangles (those of a flat mesh's corner vertices are the same), built once
-        clusters, indirect = (mesh_clusters(obj.vertices, obj.faces) if self.cull_clusters else None), None
-        if clusters is not None:
-            indirect = ctx.buffer(reserve=20 * clusters.size)
-            extra.append(indirect)
-        # a cut-out volume shows its inside through its holes: never culled
-        return GpuObject(obj.instance_id, vao, content, positions, indices, [positions, normal_buffer, indices, *extra],
-                         vertex_order, obj.is_closed and cutout is None, obj.bounds_local, cutout,
-                         clusters=clusters if indirect is not None else None, indirect=indirect, planes=planes)
-
-    def _create_framebuffer(self, shape: Shape) -> tuple[Any, list[Any]]:
-        """A framebuffer of ``shape`` (width, height, targets) and, for PBO readback, a pixel-pack buffer per
-        attachment."""
-        width, height, targets = shape
-        ctx = self.ctx
-        formats = [(c, d) for _, c, d in _attachments(targets)]
-        fbo = ctx.framebuffer(color_attachments=[ctx.renderbuffer((width, height), c, dtype=d) for c, d in formats],
-                              depth_attachment=ctx.depth_renderbuffer((width, height)))
-        pbos = ([ctx.buffer(reserve=width * height * c * int(d[1])) for c, d in formats]
-                if self.readback == "pbo" else [])
-        return fbo, pbos
-
-    def _destroy_framebuffer(self, resources: tuple[Any, list[Any]]) -> None:
-        fbo, pbos = resources
-        self._release_fbo(fbo)
-        for pbo in pbos:
-            pbo.release()
-
-    def _clear(self, fbo: Any, targets: LabelTargets | None) -> None:
-        """Clear ``fbo``: everything to 0 (depth buffer to 1); packed targets' depth to ``depth_background``
-        (a float clear value is undefined for integer targets: those are masked out of that clear)."""
-        if targets is None:
-            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-            return
-        count = len(targets.attachments())
-        fbo.color_mask = [(False,) * 4] + [(True,) * 4] * (count - 1)
-        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-        fbo.color_mask = [(True,) * 4] + [(False,) * 4] * (count - 1)
-        fbo.clear(self.depth_background, 0.0, 0.0, 0.0)
-        fbo.color_mask = [(True,) * 4] * count
-
     def _drop_fence(self, slot: Any) -> None:
         """Forget the fence of ``slot``'s previous draws (never collected)."""
         fence = self._fences.pop(slot, None)
         if fence is not None and self._gl is not None:
             self._gl.discard(fence)
-
-    @staticmethod
-    def _release_fbo(fbo: Any) -> None:
-        for attachment in (*fbo.color_attachments, fbo.depth_attachment):
-            attachment.release()
-        fbo.release()
 
     def _rays(self, intr: Intrinsics) -> np.ndarray:
         key = (intr.K.tobytes(), intr.width, intr.height)
@@ -317,7 +205,7 @@ class RasterView:
         fbo, pbos = self._framebuffers.resources(self._framebuffers.bind(slot, (width, height, targets)))
         fbo.scissor = region
         fbo.use()
-        self._clear(fbo, targets)
+        clear_framebuffer(fbo, targets, self.depth_background)
         self.ctx.enable(self.ctx.DEPTH_TEST)
         cam2world = np.asarray(cam2world, dtype=np.float64)
         world2cam = np.eye(4)
@@ -327,7 +215,7 @@ class RasterView:
         to_output = np.eye(3) if (normals_space or self.normals_space) == "camera" else cam2world[:3, :3]
         near_reach = near_plane_corner_distance(intr.K, width, height, intr.clip_start)
         draws = [(*self._draw_program(draw[0], targets), *draw)
-                 for draw in self._object_uniforms(cam2world, world2cam, near_reach, hidden)]
+                 for draw in self._poses.draws(self.gpu_objects, cam2world, world2cam, near_reach, hidden)]
         frame_uniforms = {"u_projection": projection.tobytes(),
                           "u_cam_to_output": to_output.T.astype(np.float32).tobytes(),
                           "u_pixel_to_ray": pixel_to_ray(intr.K).tobytes()}
@@ -373,7 +261,7 @@ class RasterView:
                 self._gl.draw_indirect(prog, vao, gpu.indirect, len(commands))
         queued = self.readback == "pbo" and region is None
         if queued:  # the copies run on the GPU after the draws; collect() maps them
-            for attachment, ((_, components, kind), pbo) in enumerate(zip(_attachments(targets), pbos)):
+            for attachment, ((_, components, kind), pbo) in enumerate(zip(attachments(targets), pbos)):
                 fbo.read_into(pbo, attachment=attachment, components=components, dtype=kind)
         elif self._gl is not None and region is None:  # flushes: the rasterizer starts on this keypoint now
             self._fences[slot] = self._gl.fence()
@@ -395,11 +283,11 @@ class RasterView:
                 upcoming, _ = self._framebuffers.resources(self._framebuffers.upcoming((width, height, targets)))
                 upcoming.scissor = None
                 upcoming.use()
-                self._clear(upcoming, targets)
+                clear_framebuffer(upcoming, targets, self.depth_background)
         fbo, pbos = self._framebuffers.resources(self._framebuffers.unbind(slot))
         arrays = {name: np.empty((height, width, components) if components > 1 else (height, width), np.dtype(kind))
-                  for name, components, kind in _attachments(targets)}
-        for attachment, (name, components, kind) in enumerate(_attachments(targets)):
+                  for name, components, kind in attachments(targets)}
+        for attachment, (name, components, kind) in enumerate(attachments(targets)):
             if queued:
                 pbos[attachment].read_into(arrays[name])
             elif self._gl is not None:  # waits for the rasterizer without holding the GIL
@@ -430,50 +318,6 @@ class RasterView:
         fbo.read_into(part, viewport=(x, y, w, h), attachment=1, components=1, dtype="u4")
         fbo.scissor = None
         return part
-
-    def _object_uniforms(self, cam2world: np.ndarray, world2cam: np.ndarray, near_reach: float,
-                         hidden: frozenset[int]) -> list[tuple[Any, ...]]:
-        """Per object to draw: modelview and normal matrix (float32 bytes, column-major), cull flag, the
-        front-face winding and (float64 modelview, camera centre in object-local coordinates) - computed for
-        all objects at once from cached per-pose values."""
-        cache = self._pose_cache()
-        if not cache["objects"]:
-            return []
-        modelview = np.einsum("ij,njk->nik", world2cam, cache["local2world"])
-        normal_to_cam = np.einsum("ij,njk->nik", world2cam[:3, :3], cache["normal_to_world"])
-        cam_local = np.einsum("nij,j->ni", cache["to_local"][:, :3, :3], cam2world[:3, 3]) + cache["to_local"][:, :3, 3]
-        bounds = cache["bounds"]
-        gap = np.maximum(np.maximum(bounds[:, 0] - cam_local, cam_local - bounds[:, 1]), 0.0)
-        outside = np.linalg.norm(gap, axis=1) > near_reach * cache["stretch"]
-        modelview_bytes = np.ascontiguousarray(modelview.transpose(0, 2, 1), dtype=np.float32)
-        normal_bytes = np.ascontiguousarray(normal_to_cam.transpose(0, 2, 1), dtype=np.float32)
-        draws = []
-        for i, gpu in enumerate(cache["objects"]):
-            if gpu.instance_id in hidden:
-                continue
-            draws.append((gpu, modelview_bytes[i].tobytes(), normal_bytes[i].tobytes(),
-                          bool(gpu.closed and outside[i]), "cw" if cache["det"][i] > 0 else "ccw",
-                          (modelview[i], cam_local[i])))
-        return draws
-
-    def _pose_cache(self) -> dict[str, Any]:
-        """Camera-independent per-object matrices, recomputed only when an object's pose changed."""
-        key = b"".join(obj.local2world.tobytes() for obj in self.scene.objects)
-        if self._cached_pose_key != key:
-            pairs = [(gpu, obj) for gpu, obj in zip(self.gpu_objects, self.scene.objects)
-                     if np.linalg.det(obj.local2world[:3, :3]) != 0]  # zero scale: nothing to draw
-            local2world = np.array([obj.local2world for _, obj in pairs]).reshape(-1, 4, 4)
-            to_local = np.linalg.inv(local2world) if len(pairs) else local2world
-            self._cached_pose = {
-                "objects": [gpu for gpu, _ in pairs], "local2world": local2world, "to_local": to_local,
-                "normal_to_world": to_local[:, :3, :3].transpose(0, 2, 1),
-                "det": np.linalg.det(local2world[:, :3, :3]) if len(pairs) else np.zeros(0),
-                "bounds": np.array([gpu.bounds for gpu, _ in pairs]).reshape(-1, 2, 3),
-                # a world distance d is at most d * |to_local|_2 in local units
-                "stretch": np.linalg.norm(to_local[:, :3, :3], ord=2, axis=(1, 2)) if len(pairs) else np.zeros(0),
-            }
-            self._cached_pose_key = key
-        return self._cached_pose
 
     def render(self, cam2world: np.ndarray, passes: Iterable[str] = ("depth", "normals", "instance_segmaps"),
                intrinsics: Intrinsics | None = None, normals_space: str | None = None) -> dict[str, np.ndarray]:
@@ -506,8 +350,3 @@ class RasterView:
             program.release()
         self.program = self._cutout_program = None
         self._packed_programs.clear()
-
-
-def _attachments(targets: LabelTargets | None) -> list[tuple[str, int, str]]:
-    """(name, components, moderngl dtype) of each colour attachment of a label draw into ``targets``."""
-    return DEFAULT_ATTACHMENTS if targets is None else targets.attachments()
