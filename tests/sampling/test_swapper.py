@@ -132,3 +132,45 @@ def test_swapper_errors_name_the_module(write_config, run_cli):
     code, _, err = run_cli("run", "-q", str(write_config(FAIL.replace("pool_objects: {pool: true}", "pool: [{name: x}]")
                                                          % "{name: ring}")))
     assert code == 2 and "module 'object.ObjectSwapper'" in err and "pool[0] needs a mesh 'path'" in err
+
+
+def test_scene_replace_gives_the_new_object_the_old_id_and_slot():
+    scene = hg.Scene()
+    first, second, third = (scene.add(hg.make_primitive("cube", 0.5, name=n, category_id=1)) for n in "abc")
+    new = hg.make_primitive("sphere", 0.5, name="new", category_id=1)
+    assert scene.replace(second, new) is new
+    assert [o.name for o in scene.objects] == ["a", "new", "c"]
+    assert [o.instance_id for o in scene.objects] == [first.instance_id, second.instance_id, third.instance_id]
+    assert new.instance_id == second.instance_id == 2
+
+
+def test_swapped_objects_are_drawn_under_their_originals_ids(write_config):
+    """The instance ids a render writes: every pixel of id k shows the replacement of the original that had id k
+    (drawn alone, it covers exactly those pixels where nothing else is in front), never the original itself."""
+    before, _ = _context((SCENE % (5, "fit_largest")).split("  - name: object.ObjectSwapper")[0], write_config)
+    context, _ = _context(SCENE % (5, "fit_largest"), write_config)
+    scene = context.scene
+    scene.camera.intrinsics = hg.Intrinsics.from_fov(0.9, 96, 72)
+    cam2world = hg.look_at([0.3, -2.2, 2.4], [0, 0, 0.75])
+    view = hg.RasterView(scene)
+    try:
+        ids = view.render(cam2world, ["instance_segmaps"])["instance_segmaps"]
+        all_ids = frozenset(o.instance_id for o in scene.objects)
+        originals = {o.instance_id: o.name for o in before.scene.objects if o.attributes.get("swap")}
+        for instance_id, original_name in originals.items():
+            replacement = next(o for o in scene.objects if o.instance_id == instance_id)
+            assert replacement.attributes["swapped_from"] == original_name
+            alone = view.render_raw(cam2world, hidden=all_ids - {instance_id}).instance
+            visible = ids == instance_id
+            assert visible.sum() > 20, original_name  # the replacement is seen, under the original's id
+            np.testing.assert_array_equal(alone[visible], instance_id)  # where id k is written, k's mesh is
+    finally:
+        view.release()
+    # the originals' own silhouettes differ from what is drawn under their ids (the swap changed the labels)
+    before.scene.camera.intrinsics = scene.camera.intrinsics
+    old_view = hg.RasterView(before.scene)
+    try:
+        old_ids = old_view.render(cam2world, ["instance_segmaps"])["instance_segmaps"]
+    finally:
+        old_view.release()
+    assert any(((old_ids == k) != (ids == k)).any() for k in originals)
