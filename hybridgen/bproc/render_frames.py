@@ -23,6 +23,7 @@ Labels are sampled at pixel centres (no antialiasing), where Cycles' passes aver
 """
 from __future__ import annotations
 
+import os
 from typing import Any
 
 import numpy as np
@@ -34,6 +35,9 @@ from .segmentation import map_frame
 from .session import SESSION, current_intrinsics
 from .types import Light, MeshObject
 
+MAX_SAMPLES_ENV = "HYBRIDGEN_BPROC_MAX_SAMPLES"
+"""Environment variable capping the color samples per pixel of every render (tools/check_blenderproc_scripts.py
+uses it on a slow machine); unset: the script's settings."""
 BACKGROUND_DEPTH = 1e10
 """Cycles' Z pass where a pixel sees no surface (m)."""
 DEFAULT_LOAD_KEYS = {"colors", "distance", "normals", "diffuse", "depth", "segmap"}
@@ -112,7 +116,9 @@ def _render_group(frames: list[int], meshes: list[MeshObject], color: bool) -> l
     scene, table = _scene(frames, meshes)
     sink = hg.MemorySink()
     if color:
-        trace = hg.PathTraceSettings(samples=settings.samples, noise_threshold=settings.noise_threshold,
+        cap = os.environ.get(MAX_SAMPLES_ENV)
+        samples = min(settings.samples, int(cap)) if cap else settings.samples
+        trace = hg.PathTraceSettings(samples=samples, noise_threshold=settings.noise_threshold,
                                      max_bounces=settings.max_bounces, diffuse_bounces=settings.diffuse_bounces,
                                      glossy_bounces=settings.glossy_bounces,
                                      transmission_bounces=settings.transmission_bounces)
