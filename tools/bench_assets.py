@@ -20,14 +20,13 @@ import argparse
 import json
 import math
 import os
-import resource
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
+from harness import Stopwatch, rss_mib
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -123,7 +122,7 @@ def run_mode(config: Path, shared: bool, width: int, height: int, spp: int) -> d
     from hybridgen.run.pipeline import build_modules, execute
 
     shared_geometry.ENABLED = shared
-    start = time.perf_counter()
+    watch = Stopwatch()
     loaded = load_config(config, [])
     context = execute(loaded, build_modules(loaded))
     scene = context.scene
@@ -137,26 +136,26 @@ def run_mode(config: Path, shared: bool, width: int, height: int, spp: int) -> d
             obj.material = by_uid[key]
     scene.camera.intrinsics = hg.Intrinsics.from_fov(1.2, width, height)
     poses = [hg.look_at([1.0 + i, 1.0, 1.7], [6.0, 5.0, 0.5]) for i in range(4)]
-    load_s = time.perf_counter() - start
+    load_s = watch.read()[0]
 
     def keypoint(view: PathTraceView, raster: hg.RasterView, pose: np.ndarray, seed: int) -> None:
         view.render(pose, seed=seed)
         raster.render(pose, passes=("depth", "normals", "instance_segmaps"))
 
-    start = time.perf_counter()
+    watch = Stopwatch()
     view = PathTraceView(scene, PathTraceSettings(samples=spp, max_bounces=3), variant=choose_variant())
     raster = hg.RasterView(scene)
     keypoint(view, raster, poses[0], 0)
-    first_s = time.perf_counter() - start
-    start = time.perf_counter()
+    first_s = watch.read()[0]
+    watch = Stopwatch()
     for i, pose in enumerate(poses[1:], 1):
         keypoint(view, raster, pose, i)
-    steady_s = (time.perf_counter() - start) / (len(poses) - 1)
+    steady_s = watch.read()[0] / (len(poses) - 1)
     return {"shared": shared, "objects": len(scene.objects),
             "triangles": int(sum(len(o.faces) for o in scene.objects)),
             "gpu_uploads": len({id(g.positions) for g in raster.gpu_objects}),
             "load_s": round(load_s, 2), "first_keypoint_s": round(first_s, 2), "steady_keypoint_s": round(steady_s, 2),
-            "peak_rss_mib": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)}
+            "peak_rss_mib": round(rss_mib()[1], 1)}
 
 
 def main() -> None:

@@ -7,10 +7,10 @@ Run: .venv/bin/python tools/bench_collision.py [--subdivisions 6] [--tests 60]
 from __future__ import annotations
 
 import argparse
-import time
 
 import numpy as np
 import trimesh
+from harness import Stopwatch
 
 import hybridgen as hg
 from hybridgen.scene.collision import CollisionWorld
@@ -34,19 +34,19 @@ def main() -> None:
     rng = np.random.default_rng(0)
     poses = [hg.object_pose(rng.uniform(-1, 1, 3), rng.uniform(0, 6.3, 3), [1.0, 1.2, 0.8]) for _ in range(args.tests)]
     world = CollisionWorld([obstacle])
-    start = time.perf_counter()
+    watch = Stopwatch()
     world.collides(obj, poses[0])
-    first = time.perf_counter() - start
+    first = watch.read()[0]
     times, ours = [], []
     for pose in poses:
-        start = time.perf_counter()
+        watch = Stopwatch()
         ours.append(world.collides(obj, pose))
-        times.append(time.perf_counter() - start)
+        times.append(watch.read()[0])
     baseline_times, theirs = [], []
     for pose in poses[: max(3, args.tests // 10)]:
-        start = time.perf_counter()
+        watch = Stopwatch()
         theirs.append(rebuild_per_test(obstacle, obj, pose))
-        baseline_times.append(time.perf_counter() - start)
+        baseline_times.append(watch.read()[0])
     assert ours[:len(theirs)] == theirs, "different answers"
     ours_ms, theirs_ms = np.median(times) * 1e3, np.median(baseline_times) * 1e3
     print(f"{len(obj.faces)} triangles, {sum(ours)}/{len(ours)} poses collide")

@@ -9,14 +9,11 @@ from __future__ import annotations
 
 import argparse
 import multiprocessing
-import sys
 import tempfile
-import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from tools.scene_yaml import shell_cameras  # noqa: E402
+from harness import Stopwatch
+from scene_yaml import shell_cameras
 
 CONFIG = """
 global: {all: {output_dir: "<args:0>"}}
@@ -45,25 +42,25 @@ def _reader_rate(source: Path, keys: list[str] | None = None) -> tuple[int, floa
     from hybridgen.data import KeypointDataset
 
     data = KeypointDataset(source, keys=keys)
-    start = time.perf_counter()
+    watch = Stopwatch()
     count = sum(1 for _ in data)
-    return count, count / (time.perf_counter() - start)
+    return count, count / watch.read()[0]
 
 
 def _worker(config: str, scenes: int, color: bool, worker: int, workers: int, queue) -> None:
     from hybridgen.data import GeneratorDataset
 
     data = GeneratorDataset(config, ["/nonexistent"], scenes=scenes, color=color)
-    start = time.perf_counter()
+    watch = Stopwatch()
     count = sum(1 for _ in data.samples(worker, workers))
-    queue.put((count, time.perf_counter() - start))
+    queue.put((count, watch.read()[0]))
 
 
 def _generator_rate(config: str, scenes: int, color: bool, workers: int) -> tuple[int, float, float]:
     """(samples, samples/s per worker, samples/s in all) with ``workers`` spawned processes."""
     context = multiprocessing.get_context("spawn")
     queue = context.Queue()
-    start = time.perf_counter()
+    watch = Stopwatch()
     processes = [context.Process(target=_worker, args=(config, scenes, color, w, workers, queue))
                  for w in range(workers)]
     for p in processes:
@@ -73,7 +70,7 @@ def _generator_rate(config: str, scenes: int, color: bool, workers: int) -> tupl
         p.join()
     total = sum(c for c, _ in results)
     per_worker = sum(c / s for c, s in results) / workers
-    return total, per_worker, total / (time.perf_counter() - start)
+    return total, per_worker, total / watch.read()[0]
 
 
 def main() -> None:

@@ -28,17 +28,22 @@ import time
 from pathlib import Path
 from typing import Any
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+from harness import Table, alternating, load_average, paired_ratio, run_process
+
+TOOLS = Path(__file__).resolve().parent
+PYRENDER = [sys.executable, str(TOOLS / "pyrender_reference.py")]
+"""The competitor's whole process (tools/pyrender_reference.py), followed by its spec."""
 
 CHECK_RESOLUTION = "640x480"
 E2E_KEYPOINTS = 16
 
 
 def _ours_worker(conn: Any, checkout: str | None = None) -> None:
-    if checkout is not None:  # --baseline: that checkout's hybridgen (this one's bench_scenes)
+    if checkout is not None:  # --baseline: that checkout's hybridgen (this one's label_scenes)
         sys.path.insert(0, checkout)
-    import bench_scenes as bs
+    import label_scenes as bs  # imports hybridgen: only now, after the checkout went first on sys.path
     import numpy as np
+    from stored_forms import default_file_encodings
 
     import hybridgen as hg
     from hybridgen.render.keypoint_loop import run_keypoints
@@ -57,11 +62,7 @@ def _ours_worker(conn: Any, checkout: str | None = None) -> None:
         def begin(self, n: int, layouts: list[Any], records: dict[str, Any], attributes: dict[str, Any]) -> None:
             key = tuple((layout.key, layout.shape, layout.value_range) for layout in layouts)
             if key not in probed:
-                with tempfile.TemporaryDirectory() as tmp:
-                    writer = hg.Hdf5SingleFileWriter(Path(tmp) / "probe.hdf5")
-                    writer.begin(n, layouts, records, attributes)
-                    probed[key] = writer.accepted_encodings()
-                    writer.abort()
+                probed[key] = default_file_encodings(n, layouts, records, attributes)
             self.tags = probed[key]
 
         def accepted_encodings(self) -> dict[str, str]:
@@ -153,7 +154,7 @@ def _pyrender_worker(conn: Any) -> None:
 
     if not hasattr(np, "infty"):
         np.infty = np.inf  # pyrender 0.1.45 still uses the alias removed in NumPy 2
-    import bench_scenes as bs
+    import label_scenes as bs
     import pyrender
     import trimesh
 
@@ -237,124 +238,6 @@ def _compare(depth: Any, ids: Any, ref_depth: Any, ref_ids: Any) -> str:
             f"  >1 cm {100 * np.mean(dz > 0.01):5.2f} %")
 
 # ---------------------------------------------------------------- whole processes
-
-PYRENDER_SCRIPT = "pyrender-script"
-"""argv[1] of this file that makes it the pyrender reference: a script a user would write."""
-
-
-def pyrender_script(spec_path: str, hit_fraction: bool = False) -> None:
-    """The reference a user compares with: load the same mesh files with trimesh, render depth + segmentation
-    (colour-coded ids, decoded) of the same poses with pyrender, write nothing. Runs as its own process."""
-    os.environ["PYOPENGL_PLATFORM"] = "egl"
-    import json
-
-    import numpy as np
-
-    if not hasattr(np, "infty"):
-        np.infty = np.inf  # pyrender 0.1.45 still uses the alias removed in NumPy 2
-    import pyrender
-    import trimesh
-
-    spec = json.loads(Path(spec_path).read_text())
-    scene = pyrender.Scene()
-    seg = {}
-    instance = 0
-    for entry in spec["meshes"]:
-        kwargs = {"file_type": "obj", "force": "scene"} if entry["path"].endswith(".obj") else {}
-        loaded = trimesh.load(entry["path"], process=False, **kwargs)
-        geometries = list(loaded.geometry.values()) if isinstance(loaded, trimesh.Scene) else [loaded]
-        for geometry in geometries:
-            instance += 1
-            node = scene.add(pyrender.Mesh.from_trimesh(geometry), pose=np.asarray(entry["pose"]))
-            seg[node] = [instance % 256, instance // 256, 0]
-    K, (width, height) = np.asarray(spec["K"]), spec["resolution"]
-    camera = scene.add(pyrender.IntrinsicsCamera(K[0, 0], K[1, 1], K[0, 2] + 0.5, K[1, 2] + 0.5,
-                                                 znear=spec["clip"][0], zfar=spec["clip"][1]))
-    renderer = pyrender.OffscreenRenderer(width, height)
-    flip = np.diag([1.0, -1.0, -1.0, 1.0])  # OpenCV camera axes -> OpenGL camera axes
-    for pose in spec["poses"]:
-        scene.set_pose(camera, np.asarray(pose) @ flip)
-        color, depth = renderer.render(scene, flags=pyrender.RenderFlags.SEG, seg_node_map=seg)
-        ids = color[..., 0].astype(np.int32) + 256 * color[..., 1].astype(np.int32)
-        assert depth.shape == ids.shape == (height, width)
-        if hit_fraction:  # --hit-fraction: keypoint 0's share of pixels that hit a surface, then stop
-            print(float(np.mean(depth > 0)))
-            break
-    renderer.delete()
-
-
-def export_assets(name: str, folder: Path) -> list[dict[str, Any]]:
-    """The scene's mesh files: the monastery as pybullet_data's OBJ itself; the other scenes written once as
-    binary PLY in world coordinates (vertex normals kept where the object has them). Each entry: path,
-    category_id, 4x4 pose (identity unless the file is +Y up)."""
-    import bench_scenes as bs
-    import numpy as np
-    import trimesh
-
-    if name.startswith("monastery"):
-        y_up = np.array([[1.0, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1]])
-        return [{"path": str(bs.pybullet_data_dir() / "samurai_monastry.obj"), "category_id": 1,
-                 "up_axis": "Y", "pose": y_up.tolist()}]
-    scene = bs.ALL_SCENES[name]()
-    folder.mkdir(parents=True, exist_ok=True)
-    entries = []
-    for i, obj in enumerate(scene.objects):
-        path = folder / f"{i:03d}.ply"
-        if not path.exists():
-            normals = None
-            if obj.vertex_normals is not None:
-                normals = obj.vertex_normals @ np.linalg.inv(obj.local2world[:3, :3])  # inverse transpose
-                normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-            mesh = trimesh.Trimesh(obj.world_vertices(), obj.faces, vertex_normals=normals, process=False)
-            temp = path.with_suffix(".tmp")
-            temp.write_bytes(mesh.export(file_type="ply"))
-            temp.rename(path)
-        entries.append({"path": str(path), "category_id": int(obj.category_id or 1), "up_axis": "Z",
-                        "pose": np.eye(4).tolist()})
-    return entries
-
-
-def write_configs(name: str, resolution: str, count: int, folder: Path,
-                  render_threads: int | None = None) -> tuple[Path, Path]:
-    """A labels-only hybridgen config (depth + normals + class + instance, default HDF5 writer, ``render_threads``
-    raster threads; None: SegMapRenderer's default, auto) and the pyrender script's spec: the same meshes,
-    intrinsics and ``count`` poses."""
-    import json
-
-    import bench_scenes as bs
-    import numpy as np
-
-    meshes = export_assets(name, Path(tempfile.gettempdir()) / "hybridgen_bench_assets" / name.split()[0])
-    scene = bs.ALL_SCENES[name]()
-    width, height = bs.RESOLUTIONS[resolution]
-    intr = bs.intrinsics(width, height)
-    poses = bs.orbit_poses(scene, count)
-    lines = ["global: {all: {output_dir: \"<args:0>\"}}", "modules:",
-             "  - {name: main.Initializer, config: {seed: 1}}"]
-    for i, entry in enumerate(meshes):
-        lines.append(f"  - {{name: loader.ObjLoader, config: {{path: '{entry['path']}', name: m{i}, "
-                     f"category_id: {entry['category_id']}, up_axis: {entry['up_axis']}}}}}")
-    K = [float(v) for v in intr.K.ravel()]
-    lines.append(f"  - name: camera.CameraLoader\n    config:\n      intrinsics: {{resolution_x: {width}, "
-                 f"resolution_y: {height}, cam_K: {K}, clip_start: {intr.clip_start}, clip_end: {intr.clip_end}}}\n"
-                 "      cam_poses:")
-    for pose in poses:
-        # source_frame as in BlenderProc: the OpenCV camera's axes in Blender camera axes
-        lines.append(f"        - {{cam2world_matrix: {[float(v) for v in pose.ravel()]}, source_frame: [X, -Y, -Z]}}")
-    lines.append("  - {name: renderer.SegMapRenderer, config: {render_depth: true, render_normals: true, "
-                 "map_by: [class, instance]" + ("" if render_threads is None else f", render_threads: {render_threads}")
-                 + "}}")
-    lines.append("  - {name: writer.Hdf5Writer}")
-    folder.mkdir(parents=True, exist_ok=True)
-    stem = f"{name.split()[0]}_{resolution}_{count}_{render_threads or 'default'}t"
-    config = folder / f"{stem}.yaml"
-    config.write_text("\n".join(lines) + "\n")
-    spec = folder / f"{stem}.json"
-    spec.write_text(json.dumps({"meshes": meshes, "K": intr.K.tolist(), "resolution": [width, height],
-                                "clip": [intr.clip_start, intr.clip_end], "poses": [p.tolist() for p in poses]}))
-    return config, spec
-
-
 def check_output(path: Path, spec: Path) -> None:
     """Stop if the run did not see what pyrender sees (a pose convention gone wrong renders empty images
     very fast): the hit fraction of keypoint 0 must match a pyrender render's within 2 %."""
@@ -365,31 +248,11 @@ def check_output(path: Path, spec: Path) -> None:
 
     with h5py.File(path, "r") as h5:
         ours = float(np.mean(np.isfinite(h5["depth"][0])))
-    done = subprocess.run([sys.executable, __file__, PYRENDER_SCRIPT, str(spec), "--hit-fraction"],
-                          capture_output=True, text=True, check=True)
+    done = subprocess.run([*PYRENDER, str(spec), "--hit-fraction"], capture_output=True, text=True, check=True)
     theirs = float(done.stdout.split()[-1])
     if abs(ours - theirs) > 0.02:
         raise SystemExit(f"hybridgen sees {ours:.1%} of the pixels hit, pyrender {theirs:.1%}: poses differ "
                          f"({json.loads(spec.read_text())['meshes'][0]['path']})")
-
-
-def run_timed(command: list[str], env: dict[str, str], cpu: list[float] | None = None) -> float:
-    """Wall seconds of one whole process (fails loudly); appends its CPU seconds (user + system, all its threads:
-    llvmpipe's too) to ``cpu`` - steadier than wall time while other processes share the cores."""
-    start = time.perf_counter()
-    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
-        process = subprocess.Popen(command, env=env, stdout=out, stderr=err)
-        _, status, usage = os.wait4(process.pid, 0)
-        elapsed = time.perf_counter() - start
-        code = os.waitstatus_to_exitcode(status)
-        if code != 0:
-            out.seek(0)
-            err.seek(0)
-            raise SystemExit(f"{' '.join(command)} failed ({code}):\n{out.read()[-2000:].decode(errors='replace')}"
-                             f"{err.read()[-4000:].decode(errors='replace')}")
-    if cpu is not None:
-        cpu.append(usage.ru_utime + usage.ru_stime)
-    return elapsed
 
 
 def whole_process_table(names: list[str], resolutions: list[str], count: int, rounds: int,
@@ -398,8 +261,18 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
     """The issue's table: whole ``hybridgen run`` vs the pyrender script, alternating, plus raw / in-process
     end-to-end label fps (alternating, ``e2e_keypoints`` keypoints, medians of ``rounds``) and their ratio, bytes
     per keypoint and time to first keypoint (1-keypoint runs)."""
+    from label_configs import write_configs
+
     hybridgen = [sys.executable, "-m", "hybridgen"]  # the package on sys.path (PYTHONPATH: another checkout)
     env = dict(os.environ, HYBRIDGEN_CACHE_DIR=str(cache_dir))
+
+    def run_timed(command: list[str], environment: dict[str, str], cpu: list[float] | None = None) -> float:
+        """Wall seconds of one whole process; appends its CPU seconds (llvmpipe's threads too) to ``cpu``."""
+        finished = run_process(command, environment)
+        if cpu is not None:
+            cpu.append(finished.cpu)
+        return finished.wall
+
     print(f"\nwhole processes, {count} keypoints, {rounds} alternating rounds, medians; 1st kp = a whole run of one "
           "keypoint (cold cache: once, with an empty mesh cache); hybridgen run = labels-only "
           "config (depth + normals + class + instance, default writer); pyrender = script loading the same files, "
@@ -408,9 +281,11 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
           "in process making the stored forms, handed to no writer; e2e fps = the same with the default HDF5 writer "
           "(gzip; created, written, finalized); e2e/raw = their ratio (goal >= 0.9); mesh cache in "
           f"{cache_dir} (warmed by an untimed run)")
-    print(f"{'scene':<20} {'resolution':<10} {'raw fps':>8} {'e2e fps':>8} {'e2e/raw':>7} {'run fps':>8} "
-          f"{'pyrender':>9} {'ratio':>6} {'cpu ratio':>9} {'MB/kp':>6} {'1st kp run':>11} {'cold cache':>11} "
-          f"{'1st kp pyr':>11}")
+    table = Table([("scene", "<20"), ("resolution", "<10"), ("raw fps", ">8.1f"), ("e2e fps", ">8.1f"),
+                   ("e2e/raw", ">7.2f"), ("run fps", ">8.1f"), ("pyrender", ">9.1f"), ("ratio", ">6.2f"),
+                   ("cpu ratio", ">9.2f"), ("MB/kp", ">6.2f"), ("1st kp run s", ">12.2f"), ("cold cache s", ">12.2f"),
+                   ("1st kp pyr s", ">12.2f")])
+    table.header()
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         for name in names:
@@ -420,7 +295,7 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
                 threaded = write_configs(name, resolution, count, work / "configs", render_threads)[0]
                 out = work / "out"
                 ours_cmd = [*hybridgen, "run", "--quiet", str(config), str(out)]
-                theirs_cmd = [sys.executable, __file__, PYRENDER_SCRIPT, str(spec)]
+                theirs_cmd = [*PYRENDER, str(spec)]
                 shutil.rmtree(work / "warm", ignore_errors=True)  # an existing output would be resumed
                 cold_env = dict(env, HYBRIDGEN_CACHE_DIR=str(work / f"cold_cache_{len(list(work.iterdir()))}"))
                 cold = run_timed([*hybridgen, "run", "--quiet", str(config1), str(work / "warm")], cold_env)
@@ -429,11 +304,9 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
                 times: dict[str, list[float]] = {"ours": [], "theirs": [], "ours1": [], "theirs1": [], "threads": []}
                 cpu: dict[str, list[float]] = {"ours": [], "theirs": [], "threads": []}
                 size = 0
-                for r in range(rounds):
-                    order = ("ours", "theirs") if r % 2 == 0 else ("theirs", "ours")
-                    if render_threads > 1:  # the same config on render_threads raster threads, same rounds
-                        order = ("threads", *order) if r % 2 == 0 else (*order, "threads")
-                    for engine in order:
+                engines = ("threads", "ours", "theirs") if render_threads > 1 else ("ours", "theirs")
+                for r in range(rounds):  # threads: the same config on render_threads raster threads, same rounds
+                    for engine in alternating(engines, r):
                         if engine == "threads":
                             shutil.rmtree(out, ignore_errors=True)
                             times["threads"].append(run_timed([*hybridgen, "run", "--quiet", str(threaded), str(out)],
@@ -449,22 +322,19 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
                                                              str(work / "one")], env))
                         else:
                             times["theirs"].append(run_timed(theirs_cmd, env, cpu["theirs"]))
-                            times["theirs1"].append(run_timed([sys.executable, __file__, PYRENDER_SCRIPT,
-                                                               str(spec1)], env))
+                            times["theirs1"].append(run_timed([*PYRENDER, str(spec1)], env))
                 med = {k: statistics.median(v) for k, v in times.items()}
                 raws, e2es = [], []
                 for r in range(rounds):
-                    for kind in (("raw", "hdf5") if r % 2 == 0 else ("hdf5", "raw")):
+                    for kind in alternating(("raw", "hdf5"), r):
                         if kind == "raw":
                             raws.append(ask("ours", "raw", name, resolution, e2e_keypoints))
                         else:
                             e2es.append(ask("ours", "hdf5", name, resolution, e2e_keypoints, "default")[0])
                 raw, e2e = statistics.median(raws), statistics.median(e2es)
-                print(f"{name:<20} {resolution:<10} {raw:>8.1f} {e2e:>8.1f} {e2e / raw:>7.2f} "
-                      f"{count / med['ours']:>8.1f} "
-                      f"{count / med['theirs']:>9.1f} {med['theirs'] / med['ours']:>6.2f} "
-                      f"{statistics.median(cpu['theirs']) / statistics.median(cpu['ours']):>9.2f} {size / count / 1e6:>6.2f} "
-                      f"{med['ours1']:>10.2f}s {cold:>10.2f}s {med['theirs1']:>10.2f}s", flush=True)
+                table.row(name, resolution, raw, e2e, e2e / raw, count / med["ours"], count / med["theirs"],
+                          med["theirs"] / med["ours"], statistics.median(cpu["theirs"]) / statistics.median(cpu["ours"]),
+                          size / count / 1e6, med["ours1"], cold, med["theirs1"])
                 if render_threads > 1:
                     print(f"{'':<20} {'':<10} render_threads {render_threads}: run fps {count / med['threads']:.1f}, "
                           f"ratio {med['theirs'] / med['threads']:.2f}, cpu ratio "
@@ -479,16 +349,17 @@ def e2e_table(names: list[str], resolutions: list[str], count: int, rounds: int,
     print(f"\nin process, {count} keypoints per measurement, {rounds} alternating rounds, medians; raw = the label "
           "pass making the stored forms, no writer; e2e = the same with the default HDF5 writer (created, every "
           "keypoint written, finalized); ratio = median over rounds of e2e / raw of the same round; load average "
-          f"{os.getloadavg()[0]:.1f} at the start")
-    print(f"{'scene':<20} {'resolution':<10} {'checkout':<9} {'writer':<13} {'raw fps':>8} {'e2e fps':>8} "
-          f"{'e2e/raw':>7} {'MB/kp':>6}")
+          f"{load_average():.1f} at the start")
+    table = Table([("scene", "<20"), ("resolution", "<10"), ("checkout", "<9"), ("writer", "<13"),
+                   ("raw fps", ">8.1f"), ("e2e fps", ">8.1f"), ("e2e/raw", ">7.2f"), ("MB/kp", ">6.2f")])
+    table.header()
     for name in names:
         for resolution in resolutions:
             fps: dict[tuple[str, str], list[float]] = {}
             size: dict[tuple[str, str], float] = {}
             for r in range(rounds):
                 runs = [(checkout, kind) for checkout in checkouts for kind in ("raw", *compressions)]
-                for checkout, kind in (runs if r % 2 == 0 else runs[::-1]):
+                for checkout, kind in alternating(runs, r):
                     if kind == "raw":
                         fps.setdefault((checkout, kind), []).append(ask(checkout, "raw", name, resolution, count))
                     else:
@@ -498,11 +369,10 @@ def e2e_table(names: list[str], resolutions: list[str], count: int, rounds: int,
                 raw = fps[checkout, "raw"]
                 for compression in compressions:
                     e2e = fps[checkout, compression]
-                    ratio = statistics.median(b / a for a, b in zip(raw, e2e))
-                    print(f"{name:<20} {resolution:<10} {'this' if checkout == 'ours' else checkout:<9} "
-                          f"{compression:<13} {statistics.median(raw):>8.1f} {statistics.median(e2e):>8.1f} "
-                          f"{ratio:>7.2f} {size[checkout, compression] / 1e6:>6.2f}", flush=True)
-    print(f"load average at the end: {os.getloadavg()[0]:.1f}")
+                    table.row(name, resolution, "this" if checkout == "ours" else checkout, compression,
+                              statistics.median(raw), statistics.median(e2e), paired_ratio(e2e, raw),
+                              size[checkout, compression] / 1e6)
+    print(f"load average at the end: {load_average():.1f}")
 
 
 def main() -> None:
@@ -538,7 +408,7 @@ def main() -> None:
                         "(default: a fresh temporary folder, warmed by an untimed run)")
     args = parser.parse_args()
 
-    import bench_scenes as bs
+    import label_scenes as bs
 
     names = args.scenes or list(bs.SCENES)
     unknown = [n for n in names if n not in bs.ALL_SCENES]
@@ -574,7 +444,7 @@ def main() -> None:
 
     triangles = {name: bs.ALL_SCENES[name]().triangle_count for name in names}
     print(f"{frames} keypoints per round, {rounds} rounds, median frames/s; ours = depth + normals + instance + class; "
-          f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f} (other processes skew absolute numbers)")
+          f"{os.cpu_count()} CPUs, load average {load_average():.1f} (other processes skew absolute numbers)")
     if args.e2e_only:
         e2e_table(names, resolutions, args.e2e_keypoints, args.rounds, ask, ["ours", *workers.keys() & {"baseline"}],
                   args.e2e_compression)
@@ -592,17 +462,18 @@ def main() -> None:
             process.join(timeout=10)
         return
     if not args.skip_pyrender:
-        print(f"\n{'scene':<20} {'resolution':<10} {'triangles':>10} {'ours fps':>9} {'pyrender fps':>13} "
-              f"{'ours/pyrender':>14}")
+        print()
+        table = Table([("scene", "<20"), ("resolution", "<10"), ("triangles", ">10,"), ("ours fps", ">9.1f"),
+                       ("pyrender fps", ">13.1f"), ("ours/pyrender", ">14.2f")])
+        table.header()
         for name in names:
             for resolution in resolutions:
                 fps: dict[str, list[float]] = {"ours": [], "pyrender": []}
                 for r in range(rounds):
-                    for engine in (("ours", "pyrender") if r % 2 == 0 else ("pyrender", "ours")):
+                    for engine in alternating(("ours", "pyrender"), r):
                         fps[engine].append(ask(engine, "raw", name, resolution, frames))
                 a, b = statistics.median(fps["ours"]), statistics.median(fps["pyrender"])
-                print(f"{name:<20} {resolution:<10} {triangles[name]:>10,} {a:>9.1f} {b:>13.1f} {a / b:>14.2f}",
-                      flush=True)
+                table.row(name, resolution, triangles[name], a, b, a / b)
 
     if args.breakdown:
         print("\nours, serial (no pipelining), median ms per keypoint: submit = uniforms + draw calls (llvmpipe "
@@ -632,7 +503,7 @@ def main() -> None:
         for compression in compressions:
             raw, full, size = [], [], 0.0
             for r in range(rounds):
-                for kind in (("raw", "hdf5") if r % 2 == 0 else ("hdf5", "raw")):
+                for kind in alternating(("raw", "hdf5"), r):
                     if kind == "raw":
                         raw.append(ask("ours", "raw", name, "640x480", frames))
                     else:
@@ -642,14 +513,11 @@ def main() -> None:
             print(f"{name:<20} {compression:<9} raw {a:6.1f} fps  with HDF5 {b:6.1f} fps  ratio {b / a:.2f} "
                   f"{'ok ' if b / a >= 0.8 else 'LOW'}  ({size / 1e6:.2f} MB per keypoint)", flush=True)
 
-    print(f"\nload average at the end: {os.getloadavg()[0]:.1f}")
+    print(f"\nload average at the end: {load_average():.1f}")
     for conn, process in workers.values():
         conn.send(None)
         process.join(timeout=10)
 
 
 if __name__ == "__main__":
-    if len(sys.argv) in (3, 4) and sys.argv[1] == PYRENDER_SCRIPT:
-        pyrender_script(sys.argv[2], hit_fraction=sys.argv[3:] == ["--hit-fraction"])
-    else:
-        main()
+    main()

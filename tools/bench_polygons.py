@@ -15,10 +15,10 @@ import importlib.util
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
+from harness import Stopwatch
 from scipy import ndimage
 
 REPO = Path(__file__).resolve().parents[1]
@@ -70,9 +70,9 @@ def main() -> None:
         for label, tracer in tracers.items():
             times = []
             for _ in range(ns.repeat if label == "current" else 1):
-                start = time.perf_counter()
+                watch = Stopwatch()
                 polygons = tracer(mask)
-                times.append(time.perf_counter() - start)
+                times.append(watch.read()[0])
             check(mask, polygons)
             print(f"{name:15s} {label:20s} {min(times):8.3f} s  {len(polygons):6d} polygons  "
                   f"{sum(len(p) for p in polygons) // 2:7d} corners  (exact)", flush=True)

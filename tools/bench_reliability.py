@@ -24,18 +24,17 @@ folder of 2000 files, hashed vs cached. Peak RSS is ``ru_maxrss`` of the run's p
 from __future__ import annotations
 
 import argparse
-import json
 import shutil
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
+from harness import medians, run_process
+from scene_yaml import knot_config
+
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "tools"))
-from bench_workers import CONFIG, KINDS  # noqa: E402  (one scene template for the run benchmarks)
 
 VARIANTS = ("bare", "direct", "staged")
 _PATCHES = {
@@ -47,27 +46,24 @@ _PATCHES = {
 }
 _CHILD = ("import json, resource, sys, time; {patch}; from hybridgen.cli import main; "
           "t = time.perf_counter(); c = time.process_time(); rc = main(['run', '-q', sys.argv[1], sys.argv[2]]); "
-          "print(json.dumps([time.perf_counter() - t, time.process_time() - c, "
-          "resource.getrusage(resource.RUSAGE_SELF).ru_maxrss])); sys.exit(rc)")
+          "print(json.dumps({'wall': time.perf_counter() - t, 'cpu': time.process_time() - c, "
+          "'rss_kib': resource.getrusage(resource.RUSAGE_SELF).ru_maxrss})); sys.exit(rc)")
 
 
 def config_text(scenes: int, width: int, height: int, keypoints: int) -> str:
-    """bench_workers.py's labels-only scene (knot over a floor, sampled cameras, depth/distance/normals/ids)."""
-    labels = KINDS["labels"]
-    return CONFIG.format(scenes=scenes, repo=REPO, width=width, height=height, keypoints=keypoints,
-                         renderer=labels["renderer"], renderer_config=labels["renderer_config"])
+    """The run benchmarks' labels-only knot scene (knot over a floor, sampled cameras, depth/distance/normals/ids;
+    tools/scene_yaml.py)."""
+    return knot_config("labels", scenes, width=width, height=height, keypoints=keypoints)
 
 
-def _run(config: Path, out: Path, variant: str = "staged") -> tuple[float, float, int]:
-    """(wall seconds, CPU seconds, peak RSS in MiB) of one ``hybridgen run`` into ``out`` in a fresh process."""
+def _run(config: Path, out: Path, variant: str = "staged") -> dict[str, float]:
+    """Wall and CPU seconds of ``hybridgen run`` (measured in the child, around the call) and the child's peak RSS
+    (``rss``, MiB) of one run into ``out`` in a fresh process."""
     shutil.rmtree(out, ignore_errors=True)
     code = _CHILD.format(patch=_PATCHES[variant])
-    result = subprocess.run([sys.executable, "-c", code, str(config), str(out)], cwd=REPO, capture_output=True,
-                            text=True)
-    if result.returncode != 0:
-        raise SystemExit(f"{variant} run failed:\n{result.stderr[-3000:]}")
-    wall, cpu, rss_kib = json.loads(result.stdout.strip().splitlines()[-1])
-    return wall, cpu, int(rss_kib) // 1024
+    report = run_process([sys.executable, "-c", code, str(config), str(out)], cwd=REPO).report
+    assert report is not None, f"the {variant} run printed no report"
+    return {"wall": report["wall"], "cpu": report["cpu"], "rss": int(report["rss_kib"]) // 1024}
 
 
 def _components(config: Path, out: Path) -> dict[str, float]:
@@ -127,7 +123,7 @@ def _differing_chunks(first: Path, second: Path) -> list[str] | None:
 def overhead(keypoints: int, size: tuple[int, int], rounds: int, tmp: Path) -> None:
     config = tmp / "overhead.yaml"
     config.write_text(config_text(1, size[0], size[1], keypoints))
-    runs: dict[str, list[tuple[float, float, int]]] = {variant: [] for variant in VARIANTS}
+    runs: dict[str, list[dict[str, float]]] = {variant: [] for variant in VARIANTS}
     mismatches: list[list[str]] = []
     steps: dict[str, list[float]] = {}
     for _ in range(rounds):
@@ -141,13 +137,13 @@ def overhead(keypoints: int, size: tuple[int, int], rounds: int, tmp: Path) -> N
         mismatches.append(differing)
         for name, seconds in _components(config, tmp / "direct").items():
             steps.setdefault(name, []).append(seconds)
-    wall = {v: statistics.median(r[0] for r in runs[v]) for v in VARIANTS}
-    cpu = {v: statistics.median(r[1] for r in runs[v]) for v in VARIANTS}
+    middle = {v: medians(runs[v]) for v in VARIANTS}
+    wall, cpu = {v: middle[v]["wall"] for v in VARIANTS}, {v: middle[v]["cpu"] for v in VARIANTS}
     print(f"{keypoints} keypoints, {size[0]}x{size[1]} labels (depth, distance, normals, class, instance), gzip 1, "
           f"median of {rounds} interleaved rounds (wall / CPU seconds of `hybridgen run`, imports included):")
     for variant in VARIANTS:
         print(f"  {variant:<7} {wall[variant]:6.2f} s wall {cpu[variant]:6.2f} s CPU   "
-              f"(walls {', '.join(f'{r[0]:.2f}' for r in runs[variant])})")
+              "(walls " + ", ".join(f"{r['wall']:.2f}" for r in runs[variant]) + ")")
     print(f"  fingerprint + checksums (direct / bare): {wall['direct'] / wall['bare']:.3f}x wall, "
           f"{cpu['direct'] / cpu['bare']:.3f}x CPU")
     print(f"  staged / direct:                          {wall['staged'] / wall['direct']:.3f}x wall, "
@@ -197,8 +193,8 @@ def memory(scene_counts: list[int], tmp: Path) -> None:
     for scenes in scene_counts:
         config = tmp / f"memory{scenes}.yaml"
         config.write_text(config_text(scenes, 16, 12, 2))
-        seconds, _, rss = _run(config, tmp / f"memory{scenes}")
-        print(f"  {scenes:5d} scenes: peak RSS {rss} MiB ({seconds:.1f} s)")
+        run = _run(config, tmp / f"memory{scenes}")
+        print(f"  {scenes:5d} scenes: peak RSS {run['rss']} MiB ({run['wall']:.1f} s)")
 
 
 def main() -> None:

@@ -27,14 +27,13 @@ import os
 import statistics
 import sys
 import tempfile
-import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from harness import Stopwatch, Table
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 CONFIG = REPO / "configs" / "tabletop_physics.yaml"
 
 
@@ -83,10 +82,10 @@ def bench_physics(context: Any, module: Any, rounds: int) -> list[dict[str, Any]
     with tempfile.TemporaryDirectory() as cache:
         os.environ["HYBRIDGEN_CACHE_DIR"] = cache
         for label in ("cold", "cached"):
-            t0 = time.perf_counter()
+            watch = Stopwatch()
             parts = sum(len(convex_decomposition(o.vertices, o.faces, settings.decomposition)) for o in concave)
             rows.append({"case": f"CoACD decomposition, {label}", "objects": len(concave), "parts": parts,
-                         "wall": time.perf_counter() - t0})
+                         "wall": watch.read()[0]})
         # the simulation itself (decompositions cached, as on every run after the first)
         for substeps in (None, 1):
             walls, result = [], None
@@ -166,20 +165,20 @@ def bench_cameras(context: Any, module: Any, count: int, rounds: int) -> tuple[l
     check = check_intrinsics(intr, cfg["check_width"])
     coarse = check_intrinsics(intr, 10)
 
-    t0 = time.perf_counter()
+    watch = Stopwatch()
     view = RasterView(context.scene)
     pose_failures(view, candidates[0], check, checks)  # first draw compiles / allocates
-    raster_setup = time.perf_counter() - t0
-    t0 = time.perf_counter()
+    raster_setup = watch.read()[0]
+    watch = Stopwatch()
     grid = RayGrid(context.scene)
-    ray_setup = time.perf_counter() - t0
+    ray_setup = watch.read()[0]
 
     def timed(fn: Any) -> tuple[float, list[bool]]:
         rates, accepted = [], []
         for _ in range(rounds):
-            start = time.perf_counter()
+            watch = Stopwatch()
             accepted = [not fn(pose) for pose in candidates]
-            rates.append(len(candidates) / (time.perf_counter() - start))
+            rates.append(len(candidates) / watch.read()[0])
         return statistics.median(rates), accepted
 
     raster_rate, raster_ok = timed(lambda pose: pose_failures(view, pose, check, checks))
@@ -220,23 +219,23 @@ def main() -> None:
 
     print(f"\nCamera poses with proximity checks: tabletop after physics, {info['objects']} objects, "
           f"{info['triangles']} triangles, image {info['image']}, {info['candidates']} candidates x {args.rounds} rounds")
-    print(f"{'method':38s} {'grid':>7s} {'setup s':>8s} {'cand/s':>9s} {'accepted':>9s} {'poses/s':>8s} "
-          f"{'vs raster':>9s} {'agree':>6s}")
+    table = Table([("method", "<38"), ("grid", ">7"), ("setup s", ">8.3f"), ("cand/s", ">9.1f"), ("accepted", ">9"),
+                   ("poses/s", ">8.1f"), ("vs raster", ">9.2f"), ("agree %", ">7.1f")])
+    table.header()
     base = camera_rows[0]["rate"]
     for row in camera_rows:
-        print(f"{row['method']:38s} {row['grid']:>7s} {row['setup']:8.3f} {row['rate']:9.1f} "
-              f"{row['accepted']:>4d}/{info['candidates']:<4d} {row['accepted_rate']:8.1f} "
-              f"{row['rate'] / base:8.2f}x {row['agree'] * 100:5.1f}%")
+        table.row(row["method"], row["grid"], row["setup"], row["rate"], f"{row['accepted']}/{info['candidates']}",
+                  row["accepted_rate"], row["rate"] / base, row["agree"] * 100)
     print("\nPhysics (object.PhysicsPositioning settings of the config, same start poses each round)")
-    print(f"{'case':52s} {'objects':>7s} {'sim s':>6s} {'steps':>6s} {'substeps':>8s} {'at rest':>7s} "
-          f"{'wall s':>7s} {'x realtime':>10s}")
+    table = Table([("case", "<52"), ("objects", ">7d"), ("sim s", ">6.2f"), ("steps", ">6d"), ("substeps", ">8d"),
+                   ("at rest", ">7d"), ("wall s", ">7.2f"), ("x realtime", ">10.2f")])
+    table.header()
     for row in physics_rows:
         if "simulated" in row:
-            print(f"{row['case']:52s} {row['objects']:7d} {row['simulated']:6.2f} {row['steps']:6d} "
-                  f"{row['substeps']:8d} {row['at_rest']:7d} {row['wall']:7.2f} {row['simulated'] / row['wall']:10.2f}")
-        else:
-            print(f"{row['case']:52s} {row['objects']:7d} {'':6s} {'':6s} {'':8s} {row['parts']:>4d} pt "
-                  f"{row['wall']:7.2f}")
+            table.row(row["case"], row["objects"], row["simulated"], row["steps"], row["substeps"], row["at_rest"],
+                      row["wall"], row["simulated"] / row["wall"])
+        else:  # a decomposition: its convex parts in the "at rest" column
+            table.row(row["case"], row["objects"], "", "", "", f"{row['parts']} pt", row["wall"], "")
 
 
 if __name__ == "__main__":

@@ -32,10 +32,11 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import Any
+
+from harness import Table, alternating, load_average, medians, run_process
+from label_configs import write_configs
 
 TOOLS = Path(__file__).resolve().parent
-sys.path.insert(0, str(TOOLS))
 
 SCENE_NAMES = {"monastery": "monastery (real)", "1.4M": "1.4M real, subdiv.", "50": "50 objects"}
 
@@ -60,15 +61,9 @@ sys.exit(main(sys.argv[1:]))
 
 def timed(command: list[str], env: dict[str, str]) -> tuple[float, float, float]:
     """(start wall time.time(), wall seconds, CPU seconds of the whole process); fails loudly."""
-    start_epoch, start = time.time(), time.perf_counter()
-    with tempfile.TemporaryFile() as out:
-        process = subprocess.Popen(command, env=env, stdout=out, stderr=subprocess.STDOUT)
-        _, status, usage = os.wait4(process.pid, 0)
-        elapsed = time.perf_counter() - start
-        if os.waitstatus_to_exitcode(status) != 0:
-            out.seek(0)
-            raise SystemExit(f"{' '.join(command)} failed:\n{out.read()[-4000:].decode(errors='replace')}")
-    return start_epoch, elapsed, usage.ru_utime + usage.ru_stime
+    start_epoch = time.time()
+    finished = run_process(command, env)
+    return start_epoch, finished.wall, finished.cpu
 
 
 def first_keypoint(config: Path, out: Path, env: dict[str, str], stamp: Path) -> dict[str, float]:
@@ -79,10 +74,6 @@ def first_keypoint(config: Path, out: Path, env: dict[str, str], stamp: Path) ->
                              dict(env, BENCH_FIRST_KEYPOINT=str(stamp)))
     at, cpu_at = eval(stamp.read_text())  # noqa: S307 - our own repr of two floats
     return {"first_wall": at - start, "first_cpu": cpu_at, "wall": wall, "cpu": cpu}
-
-
-def median_row(rows: list[dict[str, float]]) -> dict[str, float]:
-    return {key: statistics.median(r[key] for r in rows) for key in rows[0]}
 
 
 def profile(command: list[str], env: dict[str, str], limit: int) -> None:
@@ -124,8 +115,6 @@ def main() -> None:
     parser.add_argument("--limit", type=int, default=30, help="lines of --profile / --importtime")
     args = parser.parse_args()
 
-    import bench_labels as bl
-
     checkouts = {"this": TOOLS.parent} | ({"baseline": args.baseline.resolve()} if args.baseline else {})
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
@@ -141,38 +130,38 @@ def main() -> None:
                 envs[name]["PYTHONPYCACHEPREFIX"] = str(work / name / "pycache")
             timed([sys.executable, "-m", "hybridgen", "--help"], envs[name])  # untimed: compiles bytecode
         os.chdir(work)  # not a checkout: '' on sys.path finds no hybridgen
-        print(f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f} (others' processes skew wall times); "
+        print(f"{os.cpu_count()} CPUs, load average {load_average():.1f} (others' processes skew wall times); "
               f"bytecode {'not cached' if args.no_bytecode else 'cached'}; medians of {args.rounds} whole processes, "
               f"checkouts alternating: " + ", ".join(f"{k} = {v}" for k, v in checkouts.items()))
-        print(f"{'what':<32} {'checkout':<9} {'wall s':>8} {'cpu s':>8}")
+        table = Table([("what", "<32"), ("checkout", "<9"), ("wall s", ">8.3f"), ("cpu s", ">8.3f")])
+        table.header()
         for label, code in (("python -c 'import numpy'", ["-c", "import numpy"]),
                             ("python -c 'import hybridgen'", ["-c", "import hybridgen"]),
                             ("hybridgen --help", ["-m", "hybridgen", "--help"])):
             runs: dict[str, list[tuple[float, float]]] = {name: [] for name in checkouts}
             for r in range(args.rounds):
-                for name in (list(checkouts) if r % 2 == 0 else list(checkouts)[::-1]):
+                for name in alternating(list(checkouts), r):
                     runs[name].append(timed([sys.executable, *code], envs[name])[1:])
             for name, values in runs.items():
-                print(f"{label:<32} {name:<9} {statistics.median(v[0] for v in values):>8.3f} "
-                      f"{statistics.median(v[1] for v in values):>8.3f}", flush=True)
+                table.row(label, name, statistics.median(v[0] for v in values), statistics.median(v[1] for v in values))
         print(f"\nlabels-only run, 640x480, 1 keypoint: 1st kp = process start -> first keypoint handed to the "
               "writer; whole = the process; cold = empty cache folder (mesh cache, input hashes)")
-        print(f"{'scene':<10} {'cache':<6} {'checkout':<9} {'1st kp wall':>11} {'1st kp cpu':>11} {'whole wall':>11} "
-              f"{'whole cpu':>10}")
+        table = Table([("scene", "<10"), ("cache", "<6"), ("checkout", "<9"), ("1st kp wall s", ">13.3f"),
+                       ("1st kp cpu s", ">12.3f"), ("whole wall s", ">12.3f"), ("whole cpu s", ">11.3f")])
+        table.header()
         for short in args.scenes:
-            config, _ = bl.write_configs(SCENE_NAMES[short], "640x480", 1, work / "configs")
+            config, _ = write_configs(SCENE_NAMES[short], "640x480", 1, work / "configs")
             out, stamp = work / "out", work / "stamp"
             rows: dict[tuple[str, str], list[dict[str, float]]] = {}
             for kind in ("cold", "warm"):
                 for r in range(args.rounds):
-                    for name in (list(checkouts) if r % 2 == 0 else list(checkouts)[::-1]):
+                    for name in alternating(list(checkouts), r):
                         if kind == "cold":
                             shutil.rmtree(work / name / "cache", ignore_errors=True)
                         rows.setdefault((kind, name), []).append(first_keypoint(config, out, envs[name], stamp))
             for (kind, name), values in rows.items():
-                m = median_row(values)
-                print(f"{short:<10} {kind:<6} {name:<9} {m['first_wall']:>10.3f}s {m['first_cpu']:>10.3f}s "
-                      f"{m['wall']:>10.3f}s {m['cpu']:>9.3f}s", flush=True)
+                m = medians(values)
+                table.row(short, kind, name, m["first_wall"], m["first_cpu"], m["wall"], m["cpu"])
             command = ["-m", "hybridgen", "run", "-q", str(config), str(out)]
             for name in checkouts:
                 if args.profile:
@@ -183,7 +172,7 @@ def main() -> None:
                     shutil.rmtree(out, ignore_errors=True)
                     print(f"\n{name}: ", end="")
                     importtime(command, envs[name], args.limit)
-        print(f"\nload average at the end: {os.getloadavg()[0]:.1f}")
+        print(f"\nload average at the end: {load_average():.1f}")
 
 
 if __name__ == "__main__":

@@ -15,9 +15,9 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import time
 
 import numpy as np
+from harness import Stopwatch
 
 
 def _scene(width: int, height: int):  # noqa: ANN202 - hybridgen imported lazily
@@ -67,11 +67,11 @@ def main() -> None:
     transparent_shadows.scene_has_masks = detect  # type: ignore[assignment]
     for _ in range(args.repeats):
         for on in (False, True):
-            start_cpu, start_wall = time.process_time(), time.perf_counter()
+            watch = Stopwatch()
             views[on].render(camera, seed=1, spp=args.spp)
-            cpu[on].append(time.process_time() - start_cpu)
-            print(f"{variant} {'transparent' if on else 'opaque     '} shadows: cpu {cpu[on][-1]:.2f} s, "
-                  f"wall {time.perf_counter() - start_wall:.2f} s")
+            wall, seconds = watch.read()
+            cpu[on].append(seconds)
+            print(f"{variant} {'transparent' if on else 'opaque     '} shadows: cpu {seconds:.2f} s, wall {wall:.2f} s")
     ratio = statistics.median(cpu[True]) / statistics.median(cpu[False])
     print(f"{variant}: transparent / opaque CPU time (medians) = {ratio:.2f}")
 

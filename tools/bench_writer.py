@@ -4,7 +4,7 @@ compress (issue 13: end to end vs the raw raster pass).
 Run: .venv/bin/python tools/bench_writer.py [--scene "50 objects"] [--resolution 640x480] [--keypoints 120]
          [--compression gzip blosc2] [--skip-codecs]
 
-1. Renders ``--keypoints`` orbit poses of a benchmark scene (tools/bench_scenes.py) once, keeping the values the
+1. Renders ``--keypoints`` orbit poses of a benchmark scene (tools/label_scenes.py) once, keeping the values the
    default HDF5 file receives (packed targets: float32 depth, octahedral normal codes, narrowed ids, the JSON
    records), then discards the renderer.
 2. Stages: writes them ``--rounds`` times per ``--compression`` (alternating) with ``Hdf5SingleFileWriter`` (file
@@ -21,21 +21,21 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 import tempfile
 import time
 from collections import defaultdict
 from pathlib import Path
 from typing import Any, Callable
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+from harness import Stopwatch, accumulating, alternating
 
 
 def capture(scene_name: str, resolution: str, count: int,
             plain: bool = False) -> tuple[tuple[Any, ...], list[dict[str, Any]]]:
     """``(begin arguments, per-keypoint values)`` a default HDF5 file receives for ``count`` orbit poses
     (``plain``: the documented dtypes the renderer makes for a sink that stores nothing encoded)."""
-    import bench_scenes as bs
+    import label_scenes as bs
+    from stored_forms import default_file_encodings
 
     import hybridgen as hg
     from hybridgen.render.keypoint_loop import run_keypoints
@@ -55,11 +55,7 @@ def capture(scene_name: str, resolution: str, count: int,
             self.begun: tuple[Any, ...] = ()
 
         def begin(self, n: int, layouts: list[Any], records: dict[str, Any], attributes: dict[str, Any]) -> None:
-            with tempfile.TemporaryDirectory() as tmp:
-                probe = hg.Hdf5SingleFileWriter(Path(tmp) / "probe.hdf5")
-                probe.begin(n, layouts, records, attributes)
-                self.tags = {} if plain else probe.accepted_encodings()
-                probe.abort()
+            self.tags = {} if plain else default_file_encodings(n, layouts, records, attributes)
             self.begun = (n, layouts, records, attributes)
 
         def accepted_encodings(self) -> dict[str, str]:
@@ -83,16 +79,10 @@ def stages(begun: tuple[Any, ...], values: list[dict[str, Any]], rounds: int, co
     import hybridgen as hg
     import hybridgen.io.hdf5_single as hs
 
-    spent: dict[str, float] = defaultdict(float)
+    spent: dict[str, float] = {}
 
     def timed(name: str, function: Callable[..., Any]) -> Callable[..., Any]:
-        def wrapper(*args: Any, **kwargs: Any) -> Any:
-            start = time.thread_time()
-            try:
-                return function(*args, **kwargs)
-            finally:
-                spent[name] += time.thread_time() - start
-        return wrapper
+        return accumulating(spent, name, function, time.thread_time)
 
     hs.shuffled = timed("shuffle (pool)", hs.shuffled)
     hs.deflate = timed("deflate (pool)", hs.deflate)
@@ -105,11 +95,11 @@ def stages(begun: tuple[Any, ...], values: list[dict[str, Any]], rounds: int, co
     per_round: dict[str, dict[str, list[float]]] = {c: defaultdict(list) for c in compressions}
     size: dict[str, int] = {}
     for r in range(rounds + 1):  # round 0 untimed: imports (blosc2 ~0.2 s), first allocations
-        for compression in (compressions if r % 2 == 0 else compressions[::-1]):
+        for compression in alternating(compressions, r):
             spent.clear()
             with tempfile.TemporaryDirectory() as tmp:
                 path = Path(tmp) / "data.hdf5"
-                cpu, wall = time.process_time(), time.perf_counter()
+                watch = Stopwatch()
                 writer = hg.Hdf5SingleFileWriter(path, compression=compression)
                 writer.begin(n, layouts, records, attributes)
                 for index, value in enumerate(values):
@@ -117,8 +107,9 @@ def stages(begun: tuple[Any, ...], values: list[dict[str, Any]], rounds: int, co
                 writer.finalize({})
                 if r == 0:
                     continue
-                per_round[compression]["process CPU (all threads)"].append(time.process_time() - cpu)
-                per_round[compression]["wall"].append(time.perf_counter() - wall)
+                wall, cpu = watch.read()
+                per_round[compression]["process CPU (all threads)"].append(cpu)
+                per_round[compression]["wall"].append(wall)
                 size[compression] = path.stat().st_size
             for name, seconds in spent.items():
                 per_round[compression][name].append(seconds)

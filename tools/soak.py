@@ -7,19 +7,13 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
-
-
-def rss_mb() -> float:
-    """Resident set size of this process, MB (Linux /proc)."""
-    with open("/proc/self/statm") as handle:
-        return int(handle.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2 ** 20
+from harness import rss_mib
 
 
 def soak_scene(width: int, height: int, keypoints: int):  # type: ignore[no-untyped-def]
@@ -53,7 +47,7 @@ class MemoryCurve:
     def update(self, n: int) -> None:
         self.count += n
         if self.count % self.every == 0:
-            self.samples.append((self.what, self.count, rss_mb()))
+            self.samples.append((self.what, self.count, rss_mib()[0]))
 
     def close(self) -> None:
         pass

@@ -1,4 +1,5 @@
-"""Deterministic benchmark scenes shared by the tools (meshes in world coordinates, camera poses).
+"""Deterministic scenes of the label benchmarks (tools/bench_labels.py, bench_writer.py, bench_startup.py):
+meshes in world coordinates, orbit camera poses, intrinsics (metres, radians, pixels).
 
 The real meshes come from the ``pybullet`` wheel (its ``pybullet_data`` folder): ``pip install pybullet``.
 """
