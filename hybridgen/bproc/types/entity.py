@@ -22,15 +22,15 @@ from .struct import Struct
 
 def vector3(value: Any, what: str) -> np.ndarray:
     """A finite 3-vector as float64 (one line naming ``what`` otherwise)."""
-    array = np.asarray(value, dtype=np.float64).reshape(-1)
+    array = np.array(value, dtype=np.float64).reshape(-1)  # a copy: the caller may change its array later
     if array.shape != (3,) or not np.all(np.isfinite(array)):
         raise InputError(f"{what} must be 3 finite numbers, got {np.asarray(value).tolist()}")
     return array
 
 
 def matrix4(value: Any, what: str) -> np.ndarray:
-    """A finite 4x4 matrix as float64."""
-    array = np.asarray(value, dtype=np.float64)
+    """A finite 4x4 matrix as float64 (a copy: the caller may change its array later)."""
+    array = np.array(value, dtype=np.float64)
     if array.shape != (4, 4) or not np.all(np.isfinite(array)):
         raise InputError(f"{what} must be a finite 4x4 matrix, got shape {array.shape}")
     return array
