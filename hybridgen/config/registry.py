@@ -28,6 +28,7 @@ ENTRY_POINT_GROUP = "hybridgen.modules"
 _BUILTIN_NAMES = {
     "main.Initializer": "hybridgen.modules.main_initializer",
     "loader.ObjLoader": "hybridgen.modules.obj_loader",
+    "loader.BlendLoader": "hybridgen.modules.blend_loader",
     "loader.PrimitiveLoader": "hybridgen.modules.primitive_loader",
     "camera.CameraLoader": "hybridgen.modules.camera_loader",
     "camera.CameraSampler": "hybridgen.modules.camera_sampler",

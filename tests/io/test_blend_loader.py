@@ -88,3 +88,31 @@ def test_a_blend_scene_reads_as_blender_shows_it(fixture_blend):
 def test_object_types_and_name_pattern(fixture_blend):
     content = blend_loader.load_blend(fixture_blend, obj_types=["mesh"], entities="Gr.*")
     assert [o.name for o in content.objects] == ["Ground"] and not content.lights and not content.empties
+
+
+CONFIG = """{"version": 3, "setup": {"blender_install_path": "/opt/blender/"}, "modules": [
+  {"module": "main.Initializer", "config": {"global": {"output_dir": "<args:1>"}}},
+  {"module": "loader.BlendLoader", "config": {"path": "<args:0>", "obj_types": ["mesh", "light"],
+                                              "add_properties": {"cp_source": "blend"}}},
+  {"module": "camera.CameraLoader", "config": {"intrinsics": {"fov": 0.5, "resolution_x": 32, "resolution_y": 24},
+     "cam_poses": [{"location": [0, 0, 8], "rotation": {"value": [0, 0, 0]}}]}},
+  {"module": "renderer.SegMapRenderer", "config": {"map_by": ["instance", "class"]}},
+  {"module": "writer.Hdf5Writer", "config": {}}
+]}"""
+
+
+@needs_bpy
+def test_blenderprocs_blend_loader_module(fixture_blend, tmp_path):
+    import h5py
+
+    from hybridgen.run.pipeline import run_config
+
+    config = tmp_path / "config.yaml"
+    config.write_text(CONFIG)
+    run_config(config, [str(fixture_blend), str(tmp_path / "out")])
+    with h5py.File(tmp_path / "out" / "0.hdf5") as f:
+        segmap = f["segmap"][()]
+        states = {o["name"]: o for o in __import__("json").loads(f["object_states"][()])}
+    # looking straight down from 8 m: the box's top (2 m high, class 7) in the middle, the ground around it
+    assert segmap[12, 16, 1] == 7 and segmap[0, 0, 1] == 1
+    assert states["Box"]["source"] == "blend" and states["Box"]["category_id"] == 7

@@ -22,7 +22,6 @@ ALIASES = {
 _EXPORT = "export the scene to glTF/GLB or OBJ (e.g. with Blender: File > Export) and load it with loader.ObjLoader"
 _DATASET = "convert its meshes to OBJ/glTF/PLY and load them with loader.ObjLoader"
 UNAVAILABLE = {
-    "loader.BlendLoader": f"reading .blend files needs Blender; {_EXPORT}",
     "loader.SuncgLoader": f"the SUNCG dataset was withdrawn by its authors and is not distributed; {_DATASET}",
     "lighting.SuncgLighting": "lights SUNCG scenes, a dataset that was withdrawn; use lighting.SurfaceLighting "
                               "with a selector for the lamp objects",
