@@ -1,7 +1,8 @@
-"""Blender Cycles worker for tools/bench_color.py: renders an exported scene keypoint by keypoint, on request.
+"""Blender Cycles worker for the color benchmarks: renders an exported scene (tools/cycles_export.py) keypoint by
+keypoint, on request.
 
 Runs inside its own virtual environment (``bpy`` from PyPI needs Python 3.11 and numpy < 2), started by
-bench_color.py, which creates ``.venv-bpy`` on demand::
+tools/cycles_worker.py, which creates ``.venv-bpy`` on demand::
 
     .venv-bpy/bin/python tools/cycles_render.py SCENE.npz
 
