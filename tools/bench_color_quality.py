@@ -47,13 +47,12 @@ from typing import Any, Callable
 
 import numpy as np
 from color_lobes import LOBES, lobes_name
-from color_quality import SCENES, build
-from color_references import CLAMP, References
-from cycles_export import export_for_cycles
+from color_quality import SCENES
+from color_references import CLAMP, References, scene_and_content
 from cycles_worker import CyclesSession, ensure_bpy_venv
 from harness import Table, alternating, host_cpu, paired_ratio, paired_ratios, run_process
 from image_scores import psnr, read_png
-from reference_cache import ReferenceCache, cache_root, scene_digest
+from reference_cache import ReferenceCache, cache_root
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -225,10 +224,7 @@ def run_quality(args: Any, bpy_python: Path | None) -> list[dict[str, Any]]:
     rows = []
     try:
         for name in args.scenes.split(",") if args.scenes else SCENES:
-            scene = build(name, width, height, workdir)
-            npz = workdir / f"{name}.npz"
-            export_for_cycles(scene, npz, 1024, 3, 0, threads=args.threads)
-            content = scene_digest(npz)
+            scene, npz, content = scene_and_content(name, width, height, workdir, threads=args.threads)
             session = CyclesSession(bpy_python, npz) if bpy_python is not None else None
             try:
                 if args.precompute:

@@ -46,8 +46,8 @@ _PATCHES = {
 }
 _CHILD = ("import json, resource, sys, time; {patch}; from hybridgen.cli import main; "
           "t = time.perf_counter(); c = time.process_time(); rc = main(['run', '-q', sys.argv[1], sys.argv[2]]); "
-          "print(json.dumps({'wall': time.perf_counter() - t, 'cpu': time.process_time() - c, "
-          "'rss_kib': resource.getrusage(resource.RUSAGE_SELF).ru_maxrss})); sys.exit(rc)")
+          "print(json.dumps({{'wall': time.perf_counter() - t, 'cpu': time.process_time() - c, "
+          "'rss_kib': resource.getrusage(resource.RUSAGE_SELF).ru_maxrss}})); sys.exit(rc)")
 
 
 def config_text(scenes: int, width: int, height: int, keypoints: int) -> str:

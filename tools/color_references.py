@@ -12,9 +12,11 @@ from typing import Any
 
 import numpy as np
 from color_lobes import LOBES
+from color_quality import build
+from cycles_export import export_for_cycles
 from cycles_worker import CyclesSession, bpy_version
 from image_scores import read_png
-from reference_cache import ReferenceCache, code_digest, estimator_digest
+from reference_cache import ReferenceCache, code_digest, estimator_digest, scene_digest
 
 REPO = Path(__file__).resolve().parents[1]
 REFERENCE_SEED = 12345
@@ -37,6 +39,17 @@ def hybridgen_reference(scene: Any, spp: int, clamp: float, lobes: dict[str, int
     view = PathTraceView(scene, PathTraceSettings(samples=spp, clamp_indirect=clamp, **(lobes or {})))
     image = view.render(scene.camera.keypoints[0], seed=seed)
     return to_srgb8(image), time.perf_counter() - start
+
+
+def scene_and_content(name: str, width: int, height: int, workdir: Path,
+                      threads: int | None = None) -> tuple[Any, Path, str]:
+    """Scene ``name`` of tools/color_quality.py at ``width`` x ``height`` px, its export for Cycles
+    (``workdir/<name>.npz``: BlenderProc's 1024 spp and 3 bounces, ``threads`` render threads) and the export's
+    content digest, which keys both engines' references."""
+    scene = build(name, width, height, workdir)
+    npz = workdir / f"{name}.npz"
+    export_for_cycles(scene, npz, 1024, 3, 0, threads=threads)
+    return scene, npz, scene_digest(npz)
 
 
 class References:
@@ -66,6 +79,11 @@ class References:
             return image, {"seconds": seconds}
 
         return self.cache.fetch("hybridgen", key, render)
+
+    def hybridgen_pair(self, name: str, scene: Any, content: str) -> tuple[np.ndarray, np.ndarray]:
+        """hybridgen's reference at the default clamp and a second, independent one (:data:`SECOND_SEED`)."""
+        return (self.hybridgen(name, scene, content, CLAMP)[0],
+                self.hybridgen(name, scene, content, CLAMP, seed=SECOND_SEED)[0])
 
     def cycles(self, name: str, content: str, session: CyclesSession) -> tuple[np.ndarray, dict[str, Any]]:
         """Cycles' reference (BlenderProc's estimator at a fixed spp, ``mode: reference``) and its record."""

@@ -30,13 +30,11 @@ from typing import Any
 
 import numpy as np
 from color_lobes import LOBES
-from color_quality import build
-from color_references import CLAMP, SECOND_SEED, References
-from cycles_export import export_for_cycles
+from color_references import References, scene_and_content
 from default_color import default_render
 from harness import Table, cpu_seconds
 from image_scores import db, mse
-from reference_cache import ReferenceCache, cache_root, scene_digest
+from reference_cache import ReferenceCache, cache_root
 
 PATH_CLASSES = {"all paths": {}, "direct only": {"max_bounces": 0}, "no glossy bounce": {"glossy_bounces": 0},
                 "no transmission bounce": {"transmission_bounces": 0}}
@@ -99,15 +97,11 @@ def main() -> None:
     resolution = f"{width}x{height}"
     workdir = Path(tempfile.mkdtemp(prefix="color_regions_"))
     refs = References(ReferenceCache(cache_root(args.reference_cache)), args.reference_spp, resolution, args.lobes,
-                         None, workdir)
+                      None, workdir)
     base = {"noise_threshold": args.threshold, **LOBES[args.lobes]}
     for name in args.scenes.split(","):
-        scene = build(name, width, height, workdir)
-        npz = workdir / f"{name}.npz"
-        export_for_cycles(scene, npz, 1024, 3, 0)
-        content = scene_digest(npz)
-        ref1, _ = refs.hybridgen(name, scene, content, CLAMP)
-        ref2, _ = refs.hybridgen(name, scene, content, CLAMP, seed=SECOND_SEED)
+        scene, _, content = scene_and_content(name, width, height, workdir)
+        ref1, ref2 = refs.hybridgen_pair(name, scene, content)
         ids, names = object_map(scene)
         run = default_render(scene, PathTraceSettings(**base))
         counts = run["counts"].ravel()

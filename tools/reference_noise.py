@@ -26,12 +26,11 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from color_quality import SCENES, build
-from color_references import CLAMP, REFERENCE_SEED, SECOND_SEED, References
-from cycles_export import export_for_cycles
+from color_quality import SCENES
+from color_references import REFERENCE_SEED, SECOND_SEED, References, scene_and_content
 from default_color import default_render
 from image_scores import db, mse
-from reference_cache import ReferenceCache, cache_root, scene_digest
+from reference_cache import ReferenceCache, cache_root
 
 
 def main() -> None:
@@ -47,17 +46,13 @@ def main() -> None:
     resolution = f"{width}x{height}"
     workdir = Path(tempfile.mkdtemp(prefix="reference_noise_"))
     refs = References(ReferenceCache(cache_root(args.reference_cache)), args.reference_spp, resolution, "default",
-                         None, workdir)
+                      None, workdir)
     print(f"{resolution}, references {args.reference_spp} spp (seeds {REFERENCE_SEED}, {SECOND_SEED})\n")
     print("| scene | ref floor MSE (ceiling dB) | default dB vs ref1 / ref2 / mean | own MSE | own share |")
     print("|---|---|---|---|---|")
     for name in args.scenes.split(",") if args.scenes else SCENES:
-        scene = build(name, width, height, workdir)
-        npz = workdir / f"{name}.npz"
-        export_for_cycles(scene, npz, 1024, 3, 0)
-        content = scene_digest(npz)
-        ref1, _ = refs.hybridgen(name, scene, content, CLAMP)
-        ref2, _ = refs.hybridgen(name, scene, content, CLAMP, seed=SECOND_SEED)
+        scene, _, content = scene_and_content(name, width, height, workdir)
+        ref1, ref2 = refs.hybridgen_pair(name, scene, content)
         image = default_render(scene, PathTraceSettings())["denoised"]
         floor = mse(ref1, ref2) / 2
         measured = mse(image, ref1)
