@@ -1,5 +1,8 @@
 """Color rendering: hybridgen vs a bare Mitsuba script on the same scene, and vs Blender Cycles (one run).
 
+Over 300 lines: the bare script, the interleaving sink and the report of one run that times all three engines
+keypoint by keypoint; Cycles lives in cycles_export.py / cycles_worker.py, timing and tables in harness.py.
+
 Run: .venv/bin/python tools/bench_color.py [--res 640x480] [--spp 64] [--bounces 6] [--no-cycles] [--quick]
      .venv/bin/python tools/bench_color.py --quality [--res 320x240] [--reference-spp 4096] [--scenes a,b]
          (defaults vs Cycles at BlenderProc's defaults, the issue's settings: runs tools/bench_color_quality.py
@@ -419,8 +422,8 @@ def main() -> None:
         cells = []
         for row in (sink.rows[i], bare_rows[i]):
             k = row["kernels"]
-            cells += [row["wall"], row["cpu"] / row["wall"], f"{k['launched']:2d} ({k['compiled']}, {k['compile_s']:5.2f})",
-                      row["rss"][0]]
+            kernels = f"{k['launched']:2d} ({k['compiled']}, {k['compile_s']:5.2f})"
+            cells += [row["wall"], row["cpu"] / row["wall"], kernels, row["rss"][0]]
         table.row(i, *cells, sink.rows[i]["wall"] / bare_rows[i]["wall"])
     steady_ours, steady_bare = statistics.median(ours[1:]), statistics.median(theirs[1:])
     paired = paired_ratio(ours[1:], theirs[1:])

@@ -1,6 +1,9 @@
 """Color quality: hybridgen's default color vs Blender Cycles at BlenderProc 2.8's defaults, each scored against
 its own converged reference, on the four scenes of tools/color_quality.py.
 
+Over 300 lines: the whole-process runs, their pairing with Cycles, the rows and the table of one benchmark; scenes,
+references and Cycles are in color_quality.py, color_references.py and cycles_*.py.
+
 Run: .venv/bin/python tools/bench_color_quality.py   (the issue's settings: 320x240, 4096-spp references)
      .venv/bin/python tools/bench_color_quality.py [--res 160x120] [--reference-spp 2048] [--scenes a,b]
      nice -n 10 .venv/bin/python tools/bench_color_quality.py --precompute cycles   (only fill the cache)

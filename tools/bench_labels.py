@@ -1,5 +1,8 @@
 """Label throughput: hybridgen's raster pass vs pyrender, and end to end with HDF5 writing.
 
+Over 300 lines: the two engines' worker processes and the four tables they answer (whole processes, raw vs end to
+end, raster vs pyrender, agreement) are one benchmark; its helpers live in label_*.py, stored_forms.py, harness.py.
+
 Run: .venv/bin/python tools/bench_labels.py [--frames 8] [--rounds 5] [--quick] [--breakdown]
      .venv/bin/python tools/bench_labels.py --e2e-only [--e2e-keypoints 120] [--baseline OTHER_CHECKOUT]
 Needs the ``bench`` extras (pyrender, pybullet for the real meshes, embreex for ``--check``).
@@ -333,7 +336,8 @@ def whole_process_table(names: list[str], resolutions: list[str], count: int, ro
                             e2es.append(ask("ours", "hdf5", name, resolution, e2e_keypoints, "default")[0])
                 raw, e2e = statistics.median(raws), statistics.median(e2es)
                 table.row(name, resolution, raw, e2e, e2e / raw, count / med["ours"], count / med["theirs"],
-                          med["theirs"] / med["ours"], statistics.median(cpu["theirs"]) / statistics.median(cpu["ours"]),
+                          med["theirs"] / med["ours"],
+                          statistics.median(cpu["theirs"]) / statistics.median(cpu["ours"]),
                           size / count / 1e6, med["ours1"], cold, med["theirs1"])
                 if render_threads > 1:
                     print(f"{'':<20} {'':<10} render_threads {render_threads}: run fps {count / med['threads']:.1f}, "

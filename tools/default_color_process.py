@@ -1,6 +1,7 @@
 """One scene of tools/color_quality.py rendered with hybridgen's default color, as a whole user process.
 
-Run by tools/bench_color_quality.py and tools/color_process_ab.py (``.venv/bin/python tools/default_color_process.py SCENE WxH OUT.png WORKDIR``), which
+Run by tools/bench_color_quality.py and tools/color_process_ab.py
+(``.venv/bin/python tools/default_color_process.py SCENE WxH OUT.png WORKDIR``), which
 times this process from spawn to exit, wall clock and CPU (its rusage, children included): Python's start,
 ``import hybridgen``, building the scene (meshes read through hybridgen's loaders), Mitsuba's start and the
 variant probe, kernels (from the Dr.Jit cache the parent points ``DRJIT_CACHE_DIR`` at), raster guides, the

@@ -8,7 +8,8 @@ reference is noisy too, and its noise adds to the measured squared error whateve
 ``MSE(image, ref) = MSE(image, truth) + MSE(ref, truth)`` for independent errors. This tool renders (or finds in
 the reference cache of tools/reference_cache.py) the benchmark's hybridgen reference (seed 12345) and a second
 one at another seed (tools/color_references.py), and hybridgen's default color in this process
-(``PathTraceSettings()`` + denoising, as tools/default_color_process.py, seed 1: tools/default_color.py). Per scene it prints (8-bit sRGB, as the benchmark):
+(``PathTraceSettings()`` + denoising, as tools/default_color_process.py, seed 1: tools/default_color.py). Per
+scene it prints (8-bit sRGB, as the benchmark):
 
 - ``ref floor``: each reference's own squared error, ``MSE(ref1, ref2) / 2``, and the PSNR a perfect image
   would score against it (the benchmark's ceiling for that engine's estimator);
