@@ -22,8 +22,12 @@ def gl_context():
 
 
 @pytest.fixture
-def run_cli(capsys: pytest.CaptureFixture[str]) -> Callable[..., tuple[int, str, str]]:
-    """Run the CLI in-process; returns (exit status, stdout, stderr)."""
+def run_cli(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> Callable[..., tuple[int, str, str]]:
+    """Run the CLI in-process; returns (exit status, stdout, stderr). The environment variables a run sets for its
+    worker processes (``--lenient``, ``--strict``) are restored after the test, as a new process would start."""
+    for name in ("HYBRIDGEN_LENIENT", "HYBRIDGEN_STRICT"):  # absent now and after the test (restored at teardown)
+        monkeypatch.setenv(name, "")
+        monkeypatch.delenv(name)
 
     def run(*argv: str) -> tuple[int, str, str]:
         try:

@@ -6,6 +6,7 @@ from typing import Any, Iterable, Sequence
 import numpy as np
 
 from ..io.frame_sink import FrameSink, PassLayout
+from ..io.texture_needs import require_base_colors
 from ..scene.scene import Scene
 from .pathtrace.denoise import denoise as oidn_denoise
 from .pathtrace.denoise import require_oidn
@@ -125,7 +126,9 @@ def render_color(scene: Scene, sinks: Iterable[FrameSink], settings: PathTraceSe
                  default_category_id: int | None = None, progress: ProgressFactory | None = None,
                  indices: Sequence[int] | None = None, keep_raw: bool = False, sample_counts: bool = False) -> int:
     """Color (and ``labels`` if given) of every keypoint, as left/right pairs when ``stereo_baseline`` (m).
-    ``keep_raw`` and ``sample_counts`` as in :class:`ColorProducer`."""
+    ``keep_raw`` and ``sample_counts`` as in :class:`ColorProducer`. Stops with one line when a base-color texture a
+    mesh names is missing (:func:`hybridgen.io.texture_needs.require_base_colors`; ``--lenient``: a notice)."""
+    require_base_colors(scene.objects)
     sinks = list(sinks)
     producers: list[Producer] = []
     raster = None  # one raster view for labels and denoising guides (guides alone: ColorProducer's own thread)

@@ -115,3 +115,25 @@ def test_color_run_whose_config_overrides_the_base_color(gl_context, tmp_path, r
         images.append(_read(out)["colors"])
     np.testing.assert_array_equal(images[0], images[1])
     assert images[1][0].reshape(-1, 3).mean(axis=0).argmax() == 2  # blue-ish (0.2, 0.5, 0.7), not the texture
+
+
+def test_the_python_api_stops_on_a_missing_diffuse_map_too(gl_context, tmp_path):
+    """hg.render_color (and render_labels with albedo) check the base-color textures themselves: a script that
+    calls them (the bproc layer does) gets the same one line as a config run; labels without albedo go on."""
+    import pytest
+
+    import hybridgen as hg
+
+    mesh = _scene(tmp_path / "mesh", "newmtl wood\nmap_Kd wood.png\n")
+    scene = hg.Scene()
+    for obj in hg.load_objects(mesh, category_id=3):
+        scene.add(obj)
+    scene.camera.intrinsics = hg.Intrinsics.from_fov(0.9, 24, 16)
+    scene.camera.add_keypoint(hg.look_at([0, -0.5, 1.5], [0, 0, 0]))
+    with pytest.raises(hg.InputError, match="wood.png"):
+        hg.render_color(scene, [hg.MemorySink()], hg.PathTraceSettings(samples=2))
+    with pytest.raises(hg.InputError, match="wood.png"):
+        hg.render_labels(scene, [hg.MemorySink()], hg.LabelRequest(albedo=True))
+    sink = hg.MemorySink()
+    assert hg.render_labels(scene, [sink], hg.LabelRequest(depth=True)) == 1
+    assert np.isfinite(sink.frames[0]["depth"]).any()

@@ -4,6 +4,7 @@ from __future__ import annotations
 from typing import Any, Iterable, Sequence
 
 from ...io.frame_sink import FrameSink
+from ...io.texture_needs import require_base_colors
 from ...scene.scene import Scene
 from ..keypoint_loop import ProgressFactory, run_keypoints
 from .label_producer import LabelProducer
@@ -23,6 +24,8 @@ def render_labels(scene: Scene, sinks: Iterable[FrameSink], request: LabelReques
     then unused)."""
     sinks = list(sinks)
     request = (request or LabelRequest()).with_sinks(sinks)
+    if request.albedo:  # the albedo pass shows base colors: their textures must exist (io/texture_needs.py)
+        require_base_colors(scene.objects)
     producer: Any
     if render_threads > 1:
         from .threaded_labels import ThreadedLabelProducer
