@@ -34,7 +34,7 @@ from .coco_content import annotation, coco_file, load_coco_file
 from ..render.passes import hint
 from .frame_sink import PassLayout
 from .image_files import StagedFiles, color_format_option, jpeg_bytes, jpg_quality_option, png_bytes, write_file
-from .mask_encoding import bbox_of, mask_to_polygons, require_pycocotools, rle_compressed
+from .mask_encoding import bbox_of, mask_to_polygons, require_pycocotools, rle_compressed, rle_uncompressed
 from .output_lock import hold_output_lock
 
 ANNOTATIONS_FILE = "coco_annotations.json"
@@ -111,14 +111,22 @@ class CocoWriter:
 
     Needs per keypoint the image key and ``instance_segmaps`` + ``instance_attribute_maps``, from one or
     several renderers. :meth:`finalize` commits, :meth:`abort` drops everything staged.
+
+    Subclasses may change the JSON's form (BlenderProc 2's ``write_coco_annotations``,
+    :mod:`hybridgen.bproc.coco_writer`): ``compressed_rle``, ``indent``, :meth:`_category_name`, :meth:`_content`.
     """
+
+    compressed_rle = True
+    """RLE masks as pycocotools' compressed strings; False: uncompressed run lists (no pycocotools needed)."""
+    indent: int | str | None = None
+    """The JSON file's indent (``json.dumps``); None: compact."""
 
     def __init__(self, output_dir: str | Path, options: CocoOptions | None = None, **given: Any) -> None:
         """``options`` (validated where they were made), or the options ``given`` by name (validated here)."""
         if options is not None and given:
             raise TypeError("give CocoWriter either options or single options, not both")
         opts = options if options is not None else checked_options(CocoOptions, **given)
-        if opts.mask_encoding == "rle":
+        if opts.mask_encoding == "rle" and self.compressed_rle:
             require_pycocotools()
         self.label_mapping = load_label_mapping(opts.label_mapping)
         self.output_dir = prepare_output_dir(Path(output_dir))
@@ -196,7 +204,7 @@ class CocoWriter:
             raise InputError(f"COCO annotations need {missing} for every keypoint: " + "; ".join(sorted(hints)))
         content = self._content()
         self._staged.commit()
-        write_file(self.path, json.dumps(content).encode("utf-8"), durable=True)
+        write_file(self.path, json.dumps(content, indent=self.indent).encode("utf-8"), durable=True)
         self._unlock()
         return [self.path]
 
@@ -238,16 +246,26 @@ class CocoWriter:
         if category == 0 or not self._included(record):
             return None
         if category not in self.categories:
-            if self.label_mapping is not None:
-                if category not in self.label_mapping:
-                    raise InputError(f"label_mapping has no name for category_id {category} (object "
-                                     f"'{record.get('name')}')")
-                name = self.label_mapping[category]
-            else:
-                name = str(record.get("name", category))
+            name = self._category_name(record, category)
             supercategory = record.get("bop_dataset_name", record.get("supercategory", DEFAULT_SUPERCATEGORY))
             self.categories[category] = {"id": category, "name": name, "supercategory": supercategory}
         return category
+
+    def _category_name(self, record: dict[str, Any], category: int) -> Any:
+        """The name of ``category``, first seen on the object of ``record``: the label mapping's, else the
+        object's ``name``, else the id as text."""
+        if self.label_mapping is not None:
+            if category not in self.label_mapping:
+                raise InputError(f"label_mapping has no name for category_id {category} (object "
+                                 f"'{record.get('name')}')")
+            return self.label_mapping[category]
+        return str(record.get("name", category))
+
+    def _segmentation(self, mask: np.ndarray) -> Any:
+        """The COCO segmentation of one instance's mask in this writer's encoding."""
+        if self.mask_encoding == "polygon":
+            return mask_to_polygons(mask)
+        return rle_compressed(mask) if self.compressed_rle else rle_uncompressed(mask)
 
     def _annotate(self, image_id: int, instance: np.ndarray, records: list[dict[str, Any]]) -> list[dict[str, Any]]:
         """Annotations (without ids) of one keypoint's visible instances, by instance id."""
@@ -266,11 +284,7 @@ class CocoWriter:
             if category is None:
                 continue
             mask = instance == idx
-            if self.mask_encoding == "rle":
-                segmentation: Any = rle_compressed(mask)
-            else:
-                segmentation = mask_to_polygons(mask)
-            out.append(annotation(image_id, category, int(counts[idx]), bbox_of(mask), segmentation,
+            out.append(annotation(image_id, category, int(counts[idx]), bbox_of(mask), self._segmentation(mask),
                                   width=mask.shape[1], height=mask.shape[0]))
         return out
 
