@@ -62,3 +62,4 @@ def write_hdf5(output_dir_path: str, output_data_dict: dict[str, Any], append_to
 
 
 __getattr__ = module_getattr("writer", ["write_bop", "write_coco_annotations", "write_gif_animation"])
+from .file_writers import write_bop, write_coco_annotations, write_gif_animation  # noqa: E402,F401
