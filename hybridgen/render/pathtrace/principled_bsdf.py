@@ -1,0 +1,202 @@
+"""hybridgen's Principled BSDF: Blender 4.2's Principled BSDF (what BlenderProc 2.8 renders with) as a Mitsuba 3
+plugin, :data:`PLUGIN_NAME`.
+
+Inputs carry Blender's names (docs/principled_bsdf.md lists them with their ranges): ``base_color`` (texture),
+``roughness``, ``metallic``, ``specular`` (Specular IOR Level; each a value or a texture), ``specular_tint``
+(RGB), ``ior``, ``transmission``, ``anisotropic``, ``anisotropic_rotation`` (turns of the tangent, Mitsuba's
+dP/du direction, around the normal), ``coat_weight``, ``coat_roughness``, ``coat_ior``, ``coat_tint`` (RGB).
+Roughness maps to GGX alpha = roughness^2 as in Blender. The layering is :mod:`.principled_layers`', the lobes
+:mod:`.principled_lobes`'. The BSDF is two-sided as Blender's: a hit from the back is shaded as from the
+front with the normal flipped, except that transmission then leaves the solid (relative IOR 1/IOR). Emission
+stays the scene's area emitter and alpha the ``mask`` wrapper (:mod:`.mitsuba_materials`).
+
+Sampling picks one lobe with probability proportional to its estimated albedo (Cycles' sample weights, plus
+:data:`~.principled_layers.MIN_LOBE_SHARE`), draws a direction from it (visible GGX normals, or a cosine
+lobe for the diffuse base) and returns the whole BSDF's value over the whole mixture's pdf, so ``sample``,
+``eval``, ``pdf`` and ``eval_pdf`` agree exactly. The BSDF answers ``has_attribute`` / ``eval_attribute_1``
+for ``roughness``, ``metallic`` and ``spec_trans`` (the transmission weight) as Mitsuba's ``principled`` does,
+which the path tracer's singular-surface test reads.
+
+Registered per JIT variant by :func:`register`. In ``scalar_rgb`` hybridgen keeps Mitsuba's ``principled``
+(a Python BSDF there would be called once per ray from C++; see :func:`available`).
+"""
+from __future__ import annotations
+
+from functools import lru_cache
+from typing import Any
+
+from .mitsuba_variant import is_jit
+
+PLUGIN_NAME = "hybridgen_principled"
+
+
+def available(variant: str) -> bool:
+    """Whether hybridgen renders its Principled BSDF in ``variant`` (the JIT variants), registering it there."""
+    if not variant or not is_jit(variant):
+        return False
+    register(variant)
+    return True
+
+
+def _flags() -> Any:
+    import mitsuba as mi
+
+    return mi.BSDFFlags
+
+
+@lru_cache(maxsize=None)
+def register(variant: str) -> None:
+    """Register :data:`PLUGIN_NAME` for ``variant`` (the active variant)."""
+    import drjit as dr
+    import mitsuba as mi
+
+    from . import principled_layers as layers_mod
+
+    flags = _flags()
+    both = flags.FrontSide | flags.BackSide
+
+    def value_or_texture(props: Any, name: str, default: float) -> Any:
+        value = props.get(name, default)
+        return value if isinstance(value, mi.Texture) else float(value)
+
+    def read(value: Any, si: Any, active: Any) -> Any:
+        return value.eval_1(si, active) if isinstance(value, mi.Texture) else mi.Float(value)
+
+    def color(props: Any, name: str) -> Any:
+        value = props.get(name, 1.0)
+        return mi.ScalarColor3f(value) if not isinstance(value, (int, float)) else mi.ScalarColor3f(float(value))
+
+    class PrincipledBSDF(mi.BSDF):  # type: ignore[misc, name-defined]
+        def __init__(self, props: Any) -> None:
+            super().__init__(props)
+            self.base_color = props.get("base_color")
+            if not isinstance(self.base_color, mi.Texture):
+                self.base_color = mi.load_dict({"type": "rgb", "value": list(color(props, "base_color"))})
+            self.roughness = value_or_texture(props, "roughness", 0.5)
+            self.metallic = value_or_texture(props, "metallic", 0.0)
+            self.specular = value_or_texture(props, "specular", 0.5)
+            self.ior = float(props.get("ior", 1.5))
+            self.spec_tint = color(props, "specular_tint")
+            self.transmission = float(props.get("transmission", 0.0))
+            self.aspect = (1.0 - 0.9 * min(max(float(props.get("anisotropic", 0.0)), 0.0), 1.0)) ** 0.5
+            self.rotation = float(props.get("anisotropic_rotation", 0.0))
+            self.coat = max(float(props.get("coat_weight", 0.0)), 0.0)
+            self.coat_rough = min(max(float(props.get("coat_roughness", 0.03)), 0.0), 1.0)
+            self.coat_ior = max(float(props.get("coat_ior", 1.5)), 1.0)
+            self.coat_tint = color(props, "coat_tint")
+            lobe = flags.GlossyReflection | both
+            self.m_components = [flags.DiffuseReflection | both, lobe]
+            if self.transmission > 0:
+                self.m_components.append(flags.GlossyTransmission | flags.NonSymmetric | both)
+            self.m_flags = flags.Empty
+            for component in self.m_components:
+                self.m_flags = self.m_flags | component
+
+        def _inputs(self, si: Any, active: Any) -> Any:
+            return layers_mod.Inputs(
+                base=self.base_color.eval(si, active), rough=dr.clip(read(self.roughness, si, active), 0.0, 1.0),
+                metallic=dr.clip(read(self.metallic, si, active), 0.0, 1.0),
+                level=dr.maximum(read(self.specular, si, active), 0.0), ior=mi.Float(max(self.ior, 1e-5)),
+                spec_tint=mi.Color3f(self.spec_tint), transmission=mi.Float(min(max(self.transmission, 0.0), 1.0)),
+                aspect=mi.Float(self.aspect), coat=mi.Float(self.coat), coat_rough=mi.Float(self.coat_rough),
+                coat_ior=mi.Float(self.coat_ior), coat_tint=mi.Color3f(self.coat_tint), has_coat=self.coat > 0,
+                has_transmission=self.transmission > 0, has_coat_tint=any(c != 1.0 for c in self.coat_tint))
+
+        def _frame(self, si: Any) -> Any:
+            """Rotation of local directions into the anisotropy frame (the tangent turned by the rotation)."""
+            angle = 2.0 * dr.pi * self.rotation
+            return mi.Float(dr.cos(angle)), mi.Float(dr.sin(angle))
+
+        def _local(self, v: Any, flip: Any, rot: Any) -> Any:
+            c, s = rot
+            return mi.Vector3f(c * v.x + s * v.y, -s * v.x + c * v.y, dr.select(flip, -v.z, v.z))
+
+        def _world_local(self, v: Any, flip: Any, rot: Any) -> Any:
+            c, s = rot
+            return mi.Vector3f(c * v.x - s * v.y, s * v.x + c * v.y, dr.select(flip, -v.z, v.z))
+
+        def _setup(self, si: Any, active: Any) -> tuple[Any, Any, Any, Any, Any]:
+            flip = mi.Frame3f.cos_theta(si.wi) < 0.0
+            rot = self._frame(si)
+            wi = self._local(si.wi, flip, rot)
+            inp = self._inputs(si, active)
+            return inp, layers_mod.layers(inp, dr.maximum(wi.z, 1e-6), flip), wi, flip, rot
+
+        def eval_pdf(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> tuple[Any, Any]:
+            inp, lay, wi, flip, rot = self._setup(si, active)
+            value, pdf = layers_mod.eval_pdf(lay, wi, self._local(wo, flip, rot), inp.has_coat,
+                                             inp.has_transmission)
+            ok = active & (wi.z > 0.0)
+            return dr.select(ok, mi.Spectrum(value), 0.0), dr.select(ok, pdf, 0.0)
+
+        def eval(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> Any:
+            return self.eval_pdf(ctx, si, wo, active)[0]
+
+        def pdf(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> Any:
+            return self.eval_pdf(ctx, si, wo, active)[1]
+
+        def sample(self, ctx: Any, si: Any, sample1: Any, sample2: Any, active: Any = True) -> tuple[Any, Any]:
+            from . import principled_lobes as lobes
+
+            inp, lay, wi, flip, rot = self._setup(si, active)
+            s = lay.shares
+            c_coat, c_metal = s[0], s[0] + s[1]
+            c_glass, c_spec = c_metal + s[2], c_metal + s[2] + s[3]
+            pick_coat, pick_glass, pick_diffuse = sample1 < c_coat, (sample1 >= c_metal) & (sample1 < c_glass), \
+                sample1 >= c_spec
+            alpha_x = dr.select(pick_coat, lay.alpha_coat, dr.select(pick_glass, lay.alpha_glass, lay.ax))
+            alpha_y = dr.select(pick_coat, lay.alpha_coat, dr.select(pick_glass, lay.alpha_glass, lay.ay))
+            h = lobes.sample_visible_normal(wi, alpha_x, alpha_y, sample2)
+            cos_hi = dr.dot(h, wi)
+            wo = 2.0 * cos_hi * h - wi
+            refract = mi.Bool(False)
+            if inp.has_transmission:
+                p_reflect, _, _ = layers_mod.glass_reflect_probability(lay, cos_hi)
+                u = (sample1 - c_metal) / dr.maximum(s[2], 1e-20)
+                _, cos_t = lobes.fresnel_dielectric(cos_hi, lay.eta_glass)
+                refract = pick_glass & (u >= p_reflect) & (cos_t > 0.0)
+                wo = dr.select(refract, lobes.refract(wi, h, cos_t, lay.eta_glass), wo)
+            wo = dr.select(pick_diffuse, mi.warp.square_to_cosine_hemisphere(sample2), wo)
+            value, pdf = layers_mod.eval_pdf(lay, wi, wo, inp.has_coat, inp.has_transmission)
+            ok = active & (wi.z > 0.0) & (pdf > 0.0) & dr.select(refract, wo.z < 0.0, wo.z > 0.0)
+            bs = dr.zeros(mi.BSDFSample3f)
+            bs.wo = self._world_local(wo, flip, rot)
+            bs.pdf = dr.select(ok, pdf, 0.0)
+            bs.eta = dr.select(refract, lay.eta_glass, 1.0)
+            bs.sampled_type = dr.select(pick_diffuse, mi.UInt32(+flags.DiffuseReflection),
+                                        dr.select(refract, mi.UInt32(+flags.GlossyTransmission),
+                                                  mi.UInt32(+flags.GlossyReflection)))
+            bs.sampled_component = dr.select(pick_diffuse, mi.UInt32(0), dr.select(refract, mi.UInt32(2),
+                                                                                   mi.UInt32(1)))
+            weight = mi.Spectrum(value) / dr.maximum(pdf, 1e-20)
+            return bs, dr.select(ok, weight, 0.0)
+
+        def eval_diffuse_reflectance(self, si: Any, active: Any = True) -> Any:
+            return self.base_color.eval(si, active)
+
+        def has_attribute(self, name: str, active: Any = True) -> Any:
+            return mi.Bool(name in ("roughness", "metallic", "spec_trans", "base_color"))
+
+        def eval_attribute_1(self, name: str, si: Any, active: Any = True) -> Any:
+            if name == "roughness":
+                return read(self.roughness, si, active)
+            if name == "metallic":
+                return read(self.metallic, si, active)
+            if name == "spec_trans":
+                return mi.Float(self.transmission)
+            return mi.Float(0.0)
+
+        def eval_attribute_3(self, name: str, si: Any, active: Any = True) -> Any:
+            return self.base_color.eval(si, active) if name == "base_color" else mi.Color3f(0.0)
+
+        def traverse(self, callback: Any) -> None:
+            callback.put("base_color", self.base_color, mi.ParamFlags.Differentiable)
+
+        def parameters_changed(self, keys: Any = None) -> None:
+            pass
+
+        def to_string(self) -> str:
+            return (f"HybridgenPrincipled[ior={self.ior}, transmission={self.transmission}, coat={self.coat}, "
+                    f"roughness={self.roughness}, metallic={self.metallic}, specular={self.specular}]")
+
+    mi.register_bsdf(PLUGIN_NAME, lambda props: PrincipledBSDF(props))

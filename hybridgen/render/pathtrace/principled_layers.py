@@ -1,0 +1,185 @@
+"""The layer weights of Blender 4.2's Principled BSDF at one shading point, for one view direction.
+
+Blender stacks its closures top down and lets each layer darken what lies below it by the layer's estimated
+albedo from the view direction ``wi`` (Cycles' ``closure_layering_weight``); metal and transmission instead mix
+by their weights. With W the weight still left for the layers below (a color, 1 at the top):
+
+1. coat (``coat_weight`` > 0): a dielectric GGX reflection with the coat's own IOR and roughness, weight
+   ``coat_weight`` W; then W *= 1 - coat_weight A_coat and, for a coat tint, W *= lerp(1, tint^(1/cos_t),
+   coat_weight) with cos_t the view direction refracted into the coat (Beer's law over the coat's thickness);
+2. metal: weight ``metallic`` W, reflectance F82 tint (F0 = base color, the 82-degree tint = ``specular_tint``);
+   W *= 1 - metallic;
+3. transmission: a rough dielectric (isotropic) with the IOR (1/IOR from the back side), reflection F and
+   refraction (1 - F) sqrt(base color), weight ``transmission`` W; W *= 1 - transmission;
+4. the dielectric specular layer: GGX reflection with F0 = F0(IOR) x 2 ``specular`` (Specular IOR Level,
+   0.5 = the IOR's own F0) tinted by ``specular_tint``, weight W; W *= 1 - max_channel(A_spec);
+5. Lambertian diffuse: base color x W / pi.
+
+Every GGX lobe is energy compensated (:func:`principled_lobes.energy_factor`). A layer's albedo A is Cycles'
+estimate: (E + F_ms (1 - E)) (F0 + (1 - F0) s) with s from the ``schlick_s`` table (the Fresnel-weighted
+fraction of the lobe's energy). Sheen and subsurface are not modelled (hybridgen's materials carry neither;
+see docs/principled_bsdf.md). Per-lane quantities are Dr.Jit values of the active variant; inputs are read by
+:class:`~hybridgen.render.pathtrace.principled_bsdf.PrincipledBSDF`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import drjit as dr
+import mitsuba as mi
+
+from . import principled_lobes as lobes
+from . import principled_tables as tables
+
+MIN_LOBE_SHARE = 0.05
+"""Share of the total sampling weight every present lobe gets on top of its albedo share (keeps a BSDF-sampling
+technique for MIS on highlights of dark surfaces)."""
+
+
+@dataclass
+class Inputs:
+    """The Principled inputs at a point (Blender's names in the comments); per-lane Dr.Jit values except flags."""
+
+    base: Any  # Base Color (linear RGB, >= 0)
+    rough: Any  # Roughness 0..1
+    metallic: Any  # Metallic 0..1
+    level: Any  # Specular IOR Level >= 0
+    ior: Any  # IOR
+    spec_tint: Any  # Specular Tint (RGB)
+    transmission: Any  # Transmission Weight 0..1
+    aspect: Any  # sqrt(1 - 0.9 Anisotropic)
+    coat: Any  # Coat Weight
+    coat_rough: Any  # Coat Roughness
+    coat_ior: Any  # Coat IOR
+    coat_tint: Any  # Coat Tint (RGB)
+    has_coat: bool
+    has_transmission: bool
+    has_coat_tint: bool
+
+
+@dataclass
+class Layers:
+    """Lobe weights (colors, energy compensation included) and parameters for one view direction."""
+
+    ax: Any
+    ay: Any
+    alpha_glass: Any
+    alpha_coat: Any
+    coat_w: Any
+    coat_ior: Any
+    metal_w: Any
+    f0_metal: Any
+    b_metal: Any
+    glass_w: Any
+    eta_glass: Any
+    f0_glass: Any
+    tint_glass: Any
+    spec_w: Any
+    eta_spec: Any
+    f0_spec: Any
+    diffuse_w: Any
+    shares: list[Any]  # sampling probabilities: coat, metal, glass, spec, diffuse (sum 1 where anything reflects)
+
+
+def _average(color: Any) -> Any:
+    return (color[0] + color[1] + color[2]) * (1.0 / 3.0)
+
+
+def _max(color: Any) -> Any:
+    return dr.maximum(dr.maximum(color[0], color[1]), color[2])
+
+
+def _reflective_layer(rough: Any, mu: Any, eta: Any, f0: Any) -> tuple[Any, Any]:
+    """(energy factor, estimated albedo) of an energy-compensated dielectric GGX reflection whose Fresnel is
+    Blender's remapped curve from ``f0`` (a color) to 1 at relative IOR ``eta``."""
+    e, e_avg = tables.ggx_energy(rough, mu)
+    real_f0 = lobes.f0_from_ior(eta)
+    s_avg = dr.clip((tables.fresnel_average(eta) - real_f0) / dr.maximum(1.0 - real_f0, 1e-6), 0.0, 1.0)
+    factor = lobes.energy_factor(e, e_avg, dr.lerp(f0, 1.0, s_avg))
+    estimate = dr.lerp(f0, 1.0, tables.fresnel_interpolation(rough, mu, eta))
+    return factor, factor * e * estimate
+
+
+def layers(inp: Inputs, mu: Any, backfacing: Any) -> Layers:
+    """The layer weights for a view direction at cosine ``mu`` > 0 to the (flipped) normal."""
+    white = mi.Color3f(1.0)
+    weight = white
+    alpha = dr.maximum(dr.square(inp.rough), lobes.MIN_ALPHA)
+    ax, ay = dr.minimum(alpha / inp.aspect, 1.0), alpha * inp.aspect
+    coat_w, alpha_coat, share_coat = mi.Color3f(0.0), mi.Float(lobes.MIN_ALPHA), mi.Float(0.0)
+    if inp.has_coat:
+        alpha_coat = dr.maximum(dr.square(inp.coat_rough), lobes.MIN_ALPHA)
+        coat_f0 = mi.Color3f(lobes.f0_from_ior(inp.coat_ior))
+        factor, albedo = _reflective_layer(inp.coat_rough, mu, inp.coat_ior, coat_f0)
+        coat_w = inp.coat * factor
+        share_coat = inp.coat * _average(albedo)
+        weight = weight * dr.clip(1.0 - inp.coat * _max(albedo), 0.0, 1.0)
+        if inp.has_coat_tint:
+            cos_t = dr.safe_sqrt(1.0 - (1.0 - mu * mu) / dr.square(inp.coat_ior))
+            absorbed = dr.power(inp.coat_tint, dr.rcp(dr.maximum(cos_t, 1e-4)))
+            weight = weight * dr.lerp(white, absorbed, inp.coat)
+    f0_metal = dr.clip(inp.base, 0.0, 1.0)
+    b_metal = lobes.f82_b(f0_metal, dr.minimum(inp.spec_tint, 1.0))
+    e, e_avg = tables.ggx_energy(inp.rough, mu)
+    metal_w = weight * inp.metallic * lobes.energy_factor(e, e_avg, lobes.f82_average(f0_metal, b_metal))
+    share_metal = _average(metal_w * e * lobes.f82_average(f0_metal, b_metal))
+    weight = weight * (1.0 - inp.metallic)
+    glass_w, share_glass = mi.Color3f(0.0), mi.Float(0.0)
+    eta_glass = dr.select(backfacing, dr.rcp(inp.ior), inp.ior)
+    f0_glass = dr.clip(lobes.f0_from_ior(inp.ior) * inp.spec_tint, 0.0, 1.0)
+    tint_glass = dr.sqrt(dr.clip(inp.base, 0.0, 1.0))
+    if inp.has_transmission:
+        e_g, e_avg_g = tables.glass_energy(inp.rough, mu, eta_glass)
+        glass_w = weight * inp.transmission * lobes.energy_factor(e_g, e_avg_g, tint_glass)
+        f_mu = lobes.fresnel_remapped(mu, eta_glass, f0_glass)
+        share_glass = _average(glass_w * e_g * (f_mu + (1.0 - f_mu) * tint_glass))
+        weight = weight * (1.0 - inp.transmission)
+    real_f0 = lobes.f0_from_ior(inp.ior)
+    eta_spec = dr.select(inp.level == 0.5, inp.ior, lobes.ior_from_f0(real_f0 * 2.0 * inp.level))
+    eta_spec = dr.select((inp.ior < 1.0) & (inp.level != 0.5), dr.rcp(eta_spec), eta_spec)
+    has_spec = dr.abs(eta_spec - 1.0) > 1e-6
+    f0_spec = dr.clip(lobes.f0_from_ior(eta_spec) * inp.spec_tint, 0.0, 1.0)
+    factor, albedo = _reflective_layer(inp.rough, mu, eta_spec, f0_spec)
+    spec_w = dr.select(has_spec, weight * factor, 0.0)
+    share_spec = dr.select(has_spec, _average(weight * albedo), 0.0)
+    weight = dr.select(has_spec, weight * dr.clip(1.0 - _max(albedo), 0.0, 1.0), weight)
+    diffuse_w = weight * dr.maximum(inp.base, 0.0)
+    raw = [share_coat, share_metal, share_glass, share_spec, _average(diffuse_w)]
+    total = raw[0] + raw[1] + raw[2] + raw[3] + raw[4]
+    floored = [dr.select(r > 0.0, r + MIN_LOBE_SHARE * total, 0.0) for r in raw]
+    norm = dr.rcp(dr.maximum(floored[0] + floored[1] + floored[2] + floored[3] + floored[4], 1e-20))
+    return Layers(ax=ax, ay=ay, alpha_glass=alpha, alpha_coat=alpha_coat, coat_w=coat_w, coat_ior=inp.coat_ior,
+                  metal_w=metal_w, f0_metal=f0_metal, b_metal=b_metal, glass_w=glass_w, eta_glass=eta_glass,
+                  f0_glass=f0_glass, tint_glass=tint_glass, spec_w=spec_w, eta_spec=eta_spec, f0_spec=f0_spec,
+                  diffuse_w=diffuse_w, shares=[f * norm for f in floored])
+
+
+def glass_reflect_probability(lay: Layers, cos_hi: Any) -> tuple[Any, Any, Any]:
+    """(probability of reflecting, reflectance F, transmittance (1 - F) tint) of the glass at cos(h, wi)."""
+    f = lobes.fresnel_remapped(cos_hi, lay.eta_glass, lay.f0_glass)
+    t = (1.0 - f) * lay.tint_glass
+    return _average(f) / dr.maximum(_average(f + t), 1e-20), f, t
+
+
+def eval_pdf(lay: Layers, wi: Any, wo: Any, has_coat: bool, has_transmission: bool) -> tuple[Any, Any]:
+    """(BSDF x |cos(wo)| as RGB, pdf of :meth:`PrincipledBSDF.sample`) for local ``wi`` (upper) and ``wo``."""
+    refl, refl_pdf, cos_hi = lobes.reflection(wi, wo, lay.ax, lay.ay)
+    value = lay.spec_w * lobes.fresnel_remapped(cos_hi, lay.eta_spec, lay.f0_spec) * refl
+    value += lay.metal_w * lobes.fresnel_f82(cos_hi, lay.f0_metal, lay.b_metal) * refl
+    pdf = (lay.shares[1] + lay.shares[3]) * refl_pdf
+    upper = wo.z > 0.0
+    value += dr.select(upper, lay.diffuse_w * wo.z * dr.inv_pi, 0.0)
+    pdf += lay.shares[4] * dr.select(upper, wo.z * dr.inv_pi, 0.0)
+    if has_coat:
+        c_refl, c_pdf, c_cos = lobes.reflection(wi, wo, lay.alpha_coat, lay.alpha_coat)
+        value += lay.coat_w * lobes.fresnel_dielectric(c_cos, lay.coat_ior)[0] * c_refl
+        pdf += lay.shares[0] * c_pdf
+    if has_transmission:
+        g_refl, g_pdf, g_cos = lobes.reflection(wi, wo, lay.alpha_glass, lay.alpha_glass)
+        p_reflect, f, _ = glass_reflect_probability(lay, g_cos)
+        g_refr, t_pdf, t_cos = lobes.refraction(wi, wo, lay.alpha_glass, lay.eta_glass)
+        p_reflect_t, _, t = glass_reflect_probability(lay, t_cos)
+        value += lay.glass_w * (f * g_refl + t * g_refr)
+        pdf += lay.shares[2] * (p_reflect * g_pdf + (1.0 - p_reflect_t) * t_pdf)
+    return value, pdf
