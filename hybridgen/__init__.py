@@ -30,11 +30,11 @@ if TYPE_CHECKING:  # what static analysers see; at run time the same names come 
     from .io.hdf5_single import Hdf5SingleFileWriter
     from .io.memory_sink import MemorySink
     from .io.mesh_cache import load_objects_cached as load_objects
-    from .render.raster.label_request import LabelRequest
     from .render.pathtrace.path_trace import PathTraceSettings
+    from .render.raster.label_request import LabelRequest
     from .render.raster.raster_view import RasterView
-    from .render.render_color import render_color
     from .render.raster.render_labels import render_labels
+    from .render.render_color import render_color
     from .run.pipeline import run_config
     from .scene import Camera, Intrinsics, Light, Material, MeshObject, Scene, World
     from .scene.frames import blender_to_opencv, make_pose, object_pose, opencv_to_blender

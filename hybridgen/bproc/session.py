@@ -21,7 +21,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import InputError
-
 from .blender_camera import BlenderCamera
 
 if TYPE_CHECKING:

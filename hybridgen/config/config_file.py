@@ -8,9 +8,9 @@ from typing import Any, Mapping, Sequence
 import yaml
 
 from ..errors import ConfigError, closest
-from .blenderproc import (BLENDER_PYTHON_PACKAGES, BLENDER_SETUP_KEYS, FAMILY_READ, GLOBAL_IGNORED,
-                          translate_module)
+from .blenderproc import BLENDER_PYTHON_PACKAGES, BLENDER_SETUP_KEYS, FAMILY_READ, GLOBAL_IGNORED
 from .blenderproc import finish as finish_translation
+from .blenderproc import translate_module
 from .notices import notice
 from .placeholders import resolve_placeholders
 from .requirements import NOT_A_REQUIREMENT, RequirementCheck, check_requirements

@@ -7,8 +7,8 @@ from typing import Any, Iterable
 from ..config.schema import Param
 from ..errors import HybridgenError
 from ..io.renamed_sink import check_output_keys
-from ..render.raster.label_request import LabelRequest, parse_map_by
 from ..render.passes import pass_options
+from ..render.raster.label_request import LabelRequest, parse_map_by
 from ..render.raster.raster_view import NORMAL_SPACES
 
 

@@ -7,8 +7,8 @@ from ..config.registry import register_module
 from ..config.schema import Param, positive
 from ..io.renamed_sink import renamed_sinks
 from ..io.texture_needs import require_base_colors
-from ..render.pathtrace.mitsuba_variant import choose_variant
 from ..render.passes import color_keys
+from ..render.pathtrace.mitsuba_variant import choose_variant
 from ..render.pathtrace.path_trace import PathTraceSettings
 from ..render.render_color import render_color
 from ..run.context import RunContext

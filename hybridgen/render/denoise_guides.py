@@ -21,9 +21,9 @@ import numpy as np
 
 from ..scene.camera import Intrinsics
 from ..scene.scene import Scene
+from .pathtrace.specular_guides import SpecularGuideTracer, can_be_specular_like
 from .pixel_filter import DEFAULT_WIDTH, filter_supersampled
 from .raster.scene_raster import SceneRaster
-from .pathtrace.specular_guides import SpecularGuideTracer, can_be_specular_like
 
 DEFAULT_FACTOR = 3
 FOLLOW_SPECULAR = False

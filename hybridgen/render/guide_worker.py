@@ -26,8 +26,8 @@ from concurrent.futures import Future
 import numpy as np
 
 from ..scene.scene import Scene
-from .pathtrace import denoise
 from .denoise_guides import DenoiseGuides
+from .pathtrace import denoise
 from .raster.gl_worker import DEFAULT_TIMEOUT_S, GLWorker
 from .raster.raster_view import RasterView
 from .raster.scene_raster import SceneRaster

@@ -8,17 +8,17 @@ import numpy as np
 from ..io.frame_sink import FrameSink, PassLayout
 from ..io.texture_needs import require_base_colors
 from ..scene.scene import Scene
-from .pathtrace.denoise import denoise as oidn_denoise
-from .pathtrace.denoise import require_oidn
 from . import denoise_guides
 from .denoise_guides import DenoiseGuides
 from .guide_worker import GuideWorker
-from .raster.scene_raster import SceneRaster
-from .keypoint_loop import ProgressFactory, Producer, StereoProducer, run_keypoints
-from .raster.label_request import LabelRequest
+from .keypoint_loop import Producer, ProgressFactory, StereoProducer, run_keypoints
 from .passes import color_keys, layout
+from .pathtrace.denoise import denoise as oidn_denoise
+from .pathtrace.denoise import require_oidn
 from .pathtrace.path_trace import PathTraceSettings, PathTraceView
 from .raster.label_producer import LabelProducer
+from .raster.label_request import LabelRequest
+from .raster.scene_raster import SceneRaster
 from .tonemap import to_srgb8
 
 

@@ -6,7 +6,6 @@ from typing import Any
 
 import numpy as np
 
-
 TEXTURE_SLOTS = ("base_color_texture", "roughness_texture", "metallic_texture", "alpha_texture",
                  "normal_texture", "displacement_texture", "specular_texture", "emission_texture")
 """The material's image inputs, all sampled with the mesh UVs."""

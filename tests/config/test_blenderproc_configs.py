@@ -212,10 +212,7 @@ def test_module_and_name_together_and_unavailable_modules(tmp_path):
         load_config(both)
     blend = write(tmp_path, "blend.yaml", '{"version": 3, "modules": [{"module": "loader.BlendLoader", '
                   '"config": {"path": "x.blend"}}]}')
-    with pytest.raises(ConfigError) as info:
-        load_config(blend)
-    line = str(info.value)
-    assert "\n" not in line and "needs Blender" in line and "glTF" in line and "unknown module" not in line
+    assert [m.name for m in load_config(blend).modules] == ["loader.BlendLoader"]  # read through bpy (io/blend_loader)
     suncg = write(tmp_path, "suncg.yaml", '{"modules": [{"name": "loader.SuncgLoader", "config": {}}]}')
     with pytest.raises(ConfigError, match="withdrawn"):
         load_config(suncg)

@@ -15,14 +15,14 @@ import numpy as np
 
 from ...errors import InputError
 from ...scene.camera import Intrinsics
-from ...scene.scene import Scene
 from ...scene.depth_of_field import DepthOfField
+from ...scene.scene import Scene
 from . import camera_hidden_emission, clamped_path, pinhole_sensor, thin_lens_sensor, transparent_shadows
 from .adaptive_sampling import SamplingPlan, render_adaptive
 from .mitsuba_scene import scene_dict
 from .mitsuba_variant import activate, choose_variant, is_jit
-from .path_trace_settings import (CYCLES_MAX_SAMPLES, DEFAULT_MAX_SAMPLES, DEFAULT_MIN_SAMPLES,
-                                  DEFAULT_NOISE_THRESHOLD, PathTraceSettings)
+from .path_trace_settings import (CYCLES_MAX_SAMPLES, DEFAULT_MAX_SAMPLES, DEFAULT_MIN_SAMPLES, DEFAULT_NOISE_THRESHOLD,
+                                  PathTraceSettings)
 from .pixel_tracer import PixelTracer, launch_counts
 
 __all__ = ["CYCLES_MAX_SAMPLES", "DEFAULT_MAX_SAMPLES", "DEFAULT_MIN_SAMPLES", "DEFAULT_NOISE_THRESHOLD",

@@ -19,6 +19,7 @@ from ..material_textures import alpha_coverage
 from .projection import projection_from_K
 from .raster_view import RasterView
 from .shader_source import shader_source
+from .label_framebuffers import release_framebuffer
 
 GL_SRGB8_ALPHA8 = 0x8C43
 
@@ -138,7 +139,5 @@ class AlbedoPass:
             self.program.release()
             self.program = None
         for fbo in self._fbos.values():
-            for attachment in (*fbo.color_attachments, fbo.depth_attachment):
-                attachment.release()
-            fbo.release()
+            release_framebuffer(fbo)
         self._fbos.clear()

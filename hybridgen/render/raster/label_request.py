@@ -9,9 +9,9 @@ import numpy as np
 from ...errors import InputError
 from ...io.frame_sink import PassLayout
 from ...scene.scene import Scene
-from .keypoint_frame import KeypointFrame, LabelTables
 from .. import passes as catalogue
 from ..passes import layout, pass_options, spec
+from .keypoint_frame import KeypointFrame, LabelTables
 from .readback import RasterOutput
 
 MAP_BY_ALIASES = {"class": "category_id", "instance": "instance"}

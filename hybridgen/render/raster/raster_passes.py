@@ -12,8 +12,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ...io.array_encoding import (DERIVED_DISTANCE, NARROWED, OCTAHEDRAL, EncodedArray, decode_octahedral,
-                                 storage_tag)
+from ...io.array_encoding import DERIVED_DISTANCE, NARROWED, OCTAHEDRAL, EncodedArray, decode_octahedral, storage_tag
 from .readback import RasterOutput
 
 
