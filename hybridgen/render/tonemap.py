@@ -18,3 +18,8 @@ def srgb_encode(linear: np.ndarray) -> np.ndarray:
 def to_srgb8(linear: np.ndarray) -> np.ndarray:
     """uint8 sRGB image of a linear RGB image."""
     return np.rint(srgb_encode(linear) * 255.0).astype(np.uint8)
+
+
+def to_srgb16(linear: np.ndarray) -> np.ndarray:
+    """uint16 sRGB image of a linear RGB image (the same transfer, rounded to the nearest of 0..65535)."""
+    return np.rint(srgb_encode(linear).astype(np.float64) * 65535.0).astype(np.uint16)
