@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any, Callable, Sequence
 
 from ._version import __version__
-from .errors import HybridgenError, InputError
+from .errors import HybridgenError, InputError, fault_message, printable
 from .logs import LOGGER, configure, level_for, log_line
 from .run.executor import DEFAULT_MAX_TASKS_PER_CHILD, EXECUTORS
 
@@ -61,7 +61,9 @@ def _progress_factory(enabled: bool) -> Any:
 
 
 def _say(ns: argparse.Namespace, text: str) -> None:
-    """A command's result line: on stdout, or (with ``--json``, whose stdout is the JSON line) logged."""
+    """A command's result line: on stdout, or (with ``--json``, whose stdout is the JSON line) logged. Bytes
+    of a file name that are not UTF-8 show as ``\\xNN`` (:func:`hybridgen.errors.printable`)."""
+    text = printable(text)
     if ns.json:
         LOGGER.info(text)
     else:
@@ -180,7 +182,7 @@ def _cmd_extract(ns: argparse.Namespace) -> dict[str, Any]:
 
     result = extract(ns.files, ns.output_dir, ns.keys, ns.format, ns.depth_scale)
     for note in result.notes:
-        LOGGER.warning("note: %s", note)
+        LOGGER.warning("note: %s", printable(note))
     _say(ns, f"wrote {len(result.files)} file(s) to {ns.output_dir}")
     return {"files": [str(p) for p in result.files]}
 
@@ -304,13 +306,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     except HybridgenError as exc:
         if ns.debug:
             raise
-        LOGGER.error("%s", exc)
+        LOGGER.error("%s", printable(str(exc)))
         if ns.json:
-            _json_line(ns, "error", started, exit_code=EXIT_USER_ERROR, error=str(exc))
+            _json_line(ns, "error", started, exit_code=EXIT_USER_ERROR, error=printable(str(exc)))
         return EXIT_USER_ERROR
     except BrokenPipeError:  # the reader of stdout went away (`hybridgen modules | head`): stop quietly
         sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - Python flushes stdout at exit
         return 0
+    except (OSError, RuntimeError) as exc:  # the machine's state (disk full, name too long ...): one line too
+        message = fault_message(exc)
+        if message is None or ns.debug:
+            raise
+        message = printable(message)
+        LOGGER.error("%s", message)
+        if ns.json:
+            _json_line(ns, "error", started, exit_code=EXIT_USER_ERROR, error=message)
+        return EXIT_USER_ERROR
     except KeyboardInterrupt:
         LOGGER.error("interrupted; no output was committed for unfinished writers")
         if ns.json:

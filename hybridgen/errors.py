@@ -2,7 +2,15 @@
 from __future__ import annotations
 
 import difflib
+import os
 from typing import Iterable
+
+
+def printable(text: str) -> str:
+    """``text`` with the bytes of a file name that is not UTF-8 (Python's surrogate escapes) shown as ``\\xNN``:
+    the form messages and HDF5 string attributes give them (a strict UTF-8 stream or log file cannot take
+    the escapes themselves; ``os.fsencode`` of the original string gives the bytes back)."""
+    return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
 
 
 def closest(name: str, known: Iterable[str]) -> str:
@@ -71,3 +79,42 @@ class InputError(HybridgenError):
 
 class SystemSetupError(HybridgenError):
     """The machine lacks something hybridgen needs (EGL, a GL driver); the message says how to fix it."""
+
+
+ENVIRONMENT_ERRNOS = {28: "no space left on the device", 122: "disk quota exceeded",
+                      27: "file too large (the file size limit, ulimit -f, or the file system's)",
+                      36: "file name too long for the file system", 30: "read-only file system",
+                      13: "permission denied", 5: "input/output error"}
+"""errno -> the words of the one-line message of an environment fault (ENOSPC, EDQUOT, EFBIG, ENAMETOOLONG,
+EROFS, EACCES, EIO): the machine's state, not a bug - shown as one line like an input error."""
+
+
+def fault_errno(exc: BaseException) -> int | None:
+    """The errno of an environment fault behind ``exc`` (:data:`ENVIRONMENT_ERRNOS`), else None: an OSError's
+    own errno, or the ``errno = N`` that HDF5 writes into the text of h5py's OSError and RuntimeError (a failed
+    flush or close is a RuntimeError without an errno)."""
+    import re
+
+    if not isinstance(exc, (OSError, RuntimeError)):
+        return None
+    number = exc.errno if isinstance(exc, OSError) else None
+    if number is None:
+        match = re.search(r"errno = (\d+)", str(exc))
+        number = int(match.group(1)) if match else None
+    return number if number in ENVIRONMENT_ERRNOS else None
+
+
+def fault_message(exc: BaseException) -> str | None:
+    """One line for an environment fault (:func:`fault_errno`) - its words and the file it met, as the
+    exception names it - or None when ``exc`` is not one."""
+    import re
+
+    number = fault_errno(exc)
+    if number is None:
+        return None
+    name = getattr(exc, "filename", None)
+    if name is None:
+        match = re.search(r"filename = '([^']*)'", str(exc))
+        name = match.group(1) if match else None
+    where = f" at '{os.fsdecode(name)}'" if name is not None else ""
+    return f"{ENVIRONMENT_ERRNOS[number]}{where} ([Errno {number}])"

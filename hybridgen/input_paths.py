@@ -93,3 +93,33 @@ def not_found(noun: str, value: str | Path) -> str:
         return text
     return (f"{text} (tried {Path.cwd() / value} from the working directory and {folder / value} from the "
             "config's folder)")
+
+
+_NAME_LINKS: list[str] = []  # [folder] of this process's links, made on first use
+
+
+def utf8_path(path: str | Path) -> str:
+    """``path`` as a string for libraries that take file names as UTF-8 text (Mitsuba's ``filename``): the
+    path itself when it is valid UTF-8, else a symlink to it with a UTF-8 name and the same suffix (the
+    library picks the format by it) in a private folder of this process, removed at exit. Paths are bytes
+    on Linux: a Latin-1 file name of an old archive arrives as Python's surrogate escapes."""
+    text = os.fspath(path)
+    try:
+        text.encode("utf-8")
+        return text
+    except UnicodeEncodeError:
+        pass
+    import atexit
+    import hashlib
+    import shutil
+    import tempfile
+
+    target = os.fsencode(os.path.abspath(text))
+    if not _NAME_LINKS:
+        _NAME_LINKS.append(tempfile.mkdtemp(prefix="hybridgen-names-"))
+        atexit.register(shutil.rmtree, _NAME_LINKS[0], True)
+    suffix = os.fsdecode(os.path.splitext(target)[1]).encode("utf-8", "replace").decode("utf-8")
+    link = os.path.join(_NAME_LINKS[0], hashlib.sha256(target).hexdigest()[:16] + suffix)
+    if not os.path.lexists(link):
+        os.symlink(target, link)
+    return link

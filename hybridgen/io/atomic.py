@@ -12,8 +12,9 @@ from __future__ import annotations
 import errno
 import os
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 from ..errors import InputError
 from ..stop_request import deferred
@@ -123,6 +124,31 @@ def close_discarded_hdf5(h5: Any) -> None:
         h5.close()
     except Exception:
         pass
+
+
+@contextmanager
+def hdf5_temporary(temp: Path, mode: str = "w", **options: Any) -> Iterator[Any]:
+    """``h5py.File(temp, mode, **options)`` for a temporary file (:func:`temporary_path`), closed on leaving;
+    on an error inside, closed by :func:`close_discarded_hdf5` and deleted. A close that fails is not tried
+    again (the file is deleted and the error raised). The caller commits ``temp`` after leaving."""
+    import h5py
+
+    try:
+        h5 = h5py.File(temp, mode, **options)
+    except BaseException:
+        discard(temp)
+        raise
+    try:
+        yield h5
+    except BaseException:
+        close_discarded_hdf5(h5)
+        discard(temp)
+        raise
+    try:
+        h5.close()
+    except BaseException:
+        discard(temp)
+        raise
 
 
 def remove_live_temporaries() -> int:

@@ -23,7 +23,7 @@ import numpy as np
 
 from ..render.passes import exact
 from ..scene.frames import opencv_to_blender
-from .atomic import commit, discard, prepare_output_dir, temporary_path
+from .atomic import commit, discard, hdf5_temporary, prepare_output_dir, temporary_path
 from .output_lock import hold_output_lock
 from .frame_sink import PassLayout
 from .hdf5_single import Hdf5Options
@@ -104,17 +104,17 @@ class BlenderProcHdf5Writer:
         self._attributes.update(attributes)
 
     def write(self, index: int, values: dict[str, Any]) -> None:
-        with h5py.File(self._temp(index), "a" if index in self._touched else "w") as h5:
+        held: list[h5py.Dataset] = []  # open until the file closes (a lone close on a full disk: io/atomic.py)
+        with hdf5_temporary(self._temp(index), "a" if index in self._touched else "w") as h5:
             for key, value in values.items():
-                self._store(h5, key, value, index)
+                held += self._store(h5, key, value, index)
         self._touched.add(index)
 
-    def _store(self, h5: h5py.File, key: str, value: Any, index: int) -> None:
+    def _store(self, h5: h5py.File, key: str, value: Any, index: int) -> list[h5py.Dataset]:
+        """Store ``key`` of keypoint ``index``; returns the datasets made."""
         layout = self._layouts.get(key)
         if layout is not None and layout.dtype == "json":
-            h5.create_dataset(key, data=np.bytes_(json.dumps(value)))
-            self._store_version(h5, key)
-            return
+            return [h5.create_dataset(key, data=np.bytes_(json.dumps(value))), *self._store_version(h5, key)]
         array = np.asarray(value)
         entry = exact(key)
         renamed_normals = entry is None and layout is not None and layout.frame in ("camera", "world")
@@ -128,17 +128,17 @@ class BlenderProcHdf5Writer:
         if key in self.untrimmed and array.ndim == (3 if stereo else 2) and array.dtype.kind == "f":
             array = np.repeat(array[..., None], 3, axis=-1)
         if stereo and self.stereo_separate_keys:
-            for side in (0, 1):
-                h5.create_dataset(f"{key}_{side}", data=array[side], compression=self.compression,
-                                  compression_opts=self.level)
+            made = [h5.create_dataset(f"{key}_{side}", data=array[side], compression=self.compression,
+                                      compression_opts=self.level) for side in (0, 1)]
         else:
-            h5.create_dataset(key, data=array, compression=self.compression, compression_opts=self.level)
-        self._store_version(h5, key)
+            made = [h5.create_dataset(key, data=array, compression=self.compression, compression_opts=self.level)]
+        return made + self._store_version(h5, key)
 
-    def _store_version(self, h5: h5py.File, key: str) -> None:
+    def _store_version(self, h5: h5py.File, key: str) -> list[h5py.Dataset]:
         version = self.versions.get(key, self.versions.get("*"))
         if version is not None and f"{key}_version" not in h5:
-            h5.create_dataset(f"{key}_version", data=np.array([version.encode()], dtype=np.bytes_))
+            return [h5.create_dataset(f"{key}_version", data=np.array([version.encode()], dtype=np.bytes_))]
+        return []
 
     def end(self) -> None:
         """Nothing is buffered between keypoints."""
@@ -150,18 +150,19 @@ class BlenderProcHdf5Writer:
         paths = []
         K, cam2world = self._records.get("cam_K"), self._records.get("cam2world")
         for index in sorted(self._touched):
-            with h5py.File(self._temp(index), "a") as h5:
+            held: list[h5py.Dataset] = []  # open until the file closes (see write)
+            with hdf5_temporary(self._temp(index), "a") as h5:
                 if K is not None and cam2world is not None:
                     height, width = next((layout.image_size for layout in self._layouts.values()
                                           if layout.image_size is not None), (0, 0))
                     state = cam_state(K[index], cam2world[index], width, height)
-                    h5.create_dataset("cam_states", data=np.bytes_(json.dumps(state)))
+                    held.append(h5.create_dataset("cam_states", data=np.bytes_(json.dumps(state))))
                 for key, value in (records or {}).items():
-                    h5.create_dataset(key, data=np.bytes_(json.dumps(value)))
+                    held.append(h5.create_dataset(key, data=np.bytes_(json.dumps(value))))
                 for key, value in {**self._attributes, **(attributes or {})}.items():
                     h5.attrs[key] = value
-                h5.create_dataset("hybridgen_version",
-                                  data=np.bytes_(str(self._attributes.get("hybridgen_version", ""))))
+                held.append(h5.create_dataset("hybridgen_version",
+                                              data=np.bytes_(str(self._attributes.get("hybridgen_version", "")))))
             commit(self._temps.pop(index), self.final_path(index))
             paths.append(self.final_path(index))
         self._touched.clear()

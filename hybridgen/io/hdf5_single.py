@@ -15,6 +15,7 @@ written under a temporary name and renamed only when complete.
 """
 from __future__ import annotations
 
+import errno
 import json
 import os
 import queue
@@ -29,7 +30,7 @@ import h5py
 import numpy as np
 
 from ..config.options import checked_options, option
-from ..errors import InputError
+from ..errors import InputError, fault_errno, fault_message
 from .atomic import close_discarded_hdf5, commit, discard, prepare_output_dir, temporary_path
 from .blosc2_chunks import Blosc2Chunks
 from .frame_sink import PassLayout
@@ -287,7 +288,10 @@ class Hdf5SingleFileWriter:
             try:
                 self._file = h5py.File(self._temp, "w", libver="v110")
             except OSError as exc:
-                raise InputError(f"cannot write '{self._temp.parent}': {exc}") from None
+                if fault_errno(exc) in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):  # the run's line for a full disk
+                    raise OSError(fault_errno(exc), os.strerror(fault_errno(exc) or 0), str(self._temp)) from None
+                raise InputError(f"cannot write '{self._temp.parent}': "
+                                 f"{fault_message(exc) or str(exc).splitlines()[0]}") from None
         return self._file
 
     def _shutdown_pool(self) -> None:

@@ -22,6 +22,7 @@ import numpy as np
 from ..config.options import option
 from ..errors import InputError, SystemSetupError
 from .atomic import commit, prepare_output_dir, temporary_path
+from ..input_paths import utf8_path
 
 EXR_HINT = "EXR files are written with Mitsuba's Bitmap (the `mitsuba` package); it failed to import"
 COLOR_FORMATS = ("PNG", "JPEG")
@@ -116,13 +117,21 @@ def write_exr_file(path: Path, image: np.ndarray, channel_names: Sequence[str] |
         if len(names) != channels:
             raise InputError(f"{channels} channels need {channels} names, got {names}")
         bitmap = mi.Bitmap(array, mi.Bitmap.PixelFormat.MultiChannel, names)
-    bitmap.write(str(path), mi.Bitmap.FileFormat.OpenEXR)
+    try:
+        os.fspath(path).encode("utf-8")
+    except UnicodeEncodeError:  # Mitsuba takes UTF-8 names: encode in memory, write the bytes here
+        stream = mi.MemoryStream()
+        bitmap.write(stream, mi.Bitmap.FileFormat.OpenEXR)
+        with open(path, "wb") as handle:
+            handle.write(bytes(stream.raw_buffer())[:stream.size()])
+        return
+    bitmap.write(os.fspath(path), mi.Bitmap.FileFormat.OpenEXR)
 
 
 def read_exr(path: str | Path) -> np.ndarray:
     """The samples of an OpenEXR file as an (H, W) or (H, W, C) array."""
     mi = _mitsuba()
-    array = np.array(mi.Bitmap(str(path)))
+    array = np.array(mi.Bitmap(utf8_path(path)))
     return array[..., 0] if array.ndim == 3 and array.shape[2] == 1 else array
 
 

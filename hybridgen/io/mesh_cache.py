@@ -20,6 +20,7 @@ Entries are pickles: the cache folder must be writable only by its user (as any 
 from __future__ import annotations
 
 import hashlib
+import os
 import pickle
 from functools import cache
 from pathlib import Path
@@ -69,7 +70,7 @@ def cache_key(path: Path, options: dict[str, Any]) -> str:
         except OSError:
             pass
     for file in files:
-        digest.update(f"\0{file.name}\0".encode())
+        digest.update(b"\0" + os.fsencode(file.name) + b"\0")
         try:
             digest.update(bytes.fromhex(content_sha256(file)))
         except OSError:

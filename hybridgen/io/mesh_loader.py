@@ -19,6 +19,7 @@ the material) - a name selector picks all of them, as it would pick the one Blen
 from __future__ import annotations
 
 import io
+import os
 import re
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator
@@ -31,8 +32,9 @@ from ..errors import InputError
 from ..scene.frames import Y_UP_TO_Z_UP
 from ..scene.material import Material
 from ..scene.mesh_object import MeshObject
-from .mesh_references import is_lenient
-from .texture_needs import check_libraries, mark_missing_textures
+from .image_check import check_image_file
+from .mesh_references import is_lenient, referenced_files
+from .texture_needs import check_libraries, diffuse_maps_by_material, mark_missing_textures
 
 LOADERS: dict[str, tuple[str, str]] = {
     ".obj": ("obj", "Y"),
@@ -54,8 +56,9 @@ Notify = Callable[[str], None]
 
 
 def blender_name(text: str) -> str:
-    """An object name as Blender stores it: words joined by one space, at most 63 UTF-8 bytes."""
-    name = " ".join(text.split())
+    """An object name as Blender stores it: words joined by one space, at most 63 UTF-8 bytes. Bytes of a
+    file name that are not UTF-8 (Python's surrogate escapes) become U+FFFD, as in the OBJ text."""
+    name = " ".join(text.split()).encode("utf-8", "surrogateescape").decode("utf-8", "replace")
     return name.encode("utf-8")[:BLENDER_NAME_BYTES].decode("utf-8", errors="ignore")
 
 
@@ -129,6 +132,73 @@ def _object_statements(text: str) -> Iterator[tuple[int, int]]:
         start = text.find("o", line_end)
 
 
+def _undecodable_match(folder: Path, name: str) -> Path | None:
+    """The file below ``folder`` that ``name`` names when ``name`` was decoded from bytes that are not UTF-8
+    (each such byte read as U+FFFD, as the OBJ and MTL text is): the one entry per path part whose name reads
+    as that part. None when no part holds U+FFFD, or no entry or several match."""
+    if "\ufffd" not in name:
+        return None
+    path = folder
+    for part in name.replace("\\", "/").split("/"):
+        if part in ("", "."):
+            continue
+        if part == ".." or not path.is_dir():
+            return None
+        if "\ufffd" not in part:
+            path = path / part
+            continue
+        try:
+            with os.scandir(path) as entries:
+                found = [e.name for e in entries if os.fsencode(e.name).decode("utf-8", "replace") == part]
+        except OSError:
+            return None
+        if len(found) != 1:
+            return None
+        path = path / found[0]
+    return path if path.is_file() else None
+
+
+def _bytes_name_resolver(file: Path) -> Any:
+    """trimesh's resolver for the files an OBJ names (inside its folder), which also finds MTL and texture
+    files whose names are not valid UTF-8 (Latin-1 names from old archives): trimesh reads the names from
+    text, where such bytes are U+FFFD. An MTL that is not UTF-8 is handed to trimesh with those bytes as
+    U+FFFD too (as the OBJ is), so the texture names it holds are found the same way."""
+    import trimesh
+
+    class BytesNameResolver(trimesh.resolvers.FilePathResolver):
+        def get(self, name: str) -> bytes:
+            try:
+                data = super().get(name)
+            except FileNotFoundError:
+                match = _undecodable_match(Path(self.parent), name.strip())
+                if match is None:
+                    raise
+                data = match.read_bytes()
+            if name.strip().lower().endswith(".mtl"):
+                try:
+                    data.decode("utf-8")
+                except UnicodeDecodeError:
+                    data = data.decode("utf-8", "replace").encode("utf-8")
+            return data
+
+    return BytesNameResolver(str(file))
+
+
+def check_named_textures(file: Path) -> None:
+    """One-line InputError naming the texture when a diffuse texture an OBJ's MTL names (and that exists) is
+    damaged, truncated or declares too many pixels (:func:`hybridgen.io.image_check.check_image_file`);
+    trimesh would hand the damaged file to PIL, whose error surfaced as a traceback."""
+    for library in referenced_files(file):
+        if not library.is_file():
+            continue
+        for texture in dict.fromkeys(t for maps in diffuse_maps_by_material(library).values() for t in maps):
+            if texture.is_file():
+                try:
+                    check_image_file(texture, "texture")
+                except InputError as exc:
+                    raise InputError(f"mesh '{file}': {exc} (named by '{library.name}')") from None
+
+
 def _read_scene(file: Path, file_type: str) -> tuple[Any, list[str] | None]:
     """The trimesh scene of ``file``; for OBJ also the Blender object names its parts are tagged with."""
     import trimesh
@@ -137,7 +207,7 @@ def _read_scene(file: Path, file_type: str) -> tuple[Any, list[str] | None]:
         return trimesh.load(str(file), file_type=file_type, force="scene", process=False), None
     text = file.read_text(encoding="utf-8", errors="replace")
     tagged, names = tag_obj_objects(text, file.stem)
-    resolver = trimesh.resolvers.FilePathResolver(str(file))
+    resolver = _bytes_name_resolver(file)
     scene = trimesh.load(io.BytesIO(tagged.encode("utf-8")), file_type="obj", resolver=resolver, force="scene",
                          process=False, split_objects=True, group_material=True)
     return scene, names
@@ -181,6 +251,8 @@ def load_objects(path: str | Path, *, name: str | None = None, category_id: int 
         if not is_lenient():
             raise InputError(f"{problem} (hybridgen run --lenient renders it anyway)")
         (notify or notice)(problem)
+    if file_type == "obj":
+        check_named_textures(file)
     try:
         loaded, obj_names = _read_scene(file, file_type)
     except Exception as exc:
@@ -224,7 +296,11 @@ def load_objects(path: str | Path, *, name: str | None = None, category_id: int 
                        if _has_loaded_normals(geometry) else None)
         extra = {"material_part": _material_name(geometry)} if counts[part_name] > 1 else {}
         colors = vertex_colors_linear(geometry.visual)
-        material = Material.from_trimesh_visual(geometry.visual, fallback_name=obj_name)
+        try:
+            material = Material.from_trimesh_visual(geometry.visual, fallback_name=obj_name)
+        except (OSError, SyntaxError, ValueError) as exc:  # PIL decodes an embedded or named texture here
+            raise InputError(f"mesh '{file}': a texture of object '{obj_name}' is damaged or not an image "
+                             f"({str(exc).splitlines()[0][:120] if str(exc) else type(exc).__name__})") from None
         material.base_color_from_vertices = colors is not None
         try:
             obj = MeshObject(

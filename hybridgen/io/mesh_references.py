@@ -32,7 +32,7 @@ def referenced_files(path: Path) -> list[Path]:
 def _scan(path: Path) -> tuple[str, ...]:
     data = path.read_bytes()
     matches = _mtllib_statements(data) if path.suffix.lower() == ".obj" else _MAPS.finditer(data)
-    return tuple(m.group(1).decode("utf-8", "replace").replace("\\", "/") for m in matches)
+    return tuple(os.fsdecode(m.group(1)).replace("\\", "/") for m in matches)
 
 
 scanned_names: IdentityMemo[tuple[str, ...]] = IdentityMemo(_scan)

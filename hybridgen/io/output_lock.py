@@ -16,6 +16,7 @@ from __future__ import annotations
 import errno
 import fcntl
 import os
+import time
 from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from typing import Callable, Iterable, Iterator
@@ -27,12 +28,25 @@ LOCK_NAME = ".hybridgen.lock"
 _HELD: dict[str, list[int]] = {}  # real path of the lock file -> [fd, depth]
 
 
+HOLDER_WAIT = 1.0
+"""Seconds a refused run waits for the holder's ``pid host`` line: a run that has just taken the lock writes it
+right after (two runs started a moment apart read the new, still empty file)."""
+
+
 def _holder(path: Path) -> str:
-    try:
-        text = path.read_text(encoding="utf-8", errors="replace").split()
-    except OSError:
-        return "another process"
-    return f"pid {text[0]} on {text[1]}" if len(text) >= 2 else "another process"
+    """``pid N on HOST`` from the lock file, read again for up to :data:`HOLDER_WAIT` seconds while it holds no
+    such line yet."""
+    deadline = time.monotonic() + HOLDER_WAIT
+    while True:
+        try:
+            text = path.read_text(encoding="utf-8", errors="replace").split()
+        except OSError:
+            text = []
+        if len(text) >= 2 and text[0].isdigit():
+            return f"pid {text[0]} on {text[1]}"
+        if time.monotonic() >= deadline:
+            return "its pid and host not recorded yet"
+        time.sleep(0.01)
 
 
 def _acquire(path: Path, wait: bool, shared: bool) -> int:
@@ -54,9 +68,10 @@ def _acquire(path: Path, wait: bool, shared: bool) -> int:
             same = os.fstat(fd).st_ino == os.stat(path, follow_symlinks=False).st_ino
         except FileNotFoundError:
             same = False
-        if same:
-            os.ftruncate(fd, 0)
-            os.pwrite(fd, f"{os.getpid()} {os.uname().nodename}\n".encode(), 0)  # = socket.gethostname()
+        if same:  # the line is written over the old one, then cut to length: never an empty file between
+            line = f"{os.getpid()} {os.uname().nodename}\n".encode()  # nodename = socket.gethostname()
+            os.pwrite(fd, line, 0)
+            os.ftruncate(fd, len(line))
             return fd
         os.close(fd)  # the previous holder removed the file after we opened it: lock the new one
 

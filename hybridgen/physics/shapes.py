@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -20,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError, SystemSetupError
-from ..io.cache_folder import cache_path, cache_root
+from ..io.cache_folder import cache_path, cache_root, write_entry
 
 SHAPES = ("convex_hull", "convex_decomposition", "auto", "mesh")
 """Collision shape kinds: ``mesh`` (the exact triangles) is only possible for passive (static) objects."""
@@ -189,14 +188,11 @@ def convex_decomposition(vertices: np.ndarray, faces: np.ndarray, settings: Deco
     parts = [(np.asarray(v, dtype=np.float64), np.asarray(f, dtype=np.int64)) for v, f in result if len(f)]
     if not parts:
         raise InputError("convex decomposition (CoACD) returned no parts")
-    if path is not None:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        temporary = path.with_name(f".{path.stem}.{os.getpid()}.tmp.npz")
-        np.savez(temporary, vertices=np.concatenate([v for v, _ in parts]),
-                 faces=np.concatenate([f for _, f in parts]),
-                 vertex_counts=np.array([len(v) for v, _ in parts]),
-                 face_counts=np.array([len(f) for _, f in parts]))
-        os.replace(temporary, path)
+    if path is not None:  # a cache that cannot be written (full disk, read-only folder) is skipped
+        write_entry(path, lambda out: np.savez(out, vertices=np.concatenate([v for v, _ in parts]),
+                                               faces=np.concatenate([f for _, f in parts]),
+                                               vertex_counts=np.array([len(v) for v, _ in parts]),
+                                               face_counts=np.array([len(f) for _, f in parts])))
     return parts
 
 

@@ -8,6 +8,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..config.config_file import ConfigFile
+from ..errors import printable
 from ..io.frame_sink import FrameSink
 from ..logs import Log, no_log
 from ..scene.scene import Scene
@@ -66,4 +67,4 @@ class RunContext:
 def printable_text(text: str) -> str:
     """``text`` as valid UTF-8 for an HDF5 string attribute: bytes of a non-UTF-8 file name (Python's
     surrogate escapes) become ``\\xNN``."""
-    return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    return printable(text)

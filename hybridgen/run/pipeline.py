@@ -9,8 +9,8 @@ from pathlib import Path
 from typing import Any, Callable, Iterator, Mapping, Sequence
 
 from ..config.config_file import load_config
-from ..errors import ConfigError, InputError
-from ..io.atomic import prepare_output_dir
+from ..errors import ENVIRONMENT_ERRNOS, ConfigError, InputError, fault_errno
+from ..io.atomic import check_file_name, prepare_output_dir
 from ..io.output_lock import output_locks
 from ..logs import Log, no_log
 from ..modules.base import Module, Role
@@ -38,17 +38,34 @@ def writer_folders(modules: list[Module], file: str) -> list[Path]:
     return folders
 
 
+def check_output_names(modules: list[Module], file: str) -> None:
+    """A writer's output file name longer than its folder's filesystem allows is an error naming the module
+    and its ``file_name`` key (checked before anything looks at the path: the OS refuses it with ENAMETOOLONG)."""
+    for module in modules:
+        output = module.single_file() if module.role is Role.WRITER else None
+        if output is None:
+            continue
+        try:
+            check_file_name(output.path)
+        except InputError as exc:
+            raise ConfigError(str(exc), file=file, module=module.module_name, index=module.index,
+                              key="file_name") from None
+
+
 @contextmanager
 def disk_full_is_one_line(folders: list[Path]) -> Iterator[None]:
     """A full disk (ENOSPC, also as h5py's OSError from a worker) becomes one InputError naming the output
     folder; the writers have already deleted their temporary files."""
     try:
         yield
-    except OSError as exc:
-        if exc.errno != errno.ENOSPC and "No space left on device" not in str(exc):
+    except (OSError, RuntimeError) as exc:  # h5py: a failed flush or close is a RuntimeError naming the errno
+        number = fault_errno(exc)
+        if number is None and "No space left on device" in str(exc):
+            number = errno.ENOSPC
+        if number not in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
             raise
         where = ", ".join(f"'{folder}'" for folder in folders) or "the output folder"
-        raise InputError(f"no space left on the device writing into {where}; nothing incomplete was kept under "
+        raise InputError(f"{ENVIRONMENT_ERRNOS[number]} writing into {where}; nothing incomplete was kept under "
                          "a final name (rerun to resume once there is space)") from None
 
 
@@ -80,6 +97,7 @@ def run_config(path: str | Path, args: Sequence[str] = (), *, env: Mapping[str, 
     plan = sharding_plan(config, modules, force=workers > 1 or shard is not None)
     fingerprint = run_fingerprint(config)
     policy = ResumePolicy(fingerprint_text(fingerprint), fingerprint, restart=restart, force=force_resume)
+    check_output_names(modules, config.path)
     single = single_file_output(modules)
     if single is not None and single.is_dir():
         raise InputError(f"'{single}' is a directory; the output file cannot be written there")

@@ -118,6 +118,7 @@ def staged_plan(modules: list[Module]) -> ShardingPlan | None:
     """The plan of a non-sharded run that renders in resumable parts (:mod:`hybridgen.run.staged_output`):
     its only writer writes a single file and ``resume_chunk_keypoints`` is not 0 (-1: the default part size,
     :func:`~hybridgen.run.staged_output.part_keypoints`)."""
+    from ..io.atomic import name_max
     from .staged_output import part_keypoints, staging_folder_name
 
     single = single_file_output(modules)
@@ -128,4 +129,5 @@ def staged_plan(modules: list[Module]) -> ShardingPlan | None:
     chunk = part_keypoints(output.resume_chunk_keypoints, any(m.path_traces for m in modules))
     if chunk == 0:
         return None
-    return ShardingPlan(1, chunk, single.parent, single.name, folder=staging_folder_name(single.name), staged=True)
+    folder = staging_folder_name(single.name, name_max(single.parent))
+    return ShardingPlan(1, chunk, single.parent, single.name, folder=folder, staged=True)

@@ -19,7 +19,7 @@ import h5py
 import numpy as np
 
 from ..errors import InputError
-from ..io.atomic import commit, temporary_path
+from ..io.atomic import commit, hdf5_temporary, temporary_path
 from ..io.integrity import DIGEST_ATTR, seal
 from .fingerprint import FINGERPRINT_ATTR
 
@@ -121,25 +121,27 @@ def build_index(path: Path, shards: list[Path], fingerprint: str | None = None) 
         key_attributes = {key: dict(first[key].attrs) for key in infos[0].layouts}
     offsets = np.concatenate([[0], np.cumsum([info.count for info in infos])])
     temp = temporary_path(path)
-    with h5py.File(temp, "w", libver="v110") as index:
+    held: list[Any] = []  # datasets with data open until the file closes (a lone close on a full disk: atomic.py)
+    with hdf5_temporary(temp, libver="v110") as index:
         _small_metadata_cache(index)
         for key, (dtype, shape) in infos[0].layouts.items():
             if key in infos[0].strings:
                 values = np.concatenate([info.strings[key] for info in infos])
-                index.create_dataset(key, data=values, dtype=dtype, track_times=False)
+                held.append(index.create_dataset(key, data=values, dtype=dtype, track_times=False))
                 continue
             pieces = [(info.name, int(offsets[i]), info.count, info.layouts[key][1]) for i, info in enumerate(infos)]
             # shards of different scenes may store ids in different narrow types: the widest holds all
+            # not held: an open virtual dataset keeps its decoded mapping (~4 KB per shard) in memory
             _virtual(index, key, pieces, np.result_type(*(info.layouts[key][0] for info in infos)), shape[1:])
             for name, value in key_attributes[key].items():  # how the pass is stored (encoding), read by decoders
                 index[key].attrs[name] = value
         scenes = np.concatenate([[info.scene] * info.count for info in infos]).astype(np.int64)
-        index.create_dataset("scene_index", data=scenes, track_times=False)
+        held.append(index.create_dataset("scene_index", data=scenes, track_times=False))
         firsts = sorted((info for info in infos if info.records), key=lambda info: info.scene)
         for key in SCENE_RECORDS:
             if key in infos[0].records:
-                index.create_dataset(key, data=[info.records[key] for info in firsts], dtype=h5py.string_dtype(),
-                                     track_times=False)
+                held.append(index.create_dataset(key, data=[info.records[key] for info in firsts],
+                                                 dtype=h5py.string_dtype(), track_times=False))
         for key, value in run_attributes.items():
             index.attrs[key] = value
         index.attrs["number_of_scenes"] = len(firsts)

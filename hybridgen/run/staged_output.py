@@ -28,7 +28,9 @@ rendered again from the start, as before (a part that is never complete is never
 """
 from __future__ import annotations
 
+import hashlib
 import json
+import os
 import shutil
 from dataclasses import asdict
 from pathlib import Path
@@ -60,9 +62,20 @@ def canonical(value: Any) -> str:
     return repr(np.asarray(value).tolist())
 
 
-def staging_folder_name(file_name: str) -> str:
-    """The hidden folder (inside ``output_dir``) holding the parts of ``file_name``."""
-    return f".{file_name}.parts"
+def staging_folder_name(file_name: str, limit: int = 255) -> str:
+    """The hidden folder (inside ``output_dir``) holding the parts of ``file_name``: ``.<file_name>.parts``, or
+    for a name too long for that on a filesystem allowing ``limit`` bytes per name (a legal ``file_name`` of
+    up to ``limit`` bytes), ``.<file_name cut>~<12 hex of its SHA-256>.parts`` - the same folder on every
+    rerun, so a killed run still resumes."""
+    name = f".{file_name}.parts"
+    if len(os.fsencode(name)) <= limit:
+        return name
+    tag = "~" + hashlib.sha256(os.fsencode(file_name)).hexdigest()[:12]
+    room = max(0, limit - len(f"{tag}.parts") - 1)
+    cut = os.fsencode(file_name)[:room].decode("utf-8", "ignore")  # whole characters of a UTF-8 name
+    while len(os.fsencode(f".{cut}{tag}.parts")) > limit:  # surrogate escapes of a non-UTF-8 name
+        cut = cut[:-1]
+    return f".{cut}{tag}.parts"
 
 
 class JournalingWriter(Hdf5SingleFileWriter):

@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from ...input_paths import not_found
+from ...input_paths import not_found, utf8_path
 from ...errors import InputError
 from ...io.image_check import check_image_file
 from ...scene.light import Light
@@ -161,7 +161,7 @@ def world_dict(world: World) -> dict[str, Any] | None:
         rotation = np.eye(4)
         c, s = math.cos(world.hdri_rotation), math.sin(world.hdri_rotation)
         rotation[:2, :2] = [[c, -s], [s, c]]
-        return {"type": "envmap", "filename": str(path), "scale": float(world.strength),
+        return {"type": "envmap", "filename": utf8_path(path), "scale": float(world.strength),
                 "to_world": mi.ScalarTransform4f((rotation @ ENVMAP_TO_WORLD).tolist())}
     radiance = np.asarray(world.color, float)[:3] * world.strength
     if not np.any(radiance > 0):
@@ -173,7 +173,8 @@ def _hdri_mean_radiance(world: World) -> float:
     """Mean linear pixel value of the world's HDRI times its strength."""
     import mitsuba as mi
 
-    bitmap = mi.Bitmap(str(world.hdri_path)).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, False)
+    bitmap = mi.Bitmap(utf8_path(world.hdri_path))
+    bitmap = bitmap.convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, False)
     return float(np.mean(np.array(bitmap))) * world.strength
 
 
