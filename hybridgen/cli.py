@@ -16,12 +16,12 @@ import json
 import os
 import sys
 import time
-from pathlib import Path
 from typing import Any, Callable, Sequence
 
 from ._version import __version__
-from .errors import HybridgenError, InputError, fault_message, printable
-from .logs import LOGGER, configure, level_for, log_line
+from .errors import HybridgenError, fault_message, printable
+from .logs import LOGGER, configure, level_for
+from . import cli_commands as commands
 from .run.executor import DEFAULT_MAX_TASKS_PER_CHILD, EXECUTORS
 
 EXIT_USER_ERROR = 2
@@ -48,38 +48,6 @@ class _HelpFormatter(argparse.RawDescriptionHelpFormatter):
     """Keeps the description's and epilog's own line breaks; wraps option help at the terminal width."""
 
 
-def _progress_factory(enabled: bool) -> Any:
-    if not enabled:
-        return None
-
-    def make(total: int, what: str) -> Any:
-        from tqdm import tqdm
-
-        return tqdm(total=total, desc=what, unit="kp", file=sys.stderr, dynamic_ncols=True, leave=True)
-
-    return make
-
-
-def _say(ns: argparse.Namespace, text: str) -> None:
-    """A command's result line: on stdout, or (with ``--json``, whose stdout is the JSON line) logged. Bytes
-    of a file name that are not UTF-8 show as ``\\xNN`` (:func:`hybridgen.errors.printable`)."""
-    text = printable(text)
-    if ns.json:
-        LOGGER.info(text)
-    else:
-        print(f"hybridgen: {text}", flush=True)
-
-
-def _parse_shard(text: str | None) -> tuple[int, int] | None:
-    if not text:
-        return None
-    try:
-        index, count = (int(v) for v in text.split("/"))
-    except ValueError:
-        raise InputError(f"--shard takes i/N (e.g. 0/4), got {text!r}") from None
-    return index, count
-
-
 def _script_arguments(argv: list[str]) -> list[str] | None:
     """For ``run SCRIPT.py ARGS...``: take everything after the script out of ``argv`` and return it (the script's
     own arguments, options included, as ``blenderproc run`` passes them); None for any other command line."""
@@ -89,102 +57,6 @@ def _script_arguments(argv: list[str]) -> list[str] | None:
     tail = argv[commands[1] + 1:]
     del argv[commands[1] + 1:]
     return tail
-
-
-def _run_script(ns: argparse.Namespace) -> dict[str, Any]:
-    """A BlenderProc 2 script: :func:`hybridgen.bproc.script.run_script` (its own errors: traceback, status 1)."""
-    from .bproc.script import run_script
-
-    seconds = run_script(ns.config, ns.args)
-    _say(ns, f"{ns.config} ran in {seconds:.2f} s")
-    return {"script": str(ns.config), "args": list(ns.args), "seconds": round(seconds, 3)}
-
-
-def _cmd_run(ns: argparse.Namespace) -> dict[str, Any]:
-    if str(ns.config).endswith(".py"):
-        return _run_script(ns)
-    from .config.notices import set_strict
-    from .io.mesh_references import LENIENT_ENV
-    from .run.pipeline import run_config
-
-    set_strict(ns.strict)
-    if ns.lenient:  # inherited by worker processes, read by the mesh loader
-        os.environ[LENIENT_ENV] = "1"
-    summary = run_config(ns.config, ns.args, progress=_progress_factory(not ns.quiet), log=log_line,
-                         workers=ns.workers, shard=_parse_shard(ns.shard), executor=ns.executor,
-                         address=ns.address, restart=ns.restart, force_resume=ns.force_resume,
-                         max_tasks_per_child=ns.max_tasks_per_child)
-    from .run.context import printable_text
-
-    outputs = ", ".join(printable_text(str(p)) for p in summary.outputs) or "(no output file)"
-    rate = summary.frames / summary.seconds if summary.seconds > 0 else 0.0
-    _say(ns, f"{summary.frames} keypoint(s) in {summary.seconds:.2f} s ({rate:.1f}/s) -> {outputs}")
-    return {"config": str(ns.config), "args": list(ns.args), "keypoints": summary.frames,
-            "seconds": round(summary.seconds, 3), "keypoints_per_second": round(rate, 3),
-            "outputs": [str(p) for p in summary.outputs]}
-
-
-def _cmd_modules(ns: argparse.Namespace) -> dict[str, Any]:
-    from .config.module_listing import describe_aliases, describe_modules, describe_samplers, module_records
-    from .config.registry import all_modules, get_module, module_aliases
-
-    if ns.schema is not None:
-        return _write_schema(ns)
-    modules = {ns.name: get_module(ns.name)} if ns.name else all_modules()
-    if not ns.json:
-        print(describe_modules(modules))
-        if not ns.name:
-            print(describe_samplers())
-            print(describe_aliases())
-    return {"modules": module_records(modules), "aliases": module_aliases()}
-
-
-def _write_schema(ns: argparse.Namespace) -> dict[str, Any]:
-    from .config.json_schema import config_schema
-    from .io.atomic import commit, temporary_path
-
-    text = json.dumps(config_schema(), indent=1) + "\n"
-    if ns.schema == "-":
-        sys.stdout.write(text)
-        return {"schema": "-"}
-    target = Path(ns.schema)
-    if target.parent != Path("") and not target.parent.is_dir():
-        raise InputError(f"--schema: folder '{target.parent}' does not exist")
-    temp = temporary_path(target)
-    temp.write_text(text)
-    commit(temp, target)
-    _say(ns, f"JSON Schema of the config format written to {target}")
-    return {"schema": str(target)}
-
-
-def _cmd_vis(ns: argparse.Namespace) -> dict[str, Any]:
-    from .io.visualize import save_contact_sheets
-
-    written = save_contact_sheets(ns.files, ns.save, ns.keys)
-    _say(ns, f"wrote {len(written)} contact sheet(s) to {ns.save}")
-    return {"files": [str(p) for p in written]}
-
-
-def _cmd_gallery(ns: argparse.Namespace) -> dict[str, Any]:
-    from .io.gallery import build_gallery
-
-    page = build_gallery(ns.output, keys=ns.keys, limit=ns.limit)
-    _say(ns, f"gallery written to {page}")
-    if ns.open:
-        import webbrowser
-
-        webbrowser.open(page.resolve().as_uri())
-    return {"page": str(page)}
-
-
-def _cmd_extract(ns: argparse.Namespace) -> dict[str, Any]:
-    from .io.extract import extract
-
-    result = extract(ns.files, ns.output_dir, ns.keys, ns.format, ns.depth_scale)
-    for note in result.notes:
-        LOGGER.warning("note: %s", printable(note))
-    _say(ns, f"wrote {len(result.files)} file(s) to {ns.output_dir}")
-    return {"files": [str(p) for p in result.files]}
 
 
 def _add_global_options(parser: argparse.ArgumentParser, *, in_command: bool) -> None:
@@ -228,7 +100,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_global_options(parser, in_command=False)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    run = _command(sub, "run", _cmd_run, "run a config (or a BlenderProc 2 script) and write its outputs",
+    run = _command(sub, "run", commands.cmd_run, "run a config (or a BlenderProc 2 script) and write its outputs",
                    "Run CONFIG; the values after it fill <args:0>, <args:1>, ... in the config.\n"
                    "Rerunning the same command resumes: complete work units are verified and kept.\n"
                    "A .py CONFIG is a BlenderProc 2 script, run as 'blenderproc run main.py ARGS...' runs it:\n"
@@ -254,27 +126,27 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--max-tasks-per-child", type=int, default=DEFAULT_MAX_TASKS_PER_CHILD,
                      help="work units a pool worker renders before it is replaced (bounds memory growth)")
 
-    modules = _command(sub, "modules", _cmd_modules, "list modules, their parameters and the samplers",
+    modules = _command(sub, "modules", commands.cmd_modules, "list modules, their parameters and the samplers",
                        "List every module a config may name, with each parameter's type, unit, default, allowed\n"
                        "choices and whether it may be a sampler; then the samplers with their parameters.")
     modules.add_argument("name", nargs="?", help="show only this module")
     modules.add_argument("--schema", nargs="?", const="-", metavar="FILE",
                          help="write a JSON Schema of the config format to FILE (or stdout) for editors")
 
-    vis = _reader_command(sub, "vis", _cmd_vis, "save a contact sheet PNG per keypoint of HDF5 outputs",
+    vis = _reader_command(sub, "vis", commands.cmd_vis, "save a contact sheet PNG per keypoint of HDF5 outputs",
                           "Save one PNG per keypoint showing its color and label passes side by side.",
                           ("files", "+", "HDF5 files written by hybridgen (either layout)"), "keys to show")
     vis.add_argument("--save", required=True, help="folder for the PNG files")
 
     gallery = _reader_command(
-        sub, "gallery", _cmd_gallery, "write a static HTML page of an output folder",
+        sub, "gallery", commands.cmd_gallery, "write a static HTML page of an output folder",
         "Write OUT/gallery/index.html: thumbnails of every pass of every keypoint with legends,\n"
         "click to enlarge, filters by scene and keypoint. No server or network needed.",
         ("output", None, "output folder (data.hdf5 or BlenderProc <i>.hdf5 files) or HDF5 file"), "passes to show")
     gallery.add_argument("--open", action="store_true", help="open the page in the default web browser")
     gallery.add_argument("--limit", type=int, help="show only the first N keypoints")
 
-    ext = _reader_command(sub, "extract", _cmd_extract, "write the keys of HDF5 outputs as PNG, EXR or npy files",
+    ext = _reader_command(sub, "extract", commands.cmd_extract, "write the keys of HDF5 outputs as PNG, EXR or npy files",
                           "Write each keypoint's keys as files: PNG (8-bit images, 16-bit ids, depth and distance as\n"
                           "16-bit millimetres), EXR (the stored floats) or npy (the stored arrays).",
                           ("files", "+", "HDF5 files (single-file or BlenderProc <i>.hdf5 layout)"), "keys to extract")
