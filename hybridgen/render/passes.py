@@ -32,7 +32,7 @@ import numpy as np
 
 from ..io.frame_sink import PassLayout
 from .raster import raster_passes as raster
-from .raster.geometry_passes import nocs, optical_flow
+from .raster.geometry_passes import nocs, object_coordinates, optical_flow
 from .raster.object_passes import amodal_masks, object_boxes, visible_fractions
 from .raster.object_records import object_records
 
@@ -156,6 +156,9 @@ _SPECS = (
     PassSpec("nocs", "float32", 3, "normalized object coordinates in [0, 1] (NOCS paper)", "",
              lambda frame, key: nocs(frame.raw, frame.intrinsics, frame.cam2world, frame.scene), show="as_stored",
              smooth=True, option="render_nocs", option_doc="write 'nocs': normalized object coordinates in [0, 1]"),
+    PassSpec("object_coordinates", "float32", 3, "the surface point in its object's local (mesh) frame", "",
+             lambda frame, key: object_coordinates(frame.raw, frame.intrinsics, frame.cam2world, frame.scene),
+             units="m", background="NaN", show="as_stored"),
     PassSpec("object_records", "json", None, "per object in view: obj2cam, 3D box, visible and amodal 2D boxes, "
              "pixel counts, visible fraction (render/raster/object_records.py)", "",
              lambda frame, key: object_records(frame), ("raster", "silhouettes"), option="render_object_records",

@@ -1,4 +1,5 @@
-"""Label passes derived from the raster depth and ids with the camera geometry: optical flow and NOCS.
+"""Label passes derived from the raster depth and ids with the camera geometry: optical flow, object
+coordinates and NOCS.
 
 Optical flow (pixels, float32 H x W x 2): for the surface point seen at pixel centre (u, v) of keypoint i,
 its image position in keypoint j minus (u, v) - forward: j = i + 1, backward: j = i - 1. The point moves with
@@ -10,8 +11,9 @@ point is not visible in keypoint j: something else is in front of it there (its 
 or there is no surface (background), or there is no keypoint j. Flow is 0 where it is undefined (background,
 no keypoint j). Keypoint j's own intrinsics (per-keypoint intrinsics) project the point there.
 
-NOCS (float32 H x W x 3, background 0): the object-local coordinates of the surface point, normalized
-as in the NOCS paper: ``(p_local - box_centre) / box_diagonal + 0.5`` with the object's local bounding box.
+Object coordinates (float32 H x W x 3, m, NaN on the background): the surface point in its object's local
+frame. NOCS (float32 H x W x 3, background 0): those coordinates normalized as in the NOCS paper:
+``(p_local - box_centre) / box_diagonal + 0.5`` with the object's local bounding box.
 """
 from __future__ import annotations
 
@@ -76,17 +78,28 @@ def optical_flow(raw: RasterOutput, intr: Intrinsics, pose_from: np.ndarray, pos
     return flow, occluded
 
 
+def object_coordinates(raw: RasterOutput, intr: Intrinsics, cam2world: np.ndarray, scene: Scene) -> np.ndarray:
+    """(H, W, 3) float32 coordinates (m) of every pixel's surface point in its object's local frame (the frame
+    of the mesh's vertices, before ``local2world``; NaN on the background)."""
+    out = np.full(raw.instance.shape + (3,), np.nan, np.float32)
+    world = camera_points(raw, intr) @ cam2world[:3, :3].T + cam2world[:3, 3]
+    for obj in scene.objects:
+        mask = raw.instance == obj.instance_id
+        if mask.any():
+            to_local = np.linalg.inv(obj.local2world)
+            out[mask] = world[mask] @ to_local[:3, :3].T + to_local[:3, 3]
+    return out
+
+
 def nocs(raw: RasterOutput, intr: Intrinsics, cam2world: np.ndarray, scene: Scene) -> np.ndarray:
     """(H, W, 3) float32 normalized object coordinates of every pixel's surface point (background 0)."""
+    local = object_coordinates(raw, intr, cam2world, scene)
     out = np.zeros(raw.instance.shape + (3,), np.float32)
-    world = camera_points(raw, intr) @ cam2world[:3, :3].T + cam2world[:3, 3]
     for obj in scene.objects:
         mask = raw.instance == obj.instance_id
         if not mask.any():
             continue
-        to_local = np.linalg.inv(obj.local2world)
-        local = world[mask] @ to_local[:3, :3].T + to_local[:3, 3]
         box = obj.bounds_local
         diagonal = float(np.linalg.norm(box[1] - box[0])) or 1.0
-        out[mask] = (local - box.mean(axis=0)) / diagonal + 0.5
+        out[mask] = (local[mask] - box.mean(axis=0)) / diagonal + 0.5
     return out

@@ -6,7 +6,7 @@ from typing import Any, Iterable, Sequence
 from ...io.frame_sink import FrameSink
 from ...io.texture_needs import require_base_colors
 from ...scene.scene import Scene
-from ..keypoint_loop import ProgressFactory, run_keypoints
+from ..keypoint_loop import ProgressFactory, StereoProducer, run_keypoints
 from .label_producer import LabelProducer
 from .label_request import LabelRequest
 from .raster_view import RasterView
@@ -17,11 +17,12 @@ __all__ = ["LabelProducer", "render_labels"]  # LabelProducer lives in label_pro
 def render_labels(scene: Scene, sinks: Iterable[FrameSink], request: LabelRequest | None = None, *,
                   default_category_id: int | None = None, view: RasterView | None = None,
                   progress: ProgressFactory | None = None, indices: Sequence[int] | None = None,
-                  render_threads: int = 1) -> int:
+                  render_threads: int = 1, stereo_baseline: float | None = None) -> int:
     """Render the label passes of the keypoints ``indices`` (default: all) of ``scene.camera`` into ``sinks``
     (plus the on-request passes they ask for); returns how many. ``render_threads`` > 1: that many raster
     threads, each with its own GL context (render/raster/threaded_labels.py; same values, same order; ``view``
-    then unused)."""
+    then unused). ``stereo_baseline`` (m): left/right pairs as :func:`hybridgen.render_color` makes them
+    (:class:`~hybridgen.render.keypoint_loop.StereoProducer`)."""
     sinks = list(sinks)
     request = (request or LabelRequest()).with_sinks(sinks)
     if request.albedo:  # the albedo pass shows base colors: their textures must exist (io/texture_needs.py)
@@ -34,4 +35,6 @@ def render_labels(scene: Scene, sinks: Iterable[FrameSink], request: LabelReques
                                          default_category_id=default_category_id)
     else:
         producer = LabelProducer(scene, request, default_category_id=default_category_id, view=view)
+    if stereo_baseline is not None:
+        producer = StereoProducer([producer], stereo_baseline, scene)
     return run_keypoints(scene, sinks, [producer], progress=progress, what="labels", indices=indices)
