@@ -11,10 +11,10 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..errors import InputError
-from ..scene.frames import forward_to_rotation_blender
-from .session import SESSION
+from ..scene.frames import blender_to_opencv, forward_to_rotation_blender
+from .session import SESSION, current_intrinsics
 from .types.entity import matrix4
-from .types.unsupported import module_getattr
+from .types.unsupported import fail, module_getattr
 
 
 def add_camera_pose(cam2world_matrix: Any, frame: int | None = None) -> int:
@@ -120,16 +120,71 @@ def get_view_fac_in_px(cam: Any = None, pixel_aspect_x: float | None = None, pix
 
 
 def set_stereo_parameters(convergence_mode: str, convergence_distance: float, interocular_distance: float) -> None:
-    """Stereo pair settings: ``PARALLEL`` cameras ``interocular_distance`` m apart (the only mode hybridgen
-    renders; BlenderProc's default)."""
-    if str(convergence_mode).upper() != "PARALLEL":
-        raise InputError(f"bproc.camera.set_stereo_parameters(convergence_mode={convergence_mode!r}) is not "
-                         "supported by hybridgen yet (PARALLEL only)")
-    SESSION.camera.interocular_distance = float(interocular_distance)
+    """Stereo pair settings for ``bproc.renderer.toggle_stereo``: the left eye is the camera pose, the right eye
+    ``interocular_distance`` m along its +x (Blender's pivot LEFT). ``PARALLEL`` (BlenderProc's default) is the
+    mode hybridgen renders; ``OFFAXIS``/``TOE`` stop a stereo render with one line."""
+    mode = str(convergence_mode).upper()
+    if mode not in ("OFFAXIS", "PARALLEL", "TOE"):
+        raise InputError(f"no such stereo convergence mode: {convergence_mode!r} (OFFAXIS, PARALLEL or TOE)")
+    if not float(interocular_distance) > 0:
+        raise InputError(f"interocular_distance must be > 0 m, got {interocular_distance}")
+    camera = SESSION.camera
+    camera.convergence_mode, camera.convergence_distance = mode, float(convergence_distance)
+    camera.interocular_distance = float(interocular_distance)
 
+
+def add_depth_of_field(focal_point_obj: Any, fstop_value: float, aperture_blades: int = 0,
+                       aperture_rotation: float = 0.0, aperture_ratio: float = 1.0,
+                       focal_distance: float = -1.0) -> None:
+    """A thin lens of f-stop ``fstop_value`` (aperture radius = lens / (2 f-stop)) focused on the origin of
+    ``focal_point_obj`` at every frame (it may move), or without one at ``focal_distance`` m along the view axis
+    (:class:`hybridgen.scene.depth_of_field.DepthOfField`; color only, as in Cycles the labels stay sharp). The
+    aperture is a round disk: polygonal blades (3 or more) and an anamorphic ratio other than 1 stop with one
+    line."""
+    if int(aperture_blades) >= 3:
+        fail(f"bproc.camera.add_depth_of_field(aperture_blades={aperture_blades})", "the aperture is a round disk")
+    if float(aperture_ratio) != 1.0:
+        fail(f"bproc.camera.add_depth_of_field(aperture_ratio={aperture_ratio})", "the aperture is a round disk")
+    if not float(fstop_value) > 0:
+        raise InputError(f"fstop_value must be > 0, got {fstop_value}")
+    if focal_point_obj is not None:
+        SESSION.camera.depth_of_field = {"fstop": float(fstop_value), "focus": focal_point_obj}
+    elif float(focal_distance) >= 0.0:
+        SESSION.camera.depth_of_field = {"fstop": float(fstop_value), "distance": max(float(focal_distance), 1e-6)}
+    else:
+        raise InputError("Either a focal_point_obj have to be given or the focal_distance has to be higher than zero.")
+
+
+def set_lens_distortion(k1: float, k2: float, k3: float = 0.0, p1: float = 0.0, p2: float = 0.0,
+                        use_global_storage: bool = False) -> np.ndarray:
+    """Brown-Conrady distortion (undistorted-to-distorted, CalLab's p1/p2 order;
+    :mod:`hybridgen.scene.lens_distortion`): the camera is enlarged (resolution, principal point) to the pinhole
+    render the distorted image needs, and the (2, H * W) mapping (rows, columns in that render, per distorted
+    pixel) is returned for ``bproc.postprocessing.apply_lens_distortion``."""
+    from ..scene.lens_distortion import BrownConrady, plan_distortion
+
+    plan = plan_distortion(current_intrinsics(), BrownConrady(float(k1), float(k2), float(k3), float(p1), float(p2)))
+    camera = SESSION.camera.blender
+    set_intrinsics_from_K_matrix(plan.render.K, plan.render.width, plan.render.height, camera.clip_start,
+                                 camera.clip_end)
+    return plan.mapping
+
+
+def is_point_inside_camera_frustum(point: Sequence[float], clip_start: float | None = None,
+                                   clip_end: float | None = None, frame: int | None = None) -> bool:
+    """Whether the world point (m) is inside the view frustum of the camera pose at ``frame`` (None: the
+    current pose): between the clip distances and inside the image (:mod:`hybridgen.scene.frustum`)."""
+    from ..scene.frustum import inside_frustum
+
+    pose = blender_to_opencv(get_camera_pose(frame))
+    return bool(inside_frustum(np.asarray(point, dtype=np.float64), pose, current_intrinsics(), clip_start,
+                               clip_end)[0])
+
+
+from .camera_validation import (decrease_interest_score, perform_obstacle_in_view_check,  # noqa: E402
+                                scene_coverage_score, visible_objects)
 
 __getattr__ = module_getattr("camera", [
-    "add_depth_of_field", "get_camera_frustum", "get_camera_frustum_as_object", "is_point_inside_camera_frustum",
-    "perform_obstacle_in_view_check", "visible_objects", "scene_coverage_score", "decrease_interest_score",
-    "check_novel_pose", "set_lens_distortion", "set_camera_parameters_from_config_file", "depth_via_raytracing",
-    "depth_at_points_via_raytracing", "pointcloud_from_depth", "project_points", "unproject_points"])
+    "get_camera_frustum", "get_camera_frustum_as_object", "check_novel_pose",
+    "set_camera_parameters_from_config_file", "depth_via_raytracing", "depth_at_points_via_raytracing",
+    "pointcloud_from_depth", "project_points", "unproject_points"])

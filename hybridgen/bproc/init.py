@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import InputError
 from ..logs import LOGGER
 from .blender_camera import BlenderCamera
-from .session import SESSION, RendererSettings, reset
+from .session import SESSION, CameraState, RendererSettings, reset
 
 SEED_ENV = "BLENDER_PROC_RANDOM_SEED"
 
@@ -29,7 +29,7 @@ def init(clean_up_scene: bool = True) -> None:
     if clean_up_scene:
         clean_up(clean_up_camera=True)
     SESSION.renderer = RendererSettings()
-    SESSION.camera.blender = BlenderCamera()
+    SESSION.camera = CameraState(pose=SESSION.camera.pose)  # BlenderProc's default camera, stereo off
     seed = os.environ.get(SEED_ENV)
     if seed:
         try:

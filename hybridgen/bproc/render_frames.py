@@ -9,7 +9,9 @@ color with :func:`hybridgen.render_color`, labels alone with :func:`hybridgen.re
 The result is ``{key: [one value per frame]}`` with BlenderProc's keys, dtypes, axes and encodings, in the order
 the outputs were enabled and ``colors`` (the ``output_key``) last:
 
-- ``colors``: uint8 (H, W, 3), sRGB (hybridgen's Standard view; BlenderProc 2.8's default is Filmic).
+- ``colors``: uint8 (H, W, 3), sRGB (hybridgen's Standard view; BlenderProc 2.8's default is Filmic: a
+  notice says so), uint16 with ``set_output_format(color_depth=16)``, JPEG-round-tripped with ``file_format``
+  JPEG.
 - ``depth``: float32 (H, W), m along the optical axis; background 1e10 (Cycles' Z pass), or with antialiasing
   the mist range (10000 m) as depth.
 - ``distance``: float32 (H, W), m from the camera centre; background the mist range, or 1e10 as distance.
@@ -20,6 +22,11 @@ the outputs were enabled and ``colors`` (the ``output_key``) last:
   ``instance_attribute_maps``.
 
 Labels are sampled at pixel centres (no antialiasing), where Cycles' passes average a pixel's samples.
+
+With ``toggle_stereo(True)`` every image has a leading axis of 2 (left eye = the camera pose, right eye
+``interocular_distance`` m along its +x; :class:`~hybridgen.render.keypoint_loop.StereoProducer`). With
+``add_depth_of_field`` the color is rendered through a thin lens focused, per frame, on the focus object's origin
+(:class:`~hybridgen.scene.depth_of_field.DepthOfField`). Conversion: :mod:`hybridgen.bproc.frame_outputs`.
 """
 from __future__ import annotations
 
@@ -31,23 +38,54 @@ import numpy as np
 from ..errors import InputError
 from ..scene.frames import blender_to_opencv
 from ..scene.object_keyframes import ObjectKeyframes
-from .segmentation import map_frame
+from .frame_outputs import convert_frame
 from .session import SESSION, current_intrinsics
 from .types import Light, MeshObject
+from .types.unsupported import fail
 
 MAX_SAMPLES_ENV = "HYBRIDGEN_BPROC_MAX_SAMPLES"
 """Environment variable capping the color samples per pixel of every render (tools/check_blenderproc_scripts.py
 uses it on a slow machine); unset: the script's settings."""
-BACKGROUND_DEPTH = 1e10
-"""Cycles' Z pass where a pixel sees no surface (m)."""
 DEFAULT_LOAD_KEYS = {"colors", "distance", "normals", "diffuse", "depth", "segmap"}
 
 
 def _light_state(frame: int) -> tuple[Any, ...]:
-    """What the lights and world show at ``frame`` (frames with equal states share one scene)."""
+    """What the lights, world and depth-of-field focus show at ``frame`` (frames with equal states share one
+    scene)."""
     lights = [e for e in SESSION.entities if isinstance(e, Light) and not e.is_hidden()]
     return tuple((l.get_type(frame), l.get_energy(frame), tuple(l.get_color(frame)), l.get_radius(frame),
-                  l.world_matrix(frame).tobytes()) for l in lights)
+                  l.world_matrix(frame).tobytes()) for l in lights) + (_focus_point(frame),)
+
+
+def _focus_point(frame: int) -> tuple[float, ...] | None:
+    """The world point (m) the depth of field focuses at ``frame``, or None (fixed distance or no DoF)."""
+    dof = SESSION.camera.depth_of_field
+    if dof is None or "focus" not in dof:
+        return None
+    return tuple(float(c) for c in dof["focus"].world_matrix(frame)[:3, 3])
+
+
+def _depth_of_field(frame: int) -> Any:
+    from ..scene.depth_of_field import DepthOfField
+
+    dof = SESSION.camera.depth_of_field
+    if dof is None:
+        return None
+    point = _focus_point(frame)
+    if point is not None:
+        return DepthOfField(dof["fstop"], focus_point=point)
+    return DepthOfField(dof["fstop"], focus_distance=dof["distance"])
+
+
+def _stereo_baseline() -> float | None:
+    """The right eye's offset (m) when stereo is on; a convergence other than PARALLEL stops with one line."""
+    camera = SESSION.camera
+    if not camera.stereo:
+        return None
+    if camera.convergence_mode != "PARALLEL":
+        fail(f"bproc.renderer.toggle_stereo(True) with convergence_mode={camera.convergence_mode!r}",
+             "PARALLEL only: set it with bproc.camera.set_stereo_parameters")
+    return camera.interocular_distance
 
 
 def _groups(frames: list[int]) -> list[list[int]]:
@@ -122,40 +160,12 @@ def _render_group(frames: list[int], meshes: list[MeshObject], color: bool) -> l
                                      max_bounces=settings.max_bounces, diffuse_bounces=settings.diffuse_bounces,
                                      glossy_bounces=settings.glossy_bounces,
                                      transmission_bounces=settings.transmission_bounces)
-        hg.render_color(scene, [sink], trace, labels=request, seed=0, denoise=settings.denoiser is not None)
+        scene.camera.depth_of_field = _depth_of_field(frames[0])
+        hg.render_color(scene, [sink], trace, labels=request, seed=0, denoise=settings.denoiser is not None,
+                        hdr=settings.color_depth == 16, stereo_baseline=_stereo_baseline())
     else:
-        hg.render_labels(scene, [sink], request)
+        hg.render_labels(scene, [sink], request, stereo_baseline=_stereo_baseline())
     return [(values, table) for values in sink.frames]
-
-
-def _convert(values: dict[str, Any], table: np.ndarray, cam2world: np.ndarray, meshes: list[MeshObject],
-             ray_lengths: np.ndarray) -> dict[str, Any]:
-    """One frame's hybridgen values -> BlenderProc's keys (by output kind)."""
-    from ..io.hdf5_blenderproc import encode_normals
-    from ..render.tonemap import to_srgb8
-
-    outputs = SESSION.renderer.outputs
-    converted: dict[str, Any] = {}
-    instances = table[np.asarray(values["instance_segmaps"])] if outputs else None
-    background = instances == 0 if instances is not None else None
-    for kind, options in outputs.items():
-        if kind in ("depth", "distance"):
-            image = np.array(values[kind], dtype=np.float32)
-            far = options["distance_max"] if options["antialiasing"] else BACKGROUND_DEPTH
-            far_depth = far / ray_lengths if options["antialiasing"] else np.full_like(ray_lengths, far)
-            image[background] = (far_depth if kind == "depth" else far_depth * ray_lengths)[background]
-            converted[kind] = image
-        elif kind == "normals":
-            normals = encode_normals(values["normals"], blender_to_opencv(cam2world), "camera")
-            normals[background] = 0.5
-            converted[kind] = normals
-        elif kind == "diffuse":
-            converted[kind] = to_srgb8(np.asarray(values["albedo"])[..., :3])
-        elif kind == "segmentation":
-            converted[kind] = map_frame(instances, options["map_by"], options["default_values"], meshes)
-    if "colors" in values:
-        converted["colors"] = np.asarray(values["colors"], dtype=np.uint8)[..., :3]
-    return converted
 
 
 def render_frames(output_key: str | None, load_keys: set[str] | None, return_data: bool) -> dict[str, list[Any]]:
@@ -168,11 +178,18 @@ def render_frames(output_key: str | None, load_keys: set[str] | None, return_dat
     if not meshes:
         raise InputError("There are no mesh-objects to render, please load an object before invoking the renderer.")
     keys = set(DEFAULT_LOAD_KEYS if load_keys is None else load_keys) | ({output_key} if output_key else set())
+    view = SESSION.renderer.view_transform
+    if output_key is not None and view != "Standard":
+        from ..config.notices import notice
+
+        notice(f"colors use the Standard sRGB view; BlenderProc renders with Blender's '{view}' view transform "
+               "(its look tables are not reproduced): set_output_format(view_transform='Standard') matches exactly")
     rendered = [pair for group in _groups(frames) for pair in _render_group(group, meshes, output_key is not None)]
     ray_lengths = current_intrinsics().pixel_ray_lengths()
     data: dict[str, list[Any]] = {}
     for frame, (values, table) in zip(frames, rendered):
-        converted = _convert(values, table, SESSION.camera.pose.at(frame), meshes, ray_lengths)
+        converted = convert_frame(values, table, SESSION.camera.pose.at(frame), meshes, ray_lengths,
+                                  SESSION.camera.stereo)
         for kind, options in SESSION.renderer.outputs.items():
             if kind == "segmentation":
                 if "segmap" in keys:

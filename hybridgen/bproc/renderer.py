@@ -5,13 +5,16 @@ and ``set_noise_threshold`` the adaptive-sampling threshold (0: every pixel gets
 hybridgen's :class:`~hybridgen.PathTraceSettings` reads Cycles' settings; ``set_light_bounces`` sets Cycles'
 limits (max, diffuse, glossy, transmission; the AO, transparency and volume limits change nothing hybridgen
 renders); ``set_denoiser`` ``INTEL`` (default) or ``OPTIX`` denoise with Open Image Denoise, None renders the
-raw estimate. Settings that only change speed (threads, devices, light tree, subdivision simplification) are
-accepted. ``render()`` itself is :func:`hybridgen.bproc.render_frames.render_frames`.
+raw estimate. Settings that only change speed (threads, devices, light tree) are accepted;
+``set_simplify_subdivision_render`` gives a notice (no subdivision surfaces here). ``render()`` itself is
+:func:`hybridgen.bproc.render_frames.render_frames`; ``render_optical_flow`` and ``render_nocs`` are
+:mod:`hybridgen.bproc.label_renders`.
 """
 from __future__ import annotations
 
 from typing import Any
 
+from ..config.notices import notice
 from ..errors import InputError
 from .render_frames import render_frames
 from .session import SESSION
@@ -20,6 +23,8 @@ from .types.unsupported import fail, module_getattr
 ANTIALIASING_DISTANCE_MAX = 10000.0
 """BlenderProc's default mist range (m): the background's value in an antialiased distance image."""
 FILE_ENDINGS = {"PNG": ".png", "JPEG": ".jpg", "OPEN_EXR": ".exr"}
+VIEW_TRANSFORMS = ("Standard", "Filmic", "AgX")
+"""View transforms ``set_output_format`` takes: Standard is exact, the others render as Standard with a notice."""
 
 
 def set_denoiser(denoiser: str | None) -> None:
@@ -60,22 +65,29 @@ def set_max_amount_of_samples(samples: int) -> None:
 def set_output_format(file_format: str | None = None, color_depth: int | None = None,
                       enable_transparency: bool | None = None, jpg_quality: int | None = None,
                       view_transform: str | None = None) -> None:
-    """``file_format`` PNG or JPEG is what ``colors`` holds (JPEG: a JPEG-compressed image as BlenderProc loads
-    it back is not simulated; the exact colors come back); transparency and view transforms other than
-    ``Standard`` are not supported."""
+    """What ``colors`` holds: ``file_format`` PNG (exact) or JPEG (the image after a JPEG round trip at
+    ``jpg_quality``, as BlenderProc loads its ``.jpg`` back); ``color_depth`` 8 (uint8) or 16 (uint16, PNG only);
+    ``view_transform`` Standard, or Filmic / AgX, which hybridgen renders as Standard with a notice (Blender's
+    look tables are not reproduced; :mod:`hybridgen.bproc.render_frames`). Transparency stops with one line."""
+    settings = SESSION.renderer
     if enable_transparency:
         fail("bproc.renderer.set_output_format(enable_transparency=True)", "colors have no alpha channel")
-    if view_transform is not None and view_transform != "Standard":
+    if view_transform is not None and view_transform not in VIEW_TRANSFORMS:
         fail(f"bproc.renderer.set_output_format(view_transform={view_transform!r})",
-             "hybridgen's colors are the Standard sRGB view")
-    if color_depth is not None and int(color_depth) != 8:
-        fail(f"bproc.renderer.set_output_format(color_depth={color_depth})", "colors are 8-bit")
-    if file_format is not None:
-        if str(file_format).upper() not in ("PNG", "JPEG"):
-            fail(f"bproc.renderer.set_output_format(file_format={file_format!r})", "PNG and JPEG are")
-        SESSION.renderer.file_format = str(file_format).upper()
+             f"views: {', '.join(VIEW_TRANSFORMS)}")
+    fmt = settings.file_format if file_format is None else str(file_format).upper()
+    if fmt not in ("PNG", "JPEG"):
+        fail(f"bproc.renderer.set_output_format(file_format={file_format!r})", "PNG and JPEG are")
+    depth = settings.color_depth if color_depth is None else int(color_depth)
+    if depth not in (8, 16) or (fmt == "JPEG" and depth != 8):
+        raise InputError(f"color_depth {color_depth} is not a {fmt} color depth (PNG: 8 or 16, JPEG: 8)")
+    if jpg_quality is not None and not 0 <= int(jpg_quality) <= 100:
+        raise InputError(f"jpg_quality must be in 0..100, got {jpg_quality}")
+    settings.file_format, settings.color_depth = fmt, depth
+    if jpg_quality is not None:
+        settings.jpg_quality = int(jpg_quality)
     if view_transform is not None:
-        SESSION.renderer.view_transform = view_transform
+        settings.view_transform = view_transform
 
 
 def map_file_format_to_file_ending(file_format: str) -> str:
@@ -156,17 +168,23 @@ def accept_speed_setting(*_args: Any, **_kwargs: Any) -> None:
     """A Cycles setting that changes speed or devices only: nothing to do."""
 
 
-set_cpu_threads = set_render_devices = toggle_light_tree = accept_speed_setting
-set_simplify_subdivision_render = enable_experimental_features = accept_speed_setting
+set_cpu_threads = set_render_devices = toggle_light_tree = enable_experimental_features = accept_speed_setting
+
+
+def set_simplify_subdivision_render(simplify_subdivision_render: int) -> None:
+    """Blender's subdivision limit for renders: hybridgen's meshes have no subdivision modifiers (a notice)."""
+    notice("bproc.renderer.set_simplify_subdivision_render has no meaning in hybridgen (meshes have no "
+           "subdivision modifiers); nothing changes")
 
 
 def toggle_stereo(enable: bool) -> None:
-    """Stereo rendering is not supported yet (off is accepted)."""
-    if enable:
-        fail("bproc.renderer.toggle_stereo(True)")
+    """Render left/right pairs (``bproc.camera.set_stereo_parameters``): every image of ``render()`` then has a
+    leading axis of 2 (:mod:`hybridgen.bproc.render_frames`)."""
+    SESSION.camera.stereo = bool(enable)
 
 
-__getattr__ = module_getattr("renderer", ["enable_motion_blur", "render_segmap",
-                                          "render_optical_flow", "render_nocs"])
+from .label_renders import render_nocs, render_optical_flow  # noqa: E402
+
+__getattr__ = module_getattr("renderer", ["enable_motion_blur", "render_segmap"])
 
 from .world import set_world_background  # noqa: E402 - BlenderProc exports it from bproc.renderer

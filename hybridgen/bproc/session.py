@@ -81,6 +81,8 @@ class RendererSettings:
     glossy_bounces: int = 0
     transmission_bounces: int = 0
     file_format: str = "PNG"
+    color_depth: int = 8
+    jpg_quality: int = 95
     transparent: bool = False
     view_transform: str = "Filmic"
     outputs: dict[str, dict[str, Any]] = field(default_factory=dict)
@@ -103,14 +105,19 @@ class WorldState:
 @dataclass
 class CameraState:
     """The scene camera: Blender's lens, sensor, resolution and clip range (:mod:`hybridgen.bproc.blender_camera`),
-    stereo settings and its pose as an :class:`Animated` Blender-axes cam2world 4x4 (keyed by
+    stereo settings (BlenderProc's defaults: PARALLEL, 0.065 m apart), depth of field and its pose as an
+    :class:`Animated` Blender-axes cam2world 4x4 (keyed by
     ``add_camera_pose``)."""
 
     blender: BlenderCamera = field(default_factory=BlenderCamera)
     pose: Animated = field(default_factory=lambda: Animated(np.eye(4)))
     stereo: bool = False
     interocular_distance: float = 0.065
+    convergence_mode: str = "PARALLEL"
+    convergence_distance: float = 1e-5
     depth_of_field: dict[str, Any] | None = None
+    """``add_depth_of_field``'s settings: ``fstop``, and ``focus`` (an entity whose origin is focused, per frame)
+    or ``distance`` (m along the view axis)."""
 
 
 @dataclass
@@ -173,5 +180,7 @@ def reset(keep_initialized: bool = True) -> Session:
     renderer settings are reset by ``init()`` only). Returns the session."""
     fresh = Session(initialized=keep_initialized, renderer=SESSION.renderer)
     fresh.camera.blender = SESSION.camera.blender
+    for name in ("stereo", "interocular_distance", "convergence_mode", "convergence_distance"):
+        setattr(fresh.camera, name, getattr(SESSION.camera, name))  # scene and camera settings Blender keeps
     SESSION.__dict__.update(fresh.__dict__)
     return SESSION

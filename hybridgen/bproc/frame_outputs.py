@@ -1,0 +1,105 @@
+"""One rendered frame's hybridgen values -> BlenderProc's data-dict values (keys by output kind), for
+:mod:`hybridgen.bproc.render_frames`.
+
+Per output kind (``SESSION.renderer.outputs``) and the color key:
+
+- ``depth`` / ``distance``: float32 (H, W) m; background 1e10 (Cycles' Z pass) or, with antialiasing, the mist
+  range (10000 m) - as distance, or as depth along each pixel's ray.
+- ``normals``: float32 (H, W, 3), Blender camera axes (x right, y up, z backwards), ``0.5 n + 0.5``; 0.5 on the
+  background.
+- ``diffuse``: uint8 (H, W, 3) sRGB of the base color.
+- ``segmentation``: :func:`hybridgen.bproc.segmentation.map_frame`'s keys.
+- colors: uint8 (H, W, 3) sRGB (Standard view); ``color_depth`` 16: uint16 of the linear float16 render; file
+  format JPEG: the 8-bit image after a JPEG round trip at ``jpg_quality`` (what BlenderProc loads back from its
+  ``.jpg``; Blender and hybridgen both keep full chroma above quality 90).
+
+Stereo frames (values with a leading axis of 2: left, right) give every image a leading axis of 2 as BlenderProc's
+data dict holds them; ``instance_attribute_maps`` of a stereo frame is one list over both eyes.
+"""
+from __future__ import annotations
+
+import io
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..scene.frames import blender_to_opencv
+from .segmentation import map_frame
+from .session import SESSION
+
+BACKGROUND_DEPTH = 1e10
+"""Cycles' Z pass where a pixel sees no surface (m)."""
+
+
+def _colors(values: dict[str, Any]) -> np.ndarray:
+    settings = SESSION.renderer
+    if settings.color_depth == 16 and "colors_hdr" in values:
+        from ..render.tonemap import to_srgb16
+
+        return to_srgb16(np.asarray(values["colors_hdr"], dtype=np.float32)[..., :3])
+    colors = np.asarray(values["colors"], dtype=np.uint8)[..., :3]
+    if settings.file_format == "JPEG":
+        from PIL import Image
+
+        from ..io.image_files import jpeg_bytes
+
+        colors = np.asarray(Image.open(io.BytesIO(jpeg_bytes(colors, settings.jpg_quality))).convert("RGB"))
+    return colors
+
+
+def _convert_eye(values: dict[str, Any], table: np.ndarray, cam2world: np.ndarray, meshes: Sequence[Any],
+                 ray_lengths: np.ndarray) -> dict[str, Any]:
+    """One eye's values -> BlenderProc's values by output kind (``colors``: the color image)."""
+    from ..io.hdf5_blenderproc import encode_normals
+    from ..render.tonemap import to_srgb8
+
+    outputs = SESSION.renderer.outputs
+    converted: dict[str, Any] = {}
+    instances = table[np.asarray(values["instance_segmaps"])] if outputs else None
+    background = instances == 0 if instances is not None else None
+    for kind, options in outputs.items():
+        if kind in ("depth", "distance"):
+            image = np.array(values[kind], dtype=np.float32)
+            far = options["distance_max"] if options["antialiasing"] else BACKGROUND_DEPTH
+            far_depth = far / ray_lengths if options["antialiasing"] else np.full_like(ray_lengths, far)
+            image[background] = (far_depth if kind == "depth" else far_depth * ray_lengths)[background]
+            converted[kind] = image
+        elif kind == "normals":
+            normals = encode_normals(values["normals"], blender_to_opencv(cam2world), "camera")
+            normals[background] = 0.5
+            converted[kind] = normals
+        elif kind == "diffuse":
+            converted[kind] = to_srgb8(np.asarray(values["albedo"])[..., :3])
+        elif kind == "segmentation":
+            converted[kind] = map_frame(instances, options["map_by"], options["default_values"], meshes)
+    if "colors" in values:
+        converted["colors"] = _colors(values)
+    return converted
+
+
+def _merge_eyes(left: dict[str, Any], right: dict[str, Any]) -> dict[str, Any]:
+    """Two eyes' converted values -> one stereo frame (images stacked on a leading axis of 2)."""
+    merged: dict[str, Any] = {}
+    for kind, value in left.items():
+        if kind != "segmentation":
+            merged[kind] = np.stack([value, right[kind]])
+            continue
+        segmentation: dict[str, Any] = {}
+        for key, image in value.items():
+            if key != "instance_attribute_maps":
+                segmentation[key] = np.stack([image, right[kind][key]])
+        records: dict[int, dict[str, Any]] = {}
+        for record in value["instance_attribute_maps"] + right[kind]["instance_attribute_maps"]:
+            records.setdefault(record["idx"], {}).update(record)
+        segmentation["instance_attribute_maps"] = list(records.values())
+        merged[kind] = segmentation
+    return merged
+
+
+def convert_frame(values: dict[str, Any], table: np.ndarray, cam2world: np.ndarray, meshes: Sequence[Any],
+                  ray_lengths: np.ndarray, stereo: bool) -> dict[str, Any]:
+    """One frame's values (stereo: each with a leading axis of 2) -> BlenderProc's values by output kind."""
+    if not stereo:
+        return _convert_eye(values, table, cam2world, meshes, ray_lengths)
+    eyes = [{key: value[eye] for key, value in values.items()} for eye in (0, 1)]
+    return _merge_eyes(*(_convert_eye(eye, table, cam2world, meshes, ray_lengths) for eye in eyes))
