@@ -34,6 +34,7 @@ from check_blenderproc_configs import example_configs, make_standins  # noqa: E4
 
 REPO = TOOLS.parent
 RUN_LINE = re.compile(r"blenderproc run (examples/\S+/main\.py)([^\n`]*)")
+PLACEHOLDER = re.compile(r"<([^<>]+)>")
 
 
 def readme_args(script: Path, root: Path) -> list[str]:
@@ -42,14 +43,37 @@ def readme_args(script: Path, root: Path) -> list[str]:
     readme = script.parent / "README.md"
     if not readme.is_file():
         return []
-    found = [[arg for arg in shlex.split(match.group(2).split("#")[0]) if arg != "\\"]
-             for match in RUN_LINE.finditer(readme.read_text(errors="replace"))
-             if script.relative_to(root).as_posix() == match.group(1)]
+    matches = list(RUN_LINE.finditer(readme.read_text(errors="replace")))
+    wanted = script.relative_to(root).as_posix()
+    same = [m for m in matches if m.group(1) == wanted]
+    if not same:  # a README naming its script under another folder (nocs: examples/datasets/nocs/main.py)
+        same = [m for m in matches if Path(m.group(1)).parent.name == script.parent.name
+                and Path(m.group(1)).name == script.name]
+    found = [[arg for arg in shlex.split(PLACEHOLDER.sub(_one_word, m.group(2).split("#")[0])) if arg != "\\"]
+             for m in same]
     return max(found, key=len, default=[])
+
+
+def _one_word(match: re.Match) -> str:
+    """A README placeholder (``<path to cam_pose file>``) as one argument: ``<path_to_cam_pose_file>``."""
+    return "<" + "_".join(match.group(1).split()) + ">"
+
+
+def resolve_placeholder(arg: str, work: Path) -> str:
+    """A README placeholder's stand-in: a number for ``<number of ...>``, the camera file for a camera pose
+    file, else the name it asks for (``<path_to_house.json>`` -> ``house.json``) resolved as any argument."""
+    inner = arg[1:-1].lower()
+    if "number" in inner:
+        return "2560"
+    if "cam" in inner:
+        return str(work / "camera_positions")
+    return re.sub(r"^path_to_(the_)?", "", arg[1:-1], flags=re.IGNORECASE)
 
 
 def resolve_arg(arg: str, root: Path, work: Path, output: Path) -> str:
     """The checkout's file, a temporary output folder, or a stand-in (see the module documentation)."""
+    if arg.startswith("<") and arg.endswith(">"):
+        arg = resolve_placeholder(arg, work)
     if arg.startswith("-") or re.fullmatch(r"[-+]?\d+(\.\d+)?", arg):
         return arg
     if "output" in arg:
