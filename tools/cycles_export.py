@@ -37,12 +37,16 @@ def export_for_cycles(scene: Any, path: Path, spp: int, bounces: int, min_bounce
                 texture = np.asarray(Image.open(texture).convert("RGB"))
             arrays[f"tex{i}"] = np.ascontiguousarray(np.asarray(texture)[..., :3], dtype=np.uint8)
             arrays[f"uv{i}"] = np.asarray(obj.uvs, dtype=np.float32)
-        diffuse = m.specular == 0 and m.metallic == 0 and m.transmission == 0  # as mitsuba_scene.bsdf_dict
+        diffuse = m.specular == 0 and m.metallic == 0 and m.transmission == 0 and not m.extra  # as bsdf_dict
         objects.append({"name": obj.name, "kind": "diffuse" if diffuse else "principled",
                         "color": [float(c) for c in m.base_color[:3]], "roughness": float(m.roughness),
                         "metallic": float(m.metallic), "specular": float(m.specular),
                         "transmission": float(m.transmission), "ior": float(m.ior),
-                        "emission": emitted_radiance(obj).tolist()})
+                        "emission": emitted_radiance(obj).tolist(),
+                        # Principled inputs beyond the Material's fields (coat, tint, ...); absent when none, so
+                        # existing exports (and the benchmark's reference digests) stay byte-identical
+                        **({"extra": {k: list(v) if isinstance(v, (list, tuple)) else v for k, v in m.extra.items()}}
+                           if m.extra else {})})
     lights = [{"type": light.type, "energy": float(light.energy), "color": [float(c) for c in light.color],
                "radius": float(light.radius), "local2world": np.asarray(light.local2world).tolist()}
               for light in scene.lights if light.type in ("POINT", "SUN")]

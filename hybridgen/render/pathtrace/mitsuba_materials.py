@@ -3,8 +3,11 @@
 The BSDF is built inside out:
 
 - ``diffuse`` when the material has no specular, metal or transmission (Blender 4's principled is Lambertian
-  then), else ``principled`` with base color, roughness and metallic each a value or a texture; a specular
-  map blends principled BSDFs of a few specular amounts per texel (:func:`specular_levels`);
+  then); else, in the JIT variants, hybridgen's Principled BSDF (:mod:`.principled_bsdf`, Blender 4.2's
+  Principled BSDF, two-sided by itself; :mod:`.principled_material` maps the inputs, maps included, and
+  ``HYBRIDGEN_PRINCIPLED=mitsuba`` restores the next item); else Mitsuba's ``principled`` (Disney 2015) with
+  base color, roughness and metallic each a value or a texture, where a specular map blends principled BSDFs
+  of a few specular amounts per texel (:func:`specular_levels`);
 - ``normalmap`` around it for a tangent-space normal map (Mitsuba's tangent frame: x = dP/du projected
   into the surface, y = n x x, i.e. +v for a right-handed UV layout, the OpenGL convention; DirectX maps
   get their green channel inverted first);
@@ -30,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ...input_paths import not_found, utf8_path
+from ...input_paths import not_found
 from ...errors import InputError
 from ...io.image_check import check_image_file
 from ...scene.material import ALPHA_MODES, Material
@@ -57,7 +60,7 @@ def color_texture(texture: Any, owner: str, slot: str = "base_color_texture") ->
     import mitsuba as mi
 
     if isinstance(texture, (str, Path)):
-        return {"type": "bitmap", "filename": utf8_path(_checked_path(texture, owner, slot))}
+        return {"type": "bitmap", "filename": str(_checked_path(texture, owner, slot))}
     array = np.ascontiguousarray(np.asarray(texture)[..., :3])
     if array.dtype != np.uint8 or array.ndim != 3:
         raise InputError(f"object '{owner}': {slot} must be an HxWx3/4 uint8 image")
@@ -73,7 +76,7 @@ def data_texture(texture: Any, owner: str, slot: str, *, channels: int = 1,
     import mitsuba as mi
 
     if isinstance(texture, (str, Path)) and not invert_green and threshold is None and channels == 3:
-        return {"type": "bitmap", "filename": utf8_path(_checked_path(texture, owner, slot)), "raw": True}
+        return {"type": "bitmap", "filename": str(_checked_path(texture, owner, slot)), "raw": True}
     if isinstance(texture, (str, Path)):
         _checked_path(texture, owner, slot)
     values = data_image(texture, owner, slot, channels)  # float32 0..1, rows top-down
@@ -91,8 +94,9 @@ def _scalar_or_map(material: Material, name: str, owner: str) -> Any:
     return data_texture(texture, owner, f"{name}_texture")
 
 
-def check_material(material: Material, owner: str) -> None:
-    """One-line errors for values no renderer can use."""
+def check_material(material: Material, owner: str, *, extra_inputs: bool = False) -> None:
+    """One-line errors for values no renderer can use; ``extra_inputs``: ``material.extra`` may hold the
+    Principled inputs hybridgen's own Principled BSDF reads (:mod:`.principled_material`)."""
     for name in ("roughness", "metallic", "specular", "transmission", "alpha"):
         value = getattr(material, name)
         if not (isinstance(value, (int, float)) and 0.0 <= value <= 1.0):
@@ -102,9 +106,10 @@ def check_material(material: Material, owner: str) -> None:
                          f"got {material.alpha_mode!r}")
     if not np.isfinite(material.displacement_scale):
         raise InputError(f"object '{owner}': material '{material.name}' displacement_scale must be finite")
-    if material.extra:
+    if material.extra and not extra_inputs:
         raise InputError(f"object '{owner}': material '{material.name}' has unsupported parameter(s) "
-                         f"{sorted(material.extra)}")
+                         f"{sorted(material.extra)} (Principled inputs beyond the scene model's need hybridgen's "
+                         f"Principled BSDF: a JIT variant)")
 
 
 SPECULAR_LEVELS = 4
@@ -185,7 +190,10 @@ def bsdf_dict(material: Material, owner: str, *, vertex_colors: bool = False) ->
     """Mitsuba BSDF of ``material`` (see the module docstring for the nesting); with ``vertex_colors`` (the
     mesh carries :data:`VERTEX_COLOR_ATTRIBUTE`) and the material's ``base_color_from_vertices``, the base
     color is that attribute (a base-color texture still wins, as a linked image in Blender)."""
-    check_material(material, owner)
+    from . import principled_material
+
+    blender = principled_material.enabled()  # hybridgen's Principled BSDF (JIT variants)
+    check_material(material, owner, extra_inputs=blender)
     if material.base_color_texture is not None:
         base = color_texture(material.base_color_texture, owner)
     elif vertex_colors and material.base_color_from_vertices:
@@ -195,9 +203,15 @@ def bsdf_dict(material: Material, owner: str, *, vertex_colors: bool = False) ->
     bsdf: dict[str, Any]
     levels, weights = specular_levels(material, owner)
     plain = levels[-1] == 0 and material.metallic == 0 and material.metallic_texture is None
-    if plain and material.transmission == 0:
+    if plain and material.transmission == 0 and not material.extra:
         # A principled material without specular, metal or transmission is Lambertian (as Blender 4's).
         bsdf = {"type": "diffuse", "reflectance": base}
+    elif blender:
+        specular = float(material.specular) if material.specular_texture is None else \
+            data_texture(material.specular_texture, owner, "specular_texture")
+        bsdf = principled_material.plugin_dict(
+            material, owner, base, filtered_roughness(_scalar_or_map(material, "roughness", owner)),
+            _scalar_or_map(material, "metallic", owner), specular)
     else:
         bsdf = _specular_bsdf(material, owner, base, levels, weights)
     if material.normal_texture is not None:
@@ -208,7 +222,7 @@ def bsdf_dict(material: Material, owner: str, *, vertex_colors: bool = False) ->
         bsdf = {"type": "bumpmap", "bsdf": bsdf, "scale": float(material.displacement_scale),
                 "use_shadowing_function": False,
                 "arbitrary": data_texture(material.displacement_texture, owner, "displacement_texture")}
-    if material.transmission == 0:
+    if material.transmission == 0 and not (blender and bsdf_is_plugin(bsdf)):
         # Mitsuba's opaque BSDFs are one-sided; Blender (and real meshes with mixed windings) need both sides.
         bsdf = {"type": "twosided", "material": bsdf}
     clip = 0.5 if material.alpha_mode == "CLIP" else None
@@ -220,6 +234,15 @@ def bsdf_dict(material: Material, owner: str, *, vertex_colors: bool = False) ->
         if alpha < 1.0:
             bsdf = {"type": "mask", "opacity": alpha, "material": bsdf}
     return bsdf
+
+
+def bsdf_is_plugin(bsdf: dict[str, Any]) -> bool:
+    """Whether ``bsdf`` (possibly inside normal / bump map wrappers) is hybridgen's two-sided Principled BSDF."""
+    from .principled_bsdf import PLUGIN_NAME
+
+    while bsdf.get("type") in ("normalmap", "bumpmap"):
+        bsdf = bsdf["bsdf"]
+    return bsdf.get("type") == PLUGIN_NAME
 
 
 def loaded_bsdf(material: Material, owner: str, *, vertex_colors: bool = False,

@@ -189,8 +189,10 @@ def register(variant: str) -> None:
         def eval_attribute_3(self, name: str, si: Any, active: Any = True) -> Any:
             return self.base_color.eval(si, active) if name == "base_color" else mi.Color3f(0.0)
 
-        def traverse(self, callback: Any) -> None:
-            callback.put("base_color", self.base_color, mi.ParamFlags.Differentiable)
+        def traverse(self, callback: Any) -> None:  # mi.traverse: "<bsdf>.<input>.<texture parameter>"
+            for name in ("base_color", "roughness", "metallic", "specular"):
+                if isinstance(getattr(self, name), mi.Texture):
+                    callback.put(name, getattr(self, name), mi.ParamFlags.Differentiable)
 
         def parameters_changed(self, keys: Any = None) -> None:
             pass
