@@ -13,9 +13,17 @@ import numpy as np
 
 from ..errors import InputError
 from ..scene.primitives import make_primitive
-from .session import SESSION
+from .bvh_tree import create_bvh_tree_multi_objects, scene_ray_cast
+from .physics import simulate_physics, simulate_physics_and_fix_final_poses
+from .placement import sample_poses, sample_poses_on_surface
 from .types import Entity, MeshObject
+from .types.mesh_object import get_all_mesh_objects
 from .types.unsupported import fail, module_getattr
+
+__all__ = ["compute_poi", "convert_to_entities", "convert_to_meshes", "create_bvh_tree_multi_objects", "create_empty",
+           "create_primitive", "delete_multiple", "disable_all_rigid_bodies", "get_all_mesh_objects", "merge_objects",
+           "sample_poses", "sample_poses_on_surface", "scene_ray_cast", "simulate_physics",
+           "simulate_physics_and_fix_final_poses"]
 
 SHAPES = {"CUBE": ("cube", "Cube"), "PLANE": ("plane", "Plane"), "SPHERE": ("sphere", "Sphere"),
           "CYLINDER": ("cylinder", "Cylinder"), "CONE": ("cone", "Cone")}
@@ -53,11 +61,6 @@ def create_primitive(shape: str, **kwargs: Any) -> MeshObject:
     return obj
 
 
-def get_all_mesh_objects() -> list[MeshObject]:
-    """Every mesh object of the scene, in creation order."""
-    return [e for e in SESSION.entities if isinstance(e, MeshObject)]
-
-
 def convert_to_meshes(blender_objects: Sequence[Any]) -> list[MeshObject]:
     """The mesh objects among ``blender_objects`` (they already are hybridgen's)."""
     return [obj for obj in blender_objects if isinstance(obj, MeshObject)]
@@ -78,6 +81,25 @@ def delete_multiple(entities: Sequence[Entity], remove_all_offspring: bool = Fal
             entity.delete(remove_all_offspring)
 
 
+def merge_objects(objects: Sequence[Entity], merged_object_name: str = "merged_object") -> Entity:
+    """A new empty named ``merged_object_name`` becomes the parent of every object of ``objects`` that has no
+    parent yet (each keeps its world pose); returns the empty."""
+    if merged_object_name == "":
+        raise InputError("merge_objects: the parent object name cannot be empty")
+    parent = create_empty(merged_object_name)
+    for obj in objects:
+        if obj.get_parent() is None:
+            obj.set_parent(parent)
+    return parent
+
+
+def disable_all_rigid_bodies() -> None:
+    """Remove the rigid-body component of every mesh object that has one."""
+    for obj in get_all_mesh_objects():
+        if obj.has_rigidbody_enabled():
+            obj.disable_rigidbody()
+
+
 def compute_poi(objects: Sequence[MeshObject]) -> np.ndarray:
     """BlenderProc's point of interest (world, m): of the objects' world bound box centres, the one closest to
     their mean."""
@@ -88,7 +110,5 @@ def compute_poi(objects: Sequence[MeshObject]) -> np.ndarray:
 
 
 __getattr__ = module_getattr("object", [
-    "extract_floor", "slice_faces_with_normals", "sample_poses", "merge_objects", "replace_objects",
-    "sample_poses_on_surface", "simulate_physics_and_fix_final_poses", "simulate_physics",
-    "create_from_blender_mesh", "create_with_empty_mesh", "disable_all_rigid_bodies",
-    "create_bvh_tree_multi_objects", "scene_ray_cast", "create_from_point_cloud"])
+    "extract_floor", "slice_faces_with_normals", "replace_objects", "create_from_blender_mesh",
+    "create_with_empty_mesh", "create_from_point_cloud"])

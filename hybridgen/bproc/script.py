@@ -34,7 +34,7 @@ from ..errors import HybridgenError, InputError
 from .session import SESSION, Session
 
 PACKAGE = __name__.rpartition(".")[0]
-ALIASES = {"blenderproc": PACKAGE, "bpy": f"{PACKAGE}.bpy_standin"}
+ALIASES = {"blenderproc": PACKAGE, "bpy": f"{PACKAGE}.bpy_standin", "mathutils": f"{PACKAGE}.mathutils_standin"}
 
 
 class _AliasLoader(importlib.abc.Loader):

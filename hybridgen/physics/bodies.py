@@ -29,8 +29,10 @@ class Body:
     """One active object in the simulation and the constant map between its body and object frames."""
 
     def __init__(self, obj: MeshObject, geometry: CollisionGeometry, rotation: np.ndarray, linear: np.ndarray,
-                 mass: float) -> None:
+                 mass: float, settings: PhysicsSettings | None = None) -> None:
         self.obj = obj
+        self.settings = settings or PhysicsSettings()
+        """This body's settings (friction, damping, margin, mass: the simulation's or its own)."""
         self.geometry = geometry
         self.linear = linear  # K
         self.mass = mass
@@ -85,4 +87,4 @@ def active_body(obj: MeshObject, settings: PhysicsSettings) -> Body:
     except InputError as exc:
         raise InputError(f"active object '{obj.name}': {exc}") from None
     mass = settings.mass if settings.mass is not None else settings.density * geometry.volume
-    return Body(obj, geometry, rotation, linear, mass)
+    return Body(obj, geometry, rotation, linear, mass, settings)

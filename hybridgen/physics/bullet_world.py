@@ -94,8 +94,9 @@ class BulletWorld:
         except pb.error as exc:
             raise InputError(f"PyBullet could not build its collision shape: {exc}") from None
 
-    def add_static(self, obj: MeshObject) -> int:
-        s = self.settings
+    def add_static(self, obj: MeshObject, settings: PhysicsSettings | None = None) -> int:
+        """A passive body of ``obj`` with ``settings`` (default: the world's) for its shape and dynamics."""
+        s = settings or self.settings
         kind = shape_of(obj, s.passive_shape, active=False)
         try:
             geometry = collision_geometry(obj.vertices, obj.faces, kind, obj.local2world[:3, :3], s.decomposition,
@@ -105,7 +106,7 @@ class BulletWorld:
         shape = self.shape(geometry, geometry.parts)
         body = self.pb.createMultiBody(0.0, shape, basePosition=obj.local2world[:3, 3].tolist(),
                                        physicsClientId=self.client)
-        self._dynamics(body)
+        self._dynamics(body, s)
         return body
 
     def add_active(self, body: Body) -> None:
@@ -116,10 +117,9 @@ class BulletWorld:
         body.id = self.pb.createMultiBody(body.mass, shape, basePosition=body.start[:3, 3].tolist(),
                                           baseOrientation=quaternion.tolist(),
                                           physicsClientId=self.client)
-        self._dynamics(body.id, mass=body.mass, localInertiaDiagonal=body.principal.tolist())
+        self._dynamics(body.id, body.settings, mass=body.mass, localInertiaDiagonal=body.principal.tolist())
 
-    def _dynamics(self, body: int, **extra: Any) -> None:
-        s = self.settings
+    def _dynamics(self, body: int, s: PhysicsSettings, **extra: Any) -> None:
         self.pb.changeDynamics(body, -1, lateralFriction=s.friction, restitution=s.restitution,
                                rollingFriction=s.rolling_friction, spinningFriction=s.spinning_friction,
                                linearDamping=s.linear_damping, angularDamping=s.angular_damping,

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from ..errors import InputError
 from ..scene.mesh_object import MeshObject
 from .shapes import SHAPES, DecompositionSettings
@@ -55,6 +57,9 @@ class PhysicsSettings:
     fall_distance: float = 1.0
     """Below every passive object by this much: fallen, no longer simulated (m)."""
     decomposition: DecompositionSettings = field(default_factory=DecompositionSettings)
+    record_interval: float | None = None
+    """Record every active object's pose every this many simulated seconds (s; None: only the final poses):
+    :attr:`PhysicsResult.trajectory`."""
 
     def validate(self) -> None:
         """InputError naming the first inconsistent setting."""
@@ -69,6 +74,8 @@ class PhysicsSettings:
                 raise InputError(f"{name} must be >= 0, got {getattr(self, name)}")
         if self.min_time > self.max_time:
             raise InputError(f"min_time {self.min_time} s > max_time {self.max_time} s")
+        if self.record_interval is not None and not self.record_interval > 0:
+            raise InputError(f"record_interval must be > 0 (or null), got {self.record_interval}")
         if self.mass is not None and not self.mass > 0:
             raise InputError(f"mass must be > 0 (or null for density x volume), got {self.mass}")
         if (self.substeps is not None and self.substeps < 1) or self.solver_iterations < 1:
@@ -94,6 +101,9 @@ class PhysicsResult:
     substeps: int = 1
     last_position_change: float = 0.0  # largest per-interval change of the bodies still simulated (m)
     last_rotation_change: float = 0.0  # (rad)
+    trajectory: list[list[np.ndarray]] = field(default_factory=list)
+    """With ``record_interval``: sample ``k`` (at ``k * record_interval`` s; 0 is the start) holds each active
+    object's ``local2world`` in the order they were given (a fallen object keeps its last pose)."""
 
     def summary(self) -> str:
         text = f"simulated {self.simulated_time:.2f} s, {len(self.at_rest)} objects at rest"

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import tempfile
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
@@ -57,12 +57,16 @@ def auto_substeps(bodies: Sequence[Body], passive: Sequence[MeshObject], setting
 
 
 def simulate_physics(active: Sequence[MeshObject], passive: Sequence[MeshObject],
-                     settings: PhysicsSettings | None = None) -> PhysicsResult:
+                     settings: PhysicsSettings | None = None,
+                     per_object: Mapping[int, PhysicsSettings] | None = None) -> PhysicsResult:
     """Let ``active`` objects fall (gravity) onto ``passive`` ones, which do not move, for at least
     ``min_time`` and until every active object moved less than the rest thresholds during one
     ``check_interval`` (or ``max_time``). Writes the final poses into the active objects' ``local2world``
-    (keeping their scale) and returns how the simulation ended."""
+    (keeping their scale) and returns how the simulation ended. ``per_object`` (keyed by ``id(obj)``) gives an
+    object its own body settings (shape, mass, density, friction, restitution, damping, margin, decomposition);
+    the world's (time, gravity, solver) are ``settings``'."""
     settings = settings or PhysicsSettings()
+    own = dict(per_object or {})
     settings.validate()
     if not active:
         raise InputError("no active object to simulate")
@@ -72,14 +76,14 @@ def simulate_physics(active: Sequence[MeshObject], passive: Sequence[MeshObject]
     if overlap:
         raise InputError(f"object(s) both active and passive: {', '.join(overlap)}")
     start = time.perf_counter()
-    bodies = [active_body(obj, settings) for obj in active]
+    bodies = [active_body(obj, own.get(id(obj), settings)) for obj in active]
     floor = min(float(o.world_vertices()[:, 2].min()) for o in passive) - settings.fall_distance
     substeps = settings.substeps or auto_substeps(bodies, passive, settings)
     with tempfile.TemporaryDirectory(prefix="hybridgen-physics-") as workdir:
         world = BulletWorld(settings, workdir, substeps)
         try:
             for obj in passive:
-                world.add_static(obj)
+                world.add_static(obj, own.get(id(obj), settings))
             for body in bodies:
                 world.add_active(body)
             result = _run(world, bodies, settings, floor)
@@ -100,10 +104,14 @@ def _run(world: BulletWorld, bodies: list[Body], settings: PhysicsSettings, floo
     moving: list[Body] = live
     steps = 0
     position_change = rotation_change = 0.0
+    record = max(1, round(settings.record_interval / settings.time_step)) if settings.record_interval else 0
+    trajectory = [[b.local2world(poses[id(b)]) for b in bodies]] if record else []
     while steps < max_steps and live:
         for _ in range(min(steps_per_check, max_steps - steps)):
             world.pb.stepSimulation(physicsClientId=world.client)
-        steps += min(steps_per_check, max_steps - steps)
+            steps += 1
+            if record and steps % record == 0:
+                trajectory.append([b.local2world(world.pose(b.id) if b in live else final[id(b)]) for b in bodies])
         now = {id(b): world.pose(b.id) for b in live}
         for body in list(live):
             if now[id(body)][2, 3] < floor:
@@ -131,4 +139,4 @@ def _run(world: BulletWorld, bodies: list[Body], settings: PhysicsSettings, floo
         at_rest=[b.obj for b in bodies if id(b) not in moving_ids and id(b) not in fallen_ids],
         moving=[b.obj for b in bodies if id(b) in moving_ids and id(b) not in fallen_ids],
         fallen=[b.obj for b in fallen], wall_seconds=0.0,
-        last_position_change=position_change, last_rotation_change=rotation_change)
+        last_position_change=position_change, last_rotation_change=rotation_change, trajectory=trajectory)

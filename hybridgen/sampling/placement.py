@@ -31,19 +31,24 @@ Check = Callable[[MeshObject, np.ndarray, Sequence[MeshObject]], bool]
 
 
 def sample_poses(objects: Sequence[MeshObject], obstacles: Sequence[MeshObject], propose: Proposal,
-                 max_tries: int, extra_check: Check | None = None) -> PlacementResult:
+                 max_tries: int, extra_check: Check | None = None, keep_last: bool = False,
+                 failed_block: bool = True) -> PlacementResult:
     """Give each object, in order, the first proposed 4x4 pose (``propose`` may return None for a failed
     try) whose mesh intersects neither the obstacles nor the objects placed before it and that passes
     ``extra_check(obj, pose, placed_so_far)``. An object without such a pose in ``max_tries`` keeps its old
-    pose (later objects avoid it there) and is listed in ``failed``."""
+    pose - or, with ``keep_last``, takes the last pose proposed (BlenderProc's ``mode_on_failure='last_pose'``) -
+    is listed in ``failed``, and later objects avoid it there (unless ``failed_block`` is False).
+    ``PlacementResult.tries`` counts every try."""
     world = CollisionWorld([o for o in obstacles if o not in objects])
     placed: list[MeshObject] = []
     failed: list[MeshObject] = []
     tries = 0
     for obj in objects:
+        last = None
         for _ in range(max_tries):
             tries += 1
             pose = propose(obj)
+            last = pose if pose is not None else last
             if pose is None or world.collides(obj, pose) or \
                     (extra_check is not None and not extra_check(obj, pose, placed)):
                 continue
@@ -53,7 +58,10 @@ def sample_poses(objects: Sequence[MeshObject], obstacles: Sequence[MeshObject],
             break
         else:
             failed.append(obj)
-            world.add(obj)
+            if keep_last and last is not None:
+                obj.local2world = last
+            if failed_block:
+                world.add(obj)
     return PlacementResult(placed, failed, tries)
 
 

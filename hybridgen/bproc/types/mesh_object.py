@@ -18,8 +18,11 @@ from ...errors import InputError
 from ...scene.material import Material as SceneMaterial
 from ...scene.mesh_object import MeshObject as ScenePart
 from ...scene.shading import shade
+from ..session import SESSION
 from .entity import Entity, compose, vector3
 from .material import Material
+from .mesh_geometry import MeshGeometry
+from .rigid_body import RigidBodyMixin
 from .unsupported import unsupported_method
 
 BOUND_BOX_CORNERS = np.array([[0, 0, 0], [0, 0, 1], [0, 1, 1], [0, 1, 0], [1, 0, 0], [1, 0, 1], [1, 1, 1], [1, 1, 0]])
@@ -28,8 +31,9 @@ DEFAULT_SURFACE = SceneMaterial(name="blender_default_surface")
 """What Blender renders a mesh without material with: grey 0.8 Principled, roughness 0.5."""
 
 
-class MeshObject(Entity):
-    """A mesh object; ``parts`` are hybridgen meshes in its local frame, ``_slots`` its material slots."""
+class MeshObject(Entity, MeshGeometry, RigidBodyMixin):
+    """A mesh object; ``parts`` are hybridgen meshes in its local frame, ``_slots`` its material slots. Geometric
+    queries (BVH trees, ray casts) and the rigid body come from the mixins."""
 
     TYPE = "MESH"
 
@@ -173,9 +177,8 @@ class MeshObject(Entity):
         """The local-frame mesh (all parts) as a ``trimesh.Trimesh``."""
         import trimesh
 
-        offsets = np.cumsum([0] + [len(part.vertices) for part in self.parts])
-        faces = np.concatenate([part.faces + offset for part, offset in zip(self.parts, offsets)])
-        return trimesh.Trimesh(self.local_vertices(), faces, process=False)
+        vertices, faces = self.local_mesh()
+        return trimesh.Trimesh(vertices.copy(), faces.copy(), process=False)
 
     def scene_parts(self, frame: int | None) -> list[ScenePart]:
         """The parts as hybridgen meshes posed at ``frame`` with their slot materials (fresh shallow copies:
@@ -195,23 +198,16 @@ class MeshObject(Entity):
         assert isinstance(other, MeshObject)
         self.parts = [copy.copy(part) for part in other.parts]
         self._slots = list(other._slots)
+        self._rigid_body = copy.copy(other._rigid_body)
 
     get_mesh: Callable[..., Any] = unsupported_method("MeshObject", "get_mesh", "there is no Blender mesh")
-    enable_rigidbody: Callable[..., Any] = unsupported_method("MeshObject", "enable_rigidbody")
-    build_convex_decomposition_collision_shape: Callable[..., Any] = unsupported_method(
-        "MeshObject", "build_convex_decomposition_collision_shape")
-    disable_rigidbody: Callable[..., Any] = unsupported_method("MeshObject", "disable_rigidbody")
-    get_rigidbody: Callable[..., Any] = unsupported_method("MeshObject", "get_rigidbody")
     mesh_as_bmesh: Callable[..., Any] = unsupported_method("MeshObject", "mesh_as_bmesh", "there is no bmesh")
     update_from_bmesh: Callable[..., Any] = unsupported_method("MeshObject", "update_from_bmesh")
     join_with_other_objects: Callable[..., Any] = unsupported_method("MeshObject", "join_with_other_objects")
     edit_mode: Callable[..., Any] = unsupported_method("MeshObject", "edit_mode")
     object_mode: Callable[..., Any] = unsupported_method("MeshObject", "object_mode")
-    create_bvh_tree: Callable[..., Any] = unsupported_method("MeshObject", "create_bvh_tree")
-    position_is_above_object: Callable[..., Any] = unsupported_method("MeshObject", "position_is_above_object")
-    ray_cast: Callable[..., Any] = unsupported_method("MeshObject", "ray_cast")
-    add_uv_mapping: Callable[..., Any] = unsupported_method("MeshObject", "add_uv_mapping")
     scale_uv_coordinates: Callable[..., Any] = unsupported_method("MeshObject", "scale_uv_coordinates")
+    add_uv_mapping: Callable[..., Any] = unsupported_method("MeshObject", "add_uv_mapping")
     add_displace_modifier: Callable[..., Any] = unsupported_method("MeshObject", "add_displace_modifier")
     add_modifier: Callable[..., Any] = unsupported_method("MeshObject", "add_modifier")
     add_geometry_nodes: Callable[..., Any] = unsupported_method("MeshObject", "add_geometry_nodes")
@@ -222,6 +218,7 @@ class MeshObject(Entity):
         """Whether every part has texture coordinates."""
         return all(part.uvs is not None for part in self.parts)
 
-    def has_rigidbody_enabled(self) -> bool:
-        """Rigid bodies are not supported, so never."""
-        return False
+
+def get_all_mesh_objects() -> list[MeshObject]:
+    """Every mesh object of the session, in creation order (``bproc.object.get_all_mesh_objects``)."""
+    return [e for e in SESSION.entities if isinstance(e, MeshObject)]
