@@ -1,6 +1,8 @@
 """The default HDF5 output (docs/conventions.md section 4): one file, every pass a dataset with a leading
 keypoint axis.
 
+Over 300 lines: one writer owns its file, its compressor pool and its writer thread from begin to commit or abort.
+
 Chunks hold one keypoint each. Passes are stored compactly by default (``encoding="compact"``: ids in the
 smallest integer type, octahedral uint16 normals, distance derived from depth - see
 :mod:`hybridgen.io.label_encoding`, whose :func:`~hybridgen.io.label_encoding.decode_dataset` reads them
@@ -20,7 +22,6 @@ import json
 import os
 import queue
 import threading
-import zlib
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -33,6 +34,7 @@ from ..config.options import checked_options, option
 from ..errors import InputError, fault_errno, fault_message
 from .atomic import close_discarded_hdf5, commit, discard, prepare_output_dir, temporary_path
 from .blosc2_chunks import Blosc2Chunks
+from .chunk_codecs import blosc2_chunks, deflate, shuffled
 from .frame_sink import PassLayout
 from .hdf5_filters import READ_HINT
 from .integrity import ChunkStream, seal
@@ -41,38 +43,8 @@ from .label_encoding import (DERIVED_DISTANCE, NARROWED, OCTAHEDRAL, EncodedArra
 
 COMPRESSIONS = ("gzip", "blosc2", "lzf", "none")
 ENCODINGS = ("compact", "plain")
+__all__ = ["COMPRESSIONS", "ENCODINGS", "Hdf5Options", "Hdf5SingleFileWriter", "deflate", "shuffled"]
 _STOP = object()
-
-
-def deflate(data: Any, level: int) -> bytes:
-    """A zlib-format stream of ``data`` (what HDF5's gzip filter reads). Levels 1-3 use ISA-L (``isal``, a
-    dependency: 4-6x faster than zlib at the same ratio) for inputs of :data:`ISAL_MIN_BYTES` or more, 0 and 4-9
-    and smaller inputs zlib's own. The bytes differ between the two libraries, never between runs: ISA-L calls
-    are serialized by a process-wide lock because concurrent calls occasionally pick other matches - valid
-    streams of the same data but other bytes (measured: 2 of 320 compressions of one 192-byte segmap by 8
-    threads at once; 0 of 480 under the lock; it made resumed runs differ from direct ones at random). One
-    ISA-L call at a time (~400 MB/s on one core here) still outpaces the label pass; the compressor threads
-    overlap everything else."""
-    if 1 <= level <= 3 and _isal is not None and memoryview(data).nbytes >= ISAL_MIN_BYTES:
-        with _ISAL_LOCK:
-            return _isal.compress(data, level)
-    return zlib.compress(data, level)
-
-
-ISAL_MIN_BYTES = 16384
-"""Smaller inputs are deflated by zlib: ISA-L gave other (valid) streams for the same small input even under the
-lock - the 192-byte id maps of a 16x12 test run compressed to 42 or 43 bytes from run to run in one long process
-under load (session 6: resumed and direct files differed by a few bytes, about 1 run in 5-20) - and zlib costs
-nothing at these sizes. Every image of 128x128 pixels or more still goes through ISA-L."""
-
-
-_ISAL_LOCK = threading.Lock()
-
-
-try:
-    from isal import isal_zlib as _isal
-except ImportError:  # pragma: no cover - isal is a dependency; zlib is the fallback of a partial install
-    _isal = None
 
 
 def _tag(stored: StoredPass, layout: PassLayout) -> str | None:
@@ -99,37 +71,9 @@ class _UnknownStream(ChunkStream):
 _UNKNOWN = _UnknownStream()
 
 
-def blosc2_chunks(stored: StoredPass, level: int) -> Blosc2Chunks | None:
-    """The Blosc2 codec of a pass under ``compression: blosc2``: LZ4 at ``level`` over the byte-shuffled float
-    passes (depth: 0.5-0.63x ISA-L's CPU with the shuffle, ~18 % more bytes); None where deflate stays - the
-    octahedral normal codes (LZ4 gave 1.2-2.6x the bytes for 0.5-0.75x the CPU) and the id maps (LZ4 gave twice
-    the bytes at the same speed; tools/bench_writer.py, docs/label_pipeline.md)."""
-    if not stored.shuffle:
-        return None
-    return Blosc2Chunks("lz4", level, "byte", stored.dtype.itemsize)
-
-
 def default_threads() -> int:
     """Compressor threads: the cores left over by the render thread (at least one)."""
     return max(1, (os.cpu_count() or 2) - 1)
-
-
-def shuffled(array: np.ndarray) -> np.ndarray:
-    """The bytes HDF5's shuffle filter makes of a contiguous ``array``: byte k (in memory order) of every element
-    together, as an (itemsize, size) uint8 array. Elements of 2, 4 or 8 bytes are read as little-endian words and
-    each plane is one shift-and-narrow pass over them (0.19 instead of 0.30 ms for a 640x480 float32 image as a
-    strided transpose)."""
-    size = array.itemsize
-    if size == 1:
-        return array
-    flat = np.ascontiguousarray(array).reshape(-1)
-    if size not in (2, 4, 8):
-        return np.ascontiguousarray(flat.view(np.uint8).reshape(-1, size).T)
-    words = flat.view(f"<u{size}")  # memory byte k of an element = bits 8k..8k+7 of its little-endian word
-    planes = np.empty((size, words.size), np.uint8)
-    for k in range(size):
-        np.right_shift(words, 8 * k, out=planes[k], casting="unsafe")  # the cast keeps the low 8 bits
-    return planes
 
 
 _TEXT_TYPE = h5py.h5t.py_create(h5py.string_dtype())

@@ -17,7 +17,7 @@ frame. NOCS (float32 H x W x 3, background 0): those coordinates normalized as i
 """
 from __future__ import annotations
 
-from typing import Mapping
+from typing import Any, Iterator, Mapping
 
 import numpy as np
 
@@ -78,28 +78,33 @@ def optical_flow(raw: RasterOutput, intr: Intrinsics, pose_from: np.ndarray, pos
     return flow, occluded
 
 
-def object_coordinates(raw: RasterOutput, intr: Intrinsics, cam2world: np.ndarray, scene: Scene) -> np.ndarray:
-    """(H, W, 3) float32 coordinates (m) of every pixel's surface point in its object's local frame (the frame
-    of the mesh's vertices, before ``local2world``; NaN on the background)."""
-    out = np.full(raw.instance.shape + (3,), np.nan, np.float32)
+def _local_points(raw: RasterOutput, intr: Intrinsics, cam2world: np.ndarray,
+                  scene: Scene) -> Iterator[tuple[Any, np.ndarray, np.ndarray]]:
+    """Per object in view: (object, its pixels' mask, float64 coordinates of those pixels' surface points in the
+    object's local frame, m)."""
     world = camera_points(raw, intr) @ cam2world[:3, :3].T + cam2world[:3, 3]
     for obj in scene.objects:
         mask = raw.instance == obj.instance_id
         if mask.any():
             to_local = np.linalg.inv(obj.local2world)
-            out[mask] = world[mask] @ to_local[:3, :3].T + to_local[:3, 3]
+            yield obj, mask, world[mask] @ to_local[:3, :3].T + to_local[:3, 3]
+
+
+def object_coordinates(raw: RasterOutput, intr: Intrinsics, cam2world: np.ndarray, scene: Scene) -> np.ndarray:
+    """(H, W, 3) float32 coordinates (m) of every pixel's surface point in its object's local frame (the frame
+    of the mesh's vertices, before ``local2world``; NaN on the background)."""
+    out = np.full(raw.instance.shape + (3,), np.nan, np.float32)
+    for _, mask, local in _local_points(raw, intr, cam2world, scene):
+        out[mask] = local
     return out
 
 
 def nocs(raw: RasterOutput, intr: Intrinsics, cam2world: np.ndarray, scene: Scene) -> np.ndarray:
-    """(H, W, 3) float32 normalized object coordinates of every pixel's surface point (background 0)."""
-    local = object_coordinates(raw, intr, cam2world, scene)
+    """(H, W, 3) float32 normalized object coordinates of every pixel's surface point (background 0), from the
+    float64 local coordinates (the same values as before object_coordinates existed)."""
     out = np.zeros(raw.instance.shape + (3,), np.float32)
-    for obj in scene.objects:
-        mask = raw.instance == obj.instance_id
-        if not mask.any():
-            continue
+    for obj, mask, local in _local_points(raw, intr, cam2world, scene):
         box = obj.bounds_local
         diagonal = float(np.linalg.norm(box[1] - box[0])) or 1.0
-        out[mask] = (local[mask] - box.mean(axis=0)) / diagonal + 0.5
+        out[mask] = (local - box.mean(axis=0)) / diagonal + 0.5
     return out
