@@ -127,7 +127,10 @@ class Matrix(_Array):
     def Rotation(angle: float, size: int, axis: Any) -> "Matrix":  # noqa: N802 - mathutils' name
         """A ``size`` x ``size`` rotation by ``angle`` rad about ``axis`` ('X', 'Y', 'Z' or a 3-vector)."""
         vector = np.asarray(AXES[axis.upper()] if isinstance(axis, str) else axis, dtype=np.float64)
-        rotation = rotation_about_axis(vector / np.linalg.norm(vector), float(angle))
+        turn = np.asarray(angle, dtype=np.float64)
+        if turn.size != 1:
+            raise ValueError(f"Matrix.Rotation: angle must be one number, got {turn.tolist()}")
+        rotation = rotation_about_axis(vector / np.linalg.norm(vector), float(turn.reshape(-1)[0]))  # a 1-array too
         return Matrix(rotation).to_4x4() if size == 4 else Matrix(rotation[:size, :size])
 
     @staticmethod

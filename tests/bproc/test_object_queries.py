@@ -42,6 +42,8 @@ def test_mathutils_rotations() -> None:
     third = np.array(mathutils.Matrix.Rotation(2 * np.pi / 3, 3, axis))
     assert np.allclose(third @ [1, 0, 0], [0, 1, 0])  # a third turn about the diagonal cycles the axes
     assert np.array(mathutils.Matrix.Rotation(0.3, 4, "X")).shape == (4, 4)
+    one = np.array(mathutils.Matrix.Rotation(np.array([np.pi / 2]), 3, [0, 0, 2]))  # a random walk's 1-array angle
+    assert np.allclose(one, quarter)
     euler = mathutils.Euler((0.1, 0.2, 0.3))
     rz, ry, rx = (np.array(mathutils.Matrix.Rotation(a, 3, k)) for a, k in ((0.3, "Z"), (0.2, "Y"), (0.1, "X")))
     assert np.allclose(np.array(euler.to_matrix()), rz @ ry @ rx)  # Blender's XYZ order
