@@ -38,8 +38,6 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..config.options import option
-from ..config.schema import positive
 from ..errors import InputError
 from ..render.passes import hint
 from ..scene.mesh_object import MeshObject
@@ -47,45 +45,25 @@ from ..scene.rigid_pose import model_to_camera
 from ..scene.scene import Scene
 from .atomic import confined_path, prepare_output_dir
 from .bop_chunks import Chunks
+from .bop_options import ANNOTATION_UNITS, BopOptions
 from .bop_json import camera_json_text
 from .coco_content import annotation
 from .depth_png import depth_png_values
 from .frame_sink import PassLayout
-from .image_files import StagedFiles, color_format_option, jpeg_bytes, jpg_quality_option, png_bytes, write_file
+from .image_files import StagedFiles, jpeg_bytes, png_bytes, write_file
 from .mask_encoding import bbox_of, rle_uncompressed
 from .output_lock import hold_output_lock
 
-ANNOTATION_UNITS = {"m": 1.0, "dm": 10.0, "cm": 100.0, "mm": 1000.0}
 NEEDED_KEYS = {key: hint(key) for key in ("colors", "depth", "instance_segmaps")}
 OBJECT_PASSES = ("amodal_masks", "visible_fractions", "object_boxes")
 """The render-side passes this writer asks for when it writes masks (they come with ``instance_segmaps``)."""
 NO_BOX = [-1, -1, -1, -1]
+__all__ = ["ANNOTATION_UNITS", "BopOptions", "BopWriter", "needed_keys"]
 
 
 def needed_keys(with_masks: bool) -> dict[str, str]:
     """The keys a BOP dataset needs, with how to make them (instance maps only ``with_masks``)."""
     return {key: how for key, how in NEEDED_KEYS.items() if key != "instance_segmaps" or with_masks}
-
-
-@dataclass(frozen=True)
-class BopOptions:
-    """The options of a BOP dataset, declared once (writer.BopWriter's parameters; :mod:`hybridgen.config.options`)."""
-
-    dataset: str = option("", "str", "dataset folder inside output_dir; if set, only objects whose "
-                          "'bop_dataset_name' attribute is this are annotated")
-    append: bool = option(False, "bool", "continue the last chunk's image ids; otherwise existing chunks are an "
-                          "error", key="append_to_existing_output")
-    depth_scale: float = option(1.0, "float", "depth PNG value * depth_scale = depth in mm", unit="mm",
-                                check=positive)
-    color_file_format: str = color_format_option("rgb/ file format")
-    jpg_quality: int = jpg_quality_option()
-    frames_per_chunk: int = option(1000, "int", "images per train_pbr chunk", check=positive)
-    annotation_unit: str = option("mm", "str", "unit of cam_t_m2c, cam_t_w2c", choices=tuple(ANNOTATION_UNITS))
-    save_world2cam: bool = option(True, "bool", "write cam_R_w2c, cam_t_w2c in scene_camera.json")
-    calc_mask_info_coco: bool = option(True, "bool", "write mask/, mask_visib/, scene_gt_info.json and "
-                                       "scene_gt_coco.json (needs instance maps)")
-    ignore_dist_thres: float = option(100.0, "float", "objects farther from the camera are left out", unit="m",
-                                      check=positive)
 
 
 @dataclass
