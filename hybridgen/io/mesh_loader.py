@@ -20,9 +20,8 @@ from __future__ import annotations
 
 import io
 import os
-import re
 from pathlib import Path
-from typing import Any, Callable, Iterable, Iterator
+from typing import Any, Callable
 
 import numpy as np
 
@@ -33,6 +32,7 @@ from ..scene.frames import Y_UP_TO_Z_UP
 from ..scene.material import Material
 from ..scene.mesh_object import MeshObject
 from .image_check import check_image_file
+from .blender_names import _SENTINEL, _SENTINEL_RE, blender_name, tag_obj_objects, unique_blender_name
 from .mesh_references import is_lenient, referenced_files
 from .texture_needs import check_libraries, diffuse_maps_by_material, mark_missing_textures
 
@@ -45,33 +45,9 @@ LOADERS: dict[str, tuple[str, str]] = {
     ".gltf": ("gltf", "Y"),
 }
 """Suffix -> (trimesh file type, native up axis as Blender's importer reads the format)."""
-
-BLENDER_NAME_BYTES = 63
-"""Blender truncates object names to 63 bytes."""
-
-_SENTINEL = "__hybridgen_object_{}__"
-_SENTINEL_RE = re.compile(r"__hybridgen_object_(\d+)__")
+__all__ = ["LOADERS", "_SENTINEL", "blender_name", "load_objects", "tag_obj_objects", "unique_blender_name"]
 
 Notify = Callable[[str], None]
-
-
-def blender_name(text: str) -> str:
-    """An object name as Blender stores it: words joined by one space, at most 63 UTF-8 bytes. Bytes of a
-    file name that are not UTF-8 (Python's surrogate escapes) become U+FFFD, as in the OBJ text."""
-    name = " ".join(text.split()).encode("utf-8", "surrogateescape").decode("utf-8", "replace")
-    return name.encode("utf-8")[:BLENDER_NAME_BYTES].decode("utf-8", errors="ignore")
-
-
-def unique_blender_name(name: str, taken: Iterable[str]) -> str:
-    """``name``, or Blender's next free ``name.001``, ``name.002`` ... when ``name`` is taken."""
-    used = set(taken)
-    if name not in used:
-        return name
-    base = re.sub(r"\.\d{3}$", "", name)
-    number = 1
-    while f"{base}.{number:03d}" in used:
-        number += 1
-    return f"{base}.{number:03d}"
 
 
 def vertex_colors_linear(visual: Any) -> np.ndarray | None:
@@ -87,49 +63,6 @@ def _has_loaded_normals(geometry: Any) -> bool:
     # trimesh keeps normals read from the file in its cache; computed ones are only made on access.
     cache = getattr(getattr(geometry, "_cache", None), "cache", {})
     return "vertex_normals" in cache
-
-
-def tag_obj_objects(text: str, default_name: str) -> tuple[str, list[str]]:
-    """OBJ text with every ``o`` line replaced by a numbered marker, and the Blender names by number.
-
-    Faces before the first ``o`` belong to an object named ``default_name`` (Blender uses the file name);
-    an ``o`` name that comes again continues the same object, as Blender's importer does.
-    """
-    names: list[str] = []
-    index_of: dict[str, int] = {}
-
-    def number(name: str) -> int:
-        if name not in index_of:
-            index_of[name] = len(names)
-            names.append(name)
-        return index_of[name]
-
-    text = text.replace("\r\n", "\n").replace("\\\n", "")
-    out = [f"o {_SENTINEL.format(number(blender_name(default_name)))}\n"]
-    done = 0  # text before this index is in ``out``
-    for start, end in _object_statements(text):
-        name = blender_name(text[start + 1:end]) or blender_name(default_name)
-        line_start = text.rfind("\n", 0, start) + 1
-        out.append(text[done:line_start])
-        out.append(f"o {_SENTINEL.format(number(name))}")
-        done = end
-    out.append(text[done:])
-    return "".join(out), names
-
-
-def _object_statements(text: str) -> Iterator[tuple[int, int]]:
-    """(index of the ``o``, end of its line) of every ``o`` statement in OBJ ``text`` (lines split at "\\n"):
-    a line whose first non-whitespace character is ``o`` followed by a space, a tab or the line's end. Only the
-    lines holding an "o" are looked at (an OBJ of 10 MB has few: vertex and face lines hold none)."""
-    start = text.find("o")
-    while start >= 0:
-        line_end = text.find("\n", start)
-        line_end = len(text) if line_end < 0 else line_end
-        line_start = text.rfind("\n", 0, start) + 1
-        before = text[line_start:start]
-        if (not before or before.isspace()) and (start + 1 == line_end or text[start + 1] in " \t"):
-            yield start, line_end
-        start = text.find("o", line_end)
 
 
 def _undecodable_match(folder: Path, name: str) -> Path | None:
