@@ -1,5 +1,6 @@
-"""Principled BSDFs choose their specular / diffuse lobe by albedo (render/pathtrace/lobe_sampling.py): rates as documented,
-the same image on average, less noise."""
+"""Mitsuba's principled BSDFs choose their specular / diffuse lobe by albedo (render/pathtrace/lobe_sampling.py): rates as
+documented, the same image on average, less noise. That BSDF renders in scalar_rgb and with HYBRIDGEN_PRINCIPLED=mitsuba
+(hybridgen's own Principled BSDF picks its lobes by albedo itself), so these tests ask for it."""
 from __future__ import annotations
 
 import numpy as np
@@ -9,6 +10,7 @@ import hybridgen as hg
 from hybridgen.render.pathtrace import lobe_sampling, mitsuba_materials, path_trace
 from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
 from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
+from hybridgen.render.pathtrace.principled_material import ENV_VARIABLE
 
 
 def _material(**values: float) -> hg.Material:
@@ -18,7 +20,8 @@ def _material(**values: float) -> hg.Material:
     return material
 
 
-def test_rates_follow_the_lobes_albedos():
+def test_rates_follow_the_lobes_albedos(monkeypatch):
+    monkeypatch.setenv(ENV_VARIABLE, "mitsuba")
     material = _material(specular=0.5, roughness=0.2)
     rates = lobe_sampling.principled_sampling_rates(material, 0.5)
     luminance = float(lobe_sampling.LUMINANCE @ np.array([0.75, 0.2, 0.15]))
@@ -42,6 +45,7 @@ def test_albedo_rates_keep_the_mean_and_lower_the_noise(monkeypatch):
     """A plastic-like plane under a constant sky (the only emitter: light and BSDF samples, MIS), direct light
     only, independent samples: Mitsuba's 50/50 lobe choice vs albedo rates."""
     variant = choose_variant(None)
+    monkeypatch.setenv(ENV_VARIABLE, "mitsuba")
     monkeypatch.setattr(path_trace, "SAMPLER", "independent")
     scene = hg.Scene()
     plane = hg.make_primitive("plane", 50.0, name="plane", category_id=1, color=(0.75, 0.2, 0.15))

@@ -194,3 +194,22 @@ def test_sampled_directions_follow_the_pdf(mi, inputs) -> None:
         found = g(wo)[pdfs > 0].sum() / len(wo)
         error = 4.0 * math.sqrt(max(expected - expected ** 2, 1e-4) / len(wo)) + 0.004
         assert found == pytest.approx(expected, abs=error), name
+
+
+def test_flags_name_the_lobes(mi) -> None:
+    """The path tracer reads transmission from the flags (Cycles' transmission bounces, caustics_refractive)."""
+    flags = mi.BSDFFlags
+    opaque, glass = bsdf(mi, roughness=0.3).flags(), bsdf(mi, roughness=0.3, transmission=0.5).flags()
+    for value in (opaque, glass):
+        assert mi.has_flag(value, flags.DiffuseReflection) and mi.has_flag(value, flags.GlossyReflection)
+        assert mi.has_flag(value, flags.FrontSide) and mi.has_flag(value, flags.BackSide)
+    assert not mi.has_flag(opaque, flags.GlossyTransmission)
+    assert mi.has_flag(glass, flags.GlossyTransmission)
+    _, _, pdfs = sampled(mi, bsdf(mi, roughness=0.3, transmission=1.0), 0.8, n=64)
+    u = np.random.default_rng(1).random((3, 64))
+    bs, _ = bsdf(mi, roughness=0.3, transmission=1.0).sample(mi.BSDFContext(), interaction(mi, 0.8, 64),
+                                                             mi.Float(u[0]), mi.Point2f(u[1], u[2]))
+    below = np.array(bs.wo)[2] < 0
+    types = np.array(bs.sampled_type)
+    assert below.any() and np.all(types[below] == int(flags.GlossyTransmission))
+    assert np.all(types[~below & (pdfs > 0)] == int(flags.GlossyReflection))

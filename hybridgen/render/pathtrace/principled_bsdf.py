@@ -84,12 +84,12 @@ def register(variant: str) -> None:
             self.coat_rough = min(max(float(props.get("coat_roughness", 0.03)), 0.0), 1.0)
             self.coat_ior = max(float(props.get("coat_ior", 1.5)), 1.0)
             self.coat_tint = color(props, "coat_tint")
-            lobe = flags.GlossyReflection | both
-            self.m_components = [flags.DiffuseReflection | both, lobe]
+            components = [flags.DiffuseReflection | both, flags.GlossyReflection | both]
             if self.transmission > 0:
-                self.m_components.append(flags.GlossyTransmission | flags.NonSymmetric | both)
+                components.append(flags.GlossyTransmission | flags.NonSymmetric | both)
+            self.m_components = components  # (the property returns a copy: assign the whole list)
             self.m_flags = flags.Empty
-            for component in self.m_components:
+            for component in components:
                 self.m_flags = self.m_flags | component
 
         def _inputs(self, si: Any, active: Any) -> Any:

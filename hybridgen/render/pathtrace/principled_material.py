@@ -25,7 +25,7 @@ COLOR_INPUTS = ("specular_tint", "coat_tint")
 ENV_VARIABLE = "HYBRIDGEN_PRINCIPLED"
 """``mitsuba`` renders principled materials with Mitsuba's ``principled`` (Disney 2015) in every variant,
 ``blender`` with hybridgen's Principled BSDF in the JIT variants (default: :data:`DEFAULT_MODEL`)."""
-DEFAULT_MODEL = "mitsuba"
+DEFAULT_MODEL = "blender"
 
 
 def enabled() -> bool:
