@@ -2,11 +2,15 @@
 this executor is chosen; a local cluster started here binds 127.0.0.1 only and is stopped with the run."""
 from __future__ import annotations
 
+import logging
 import os
 import socket
 from concurrent.futures import Future
+from contextlib import contextmanager
+from typing import Any, Iterator
 
-from ..errors import InputError, SystemSetupError
+from ..errors import InputError, SystemSetupError, printable
+from ..logs import LOGGER
 from .executor import Executor
 from .ray_loopback import keep_ray_on_loopback
 from .signals import reclaim_sigterm
@@ -32,7 +36,65 @@ def check_reachable(address: str) -> None:
 
 
 def _run(task: UnitTask, unit: WorkUnit) -> tuple[int, int]:
-    return task(unit)
+    try:
+        return task(unit)
+    except BaseException as exc:
+        raise _utf8_safe(exc)  # same exception, same chain; only its texts changed
+
+
+def _utf8_safe(exc: BaseException) -> BaseException:
+    """``exc`` and the exceptions chained to it with every text that holds non-UTF-8 bytes of a file name shown as
+    ``\\xNN`` (:func:`hybridgen.errors.printable`). Ray sends a task's error as a UTF-8 string and its worker died
+    (WorkerCrashedError, a traceback instead of the user's one line) on the surrogate escapes of a Latin-1 path."""
+    pending: list[BaseException | None] = [exc]
+    seen: set[int] = set()
+    while pending:
+        current = pending.pop()
+        if current is None or id(current) in seen:
+            continue
+        seen.add(id(current))
+        current.args = tuple(printable(a) if isinstance(a, str) else a for a in current.args)
+        for name in ("filename", "filename2"):
+            value = getattr(current, name, None)
+            if isinstance(value, str):
+                setattr(current, name, printable(value))
+        pending += [current.__cause__, current.__context__]
+    return exc
+
+
+def _unwrapped(remote: Future) -> Future:
+    """A future of ``remote``'s result whose error is the unit's own exception: Ray raises a RayTaskError subclass of
+    it whose text holds the worker's traceback, so a user's InputError would print as a traceback instead of its
+    one line (as a pool run prints it)."""
+    local: Future = Future()
+
+    def settle(done: Future) -> None:
+        error = done.exception()
+        if error is None:
+            local.set_result(done.result())
+        else:
+            cause = getattr(error, "cause", None)
+            local.set_exception(cause if isinstance(cause, BaseException) else error)
+
+    remote.add_done_callback(settle)
+    return local
+
+
+@contextmanager
+def _printable_entrypoint(ray: Any) -> Iterator[None]:
+    """While Ray starts, its record of the driver's command line (``ray._private.utils.get_entrypoint_name``, read
+    from /proc) with non-UTF-8 bytes of file names as ``\\xNN``: Ray stores it in a UTF-8 string and raised
+    UnicodeEncodeError for a Latin-1 path argument. The units receive the real paths (pickled, not encoded)."""
+    utils = getattr(getattr(ray, "_private", None), "utils", None)
+    original = getattr(utils, "get_entrypoint_name", None)
+    if original is None:  # another Ray version: nothing to wrap
+        yield
+        return
+    utils.get_entrypoint_name = lambda: printable(original())
+    try:
+        yield
+    finally:
+        utils.get_entrypoint_name = original
 
 
 class RayExecutor(Executor):
@@ -48,20 +110,24 @@ class RayExecutor(Executor):
         if not ray.is_initialized():
             threads = str(max(1, (os.cpu_count() or 1) // workers))
             runtime_env = {"env_vars": {"LP_NUM_THREADS": threads, "HYBRIDGEN_THREADS": threads}}
-            if address:
-                check_reachable(address)
-                ray.init(address=address, include_dashboard=False, log_to_driver=False, runtime_env=runtime_env)
-            else:
-                keep_ray_on_loopback()  # _node_ip_address alone is overridden by Ray (see ray_loopback.py)
-                ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False, runtime_env=runtime_env,
-                         _node_ip_address="127.0.0.1")
+            # Ray's own start-up lines (INFO, the token-authentication WARNING) only with -v: an error stays one line
+            quiet = {"logging_level": logging.DEBUG if LOGGER.getEffectiveLevel() <= logging.DEBUG else logging.ERROR}
+            with _printable_entrypoint(ray):
+                if address:
+                    check_reachable(address)
+                    ray.init(address=address, include_dashboard=False, log_to_driver=False, runtime_env=runtime_env,
+                             **quiet)
+                else:
+                    keep_ray_on_loopback()  # _node_ip_address alone is overridden by Ray (see ray_loopback.py)
+                    ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False,
+                             runtime_env=runtime_env, _node_ip_address="127.0.0.1", **quiet)
             self.started = True
             reclaim_sigterm()  # ray.init replaced it with a handler that exits without stopping the cluster
         self.remote = ray.remote(_run)
         self.task = task
 
     def submit(self, unit: WorkUnit) -> Future:
-        return self.remote.remote(self.task, unit).future()
+        return _unwrapped(self.remote.remote(self.task, unit).future())
 
     def shutdown(self, interrupted: bool = False) -> None:
         if self.started:

@@ -388,3 +388,36 @@ def test_environment_fault_outside_the_writers_is_one_line(tmp_path, write_confi
         f"hybridgen: error: input/output error at '{tmp_path / 'config.yaml'}' ([Errno 5])"]
     with pytest.raises(OSError):
         run_cli("run", "-q", "--debug", str(config), str(tmp_path / "out"))
+
+
+def test_hostile_inputs_on_ray_workers(gl_context, tmp_path):
+    """On a local Ray cluster (loopback only, started by the run) a Latin-1 mesh, MTL and texture load and are
+    recorded, and a damaged texture is one line naming it with exit status 2 and nothing under a final name - as
+    in single and pool runs."""
+    import subprocess
+    import sys
+
+    import h5py
+
+    pytest.importorskip("ray")
+    mesh = latin1_mesh(tmp_path)
+    config = tmp_path / "mesh.yaml"
+    config.write_text(MESH_CONFIG.replace("SCENES", "2"))
+
+    def run(out: Path, mesh_path: bytes) -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, "-m", "hybridgen", "run", "-q", "--executor", "ray", "--workers", "2",
+                               os.fsencode(config), os.fsencode(out), mesh_path], cwd=REPO, capture_output=True,
+                              timeout=600)
+
+    done = run(tmp_path / "good", mesh)
+    assert done.returncode == 0, done.stderr[-2000:]
+    with h5py.File(tmp_path / "good/data.hdf5") as index:
+        assert index["instance_segmaps"].shape[0] == 2 and (index["instance_segmaps"][()] > 0).any()
+    damaged = tmp_path / "damaged"
+    damaged.mkdir()
+    bad_mesh = latin1_mesh(damaged, texture=(REPO / "tests/bad_inputs/meshes/truncated.png").read_bytes())
+    done = run(tmp_path / "bad", bad_mesh)
+    err = done.stderr.decode("utf-8", "replace")
+    assert done.returncode == 2 and len(err.strip().splitlines()) == 1 and "Traceback" not in err, err[-2000:]
+    assert "t\\xe9x.png' is damaged" in err
+    assert not [p for p in (tmp_path / "bad").rglob("*") if p.is_file()]
