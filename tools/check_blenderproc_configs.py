@@ -1,5 +1,7 @@
 """Validate (and run) every example config of a BlenderProc checkout with hybridgen, unchanged.
 
+Over 300 lines: the checker and the stand-in inputs of every example family it runs, kept beside the runs that need them.
+
     .venv/bin/python tools/check_blenderproc_configs.py PATH [--tag v1.12.0] [--run] [--only SUBSTRING]
         [--example-inputs] [--notices] [--max-samples N]
 
