@@ -4,9 +4,10 @@ does, on hybridgen's ``bproc`` layer.
 For the script's run:
 
 - ``import blenderproc`` (and ``blenderproc.<area>``) is this package, ``hybridgen.bproc``, through a meta-path
-  finder placed first - also when the real ``blenderproc`` package is installed or already imported; its other
-  submodules (``blenderproc.python...``) raise one line naming the module. ``import bpy`` is
-  :mod:`hybridgen.bproc.bpy_standin`.
+  finder placed first - also when the real ``blenderproc`` package is installed or already imported.
+  BlenderProc's internal modules (``blenderproc.python.utility.Utility``, ...) are
+  :mod:`hybridgen.bproc.internal_modules`; a module path neither knows raises one line naming the
+  module. ``import bpy`` is :mod:`hybridgen.bproc.bpy_standin`.
 - ``sys.argv`` is ``[script, ARGS...]`` and the script's folder is first on ``sys.path``, as for
   ``python main.py``; the working directory is unchanged, so relative paths resolve as under BlenderProc.
 - The session starts empty; ``bproc.init()`` seeds ``random`` and ``np.random`` from ``BLENDER_PROC_RANDOM_SEED``
@@ -31,6 +32,7 @@ from types import ModuleType
 from typing import Any, Sequence
 
 from ..errors import HybridgenError, InputError
+from .internal_modules import INTERNAL_MODULES, PACKAGES, ROOT, internal_module
 from .session import SESSION, Session
 
 PACKAGE = __name__.rpartition(".")[0]
@@ -50,6 +52,16 @@ class _AliasLoader(importlib.abc.Loader):
         """The target module ran when it was imported."""
 
 
+class _InternalLoader(importlib.abc.Loader):
+    """Builds a BlenderProc internal module (``blenderproc.python...``) over hybridgen.bproc."""
+
+    def create_module(self, spec: importlib.machinery.ModuleSpec) -> ModuleType:
+        return internal_module(spec.name, PACKAGE)
+
+    def exec_module(self, module: ModuleType) -> None:
+        """Nothing to run: the module looks its names up when they are read."""
+
+
 class BlenderProcFinder(importlib.abc.MetaPathFinder):
     """``blenderproc[.area]`` -> ``hybridgen.bproc[.area]``, ``bpy`` -> the bpy stand-in."""
 
@@ -57,11 +69,21 @@ class BlenderProcFinder(importlib.abc.MetaPathFinder):
         head, _, rest = fullname.partition(".")
         if head not in ALIASES:
             return None
+        if fullname in INTERNAL_MODULES or fullname in PACKAGES:
+            return importlib.machinery.ModuleSpec(fullname, _InternalLoader(), is_package=fullname in PACKAGES)
         module = ALIASES[head] + (f".{rest}" if rest else "")
-        if head == "bpy" and rest or importlib.util.find_spec(module) is None:
+        if head == "bpy" and rest or not _exists(module):
             raise InputError(f"import {fullname}: the module is not supported by hybridgen yet (hybridgen's "
-                             f"blenderproc has the bproc.<area> API modules only)")
+                             f"blenderproc has the bproc.<area> API modules and {ROOT}'s modules behind them)")
         return importlib.machinery.ModuleSpec(fullname, _AliasLoader(module), is_package=not rest)
+
+
+def _exists(module: str) -> bool:
+    """Whether the hybridgen module ``module`` exists (False also when a package on its way does not)."""
+    try:
+        return importlib.util.find_spec(module) is not None
+    except ModuleNotFoundError:
+        return False
 
 
 def _script_traceback(exc: BaseException, script: str) -> str:

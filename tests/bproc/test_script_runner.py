@@ -82,7 +82,8 @@ def test_a_script_error_shows_its_traceback_and_exits_1(run_cli, tmp_path: Path)
 
 
 @pytest.mark.parametrize("call, line", [
-    ("bproc.object.simulate_physics()", "bproc.object.simulate_physics is not supported by hybridgen yet"),
+    ("bproc.renderer.enable_motion_blur(0.5)",
+     "bproc.renderer.enable_motion_blur is not supported by hybridgen yet"),
     ("bproc.loader.load_obj('missing.obj')", "The given filepath does not exist: missing.obj"),
     ("bproc.renderer.render()", "No camera poses have been registered"),
     ("import bpy; bpy.ops.mesh.primitive_cube_add()", "bpy.ops is not supported by hybridgen yet"),
