@@ -181,10 +181,39 @@ def is_point_inside_camera_frustum(point: Sequence[float], clip_start: float | N
                                clip_end)[0])
 
 
+def get_camera_frustum(clip_start: float | None = None, clip_end: float | None = None,
+                       frame: int | None = None) -> np.ndarray:
+    """(8, 3) world corners (m) of the view frustum of the camera pose at ``frame`` (None: the current pose)
+    between the clip distances (default: the camera's), in normalized device coordinates' order:
+    ``itertools.product((-1, 1), repeat=3)`` over (left/right, bottom/top, near/far)
+    (:func:`hybridgen.scene.frustum.frustum_corners`)."""
+    from ..scene.frustum import frustum_corners
+
+    pose = blender_to_opencv(get_camera_pose(frame))
+    return frustum_corners(pose, current_intrinsics(), clip_start, clip_end)
+
+
+def get_camera_frustum_as_object(clip_start: float | None = None, clip_end: float | None = None,
+                                 frame: int | None = None) -> Any:
+    """A new mesh object "Camera Frustum": Blender's cube with each vertex moved to the frustum corner of its
+    sign pattern (:func:`get_camera_frustum`), in world coordinates at an identity pose."""
+    from .object import create_primitive
+
+    corners = get_camera_frustum(clip_start, clip_end, frame)
+    cube = create_primitive("CUBE")
+    cube.set_name("Camera Frustum")
+    part = cube.parts[0]
+    signs = (part.vertices > 0).astype(int)  # Blender's cube: vertex (sx, sy, sz) is product's index 4x + 2y + z
+    part.vertices = corners[signs @ np.array([4, 2, 1])]
+    for derived in ("face_normals", "is_closed"):
+        part.__dict__.pop(derived, None)
+    return cube
+
+
 from .camera_validation import (decrease_interest_score, perform_obstacle_in_view_check,  # noqa: E402
                                 scene_coverage_score, visible_objects)
 
 __getattr__ = module_getattr("camera", [
-    "get_camera_frustum", "get_camera_frustum_as_object", "check_novel_pose",
+    "check_novel_pose",
     "set_camera_parameters_from_config_file", "depth_via_raytracing", "depth_at_points_via_raytracing",
     "pointcloud_from_depth", "project_points", "unproject_points"])

@@ -1,7 +1,8 @@
 """bproc.camera's view checks and lens model against analytic truth: the ray grid of visible_objects /
 scene_coverage_score over two floor halves seen from above, perform_obstacle_in_view_check over a plane at a known
 distance, is_point_inside_camera_frustum, set_lens_distortion's mapping (it must distort back onto every pixel)
-and add_depth_of_field's thin lens (Blender's aperture lens / (2 f-stop), the focus following its object)."""
+and add_depth_of_field's thin lens (Blender's aperture lens / (2 f-stop), the focus following its object);
+get_camera_frustum against BlenderProc's inverse perspective matrix and its object's volume."""
 from __future__ import annotations
 
 import math
@@ -150,3 +151,29 @@ def test_depth_of_field_is_blenders_thin_lens_focused_on_its_object(bproc) -> No
     assert render_frames._depth_of_field(0).distance_at(pose) == pytest.approx(1.5)
     with pytest.raises(Exception, match="aperture_blades"):
         bproc.camera.add_depth_of_field(focus, 1.0, aperture_blades=6)
+
+
+def test_camera_frustum_corners_and_object(bproc) -> None:  # noqa: F811
+    bproc.camera.set_resolution(640, 480)
+    pose = bproc.math.build_transformation_mat([1.0, -2.0, 3.0], [0.4, -0.2, 1.1])
+    bproc.camera.add_camera_pose(pose)
+    corners = bproc.camera.get_camera_frustum(clip_start=0.5, clip_end=4.0)
+    # BlenderProc's path: NDC corners through the inverse of the perspective matrix built from the fov
+    fov_x, fov_y = bproc.camera.get_fov()
+    near, far = 0.5, 4.0
+    projection = np.array([[1 / math.tan(fov_x / 2), 0, 0, 0], [0, 1 / math.tan(fov_y / 2), 0, 0],
+                           [0, 0, -(near + far) / (far - near), -2 * near * far / (far - near)], [0, 0, -1, 0]])
+    ndc = np.array([[x, y, z, 1.0] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
+    local = ndc @ np.linalg.inv(projection).T
+    expected = (local / local[:, 3:]) @ pose.T
+    np.testing.assert_allclose(corners, expected[:, :3], atol=1e-9)
+    frustum = bproc.camera.get_camera_frustum_as_object(clip_start=near, clip_end=far)
+    assert frustum.get_name() == "Camera Frustum"
+    vertices, faces = frustum.world_triangles()
+    assert sorted(map(tuple, np.round(vertices, 9))) == sorted(map(tuple, np.round(corners, 9)))
+    # a closed truncated pyramid of volume (h / 3) (A1 + A2 + sqrt(A1 A2)); the cube's +z corners go to the far
+    # plane, along the camera's -z, a mirroring: its faces wind inwards, as in Blender (negative signed volume)
+    tri = vertices[faces]
+    volume = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6
+    areas = [4 * d * d * math.tan(fov_x / 2) * math.tan(fov_y / 2) for d in (near, far)]
+    assert -volume == pytest.approx((far - near) / 3 * (areas[0] + areas[1] + math.sqrt(areas[0] * areas[1])))
