@@ -27,11 +27,9 @@ from ..config.registry import register_module
 from ..errors import ConfigError
 from ..io.mesh_loader import unique_blender_name
 from ..run.context import RunContext
-from ..scene.collision import CollisionWorld
-from ..scene.frames import object_pose
+from ..sampling.room_filling import RoomPlacer, fill_round_robin
 from ..scene.mesh_object import MeshObject
 from ..scene.room_plan import Rect, random_plan, room_meshes
-from ..sampling.placement import scale_of
 from .base import Module, Role
 from .camera_object_sampler import nested_module
 from .material_library import material_library
@@ -91,34 +89,6 @@ def _duplicate(group: list[MeshObject]) -> list[MeshObject]:
     return copies
 
 
-class _Placer:
-    """Tries poses of object groups on the floor pieces against walls, ceiling and what is placed."""
-
-    def __init__(self, context: RunContext, obstacles: list[MeshObject], tries: int) -> None:
-        self.context = context
-        self.world = CollisionWorld(obstacles)
-        self.tries = tries
-        self.placed: list[list[MeshObject]] = []
-
-    def try_piece(self, group: list[MeshObject], piece: Rect) -> bool:
-        """Up to ``tries`` poses of ``group`` on ``piece``; the first free one is applied, and True."""
-        rng = self.context.rng
-        reference = group[0].local2world
-        for _ in range(self.tries):
-            location = [rng.uniform(piece[0], piece[2]), rng.uniform(piece[1], piece[3]), 0.0]
-            turn = rng.uniform(0.0, 2.0 * np.pi)
-            moved = object_pose(location, [0.0, 0.0, turn], scale_of(group[0])) @ np.linalg.inv(reference)
-            poses = [moved @ part.local2world for part in group]
-            if any(self.world.collides(part, pose) for part, pose in zip(group, poses)):
-                continue
-            for part, pose in zip(group, poses):
-                part.local2world = pose
-                self.world.add(part)
-            self.placed.append(group)
-            return True
-        return False
-
-
 @register_module("constructor.RandomRoomConstructor")
 class RandomRoomConstructor(Module):
     """Builds a random room and places the objects of its loaders in it (see the module doc)."""
@@ -170,8 +140,8 @@ class RandomRoomConstructor(Module):
                              cfg["minimum_corridor_width"], cfg["amount_of_floor_cuts"], cfg["only_use_big_edges"],
                              context.rng)
         floor, walls, ceiling = self._build(context, pieces)
-        placer = _Placer(context, [walls] + ([ceiling] if ceiling is not None else []),
-                         cfg["placement_tries_per_face"])
+        placer = RoomPlacer([walls] + ([ceiling] if ceiling is not None else []), cfg["placement_tries_per_face"],
+                            context.rng)
         models = _group_models(loaded)
         self._fill(context, pieces, models, placer)
         taken = {o.name for o in scene.objects}
@@ -209,37 +179,8 @@ class RandomRoomConstructor(Module):
         return floor, walls, ceiling
 
     def _fill(self, context: RunContext, pieces: list[Rect], groups: list[list[MeshObject]],
-              placer: _Placer) -> None:
-        """BlenderProc's round robin: each model walks the pieces from a random one, placing a copy every
-        ``step`` m^2 of floor (step = models / density)."""
-        if not groups:
-            return
-        rng = context.rng
-        sizes = [(r[2] - r[0]) * (r[3] - r[1]) for r in pieces]
-        total = sum(sizes)
-        step = len(groups) / self.config["amount_of_objects_per_sq_meter"]
-        counter = rng.uniform(-step, step)
-        for group in sorted(groups, key=_bounding_volume, reverse=True):
-            current = group
-            if step > total:  # fewer placements than models: some models are skipped
-                counter += total
-                if counter > step:
-                    counter = rng.uniform(-step, step)
-                    continue
-            walked = 0.0
-            i = int(rng.integers(len(pieces)))
-            accumulated = rng.uniform(0.0, step + 1e-7)
-            while walked < total:
-                size = sizes[i]
-                if size < step:
-                    accumulated += size
-                    placements = 1 if accumulated > step else 0
-                    accumulated -= step * placements
-                else:
-                    placements = int((size + accumulated) / step)
-                    accumulated = size - placements * step
-                for _ in range(placements):
-                    if placer.try_piece(current, pieces[i]):
-                        current = _duplicate(current)
-                i = (i + 1) % len(pieces)
-                walked += size
+              placer: RoomPlacer) -> None:
+        """BlenderProc's round robin (:func:`hybridgen.sampling.room_filling.fill_round_robin`), biggest model
+        first."""
+        fill_round_robin(pieces, sorted(groups, key=_bounding_volume, reverse=True),
+                         self.config["amount_of_objects_per_sq_meter"], context.rng, placer.try_piece, _duplicate)
