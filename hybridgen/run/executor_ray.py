@@ -35,6 +35,10 @@ def check_reachable(address: str) -> None:
                          f"{exc.strerror or exc}") from None
 
 
+CANCEL_WAIT_S = 30.0
+"""How long an interrupted run waits for its cancelled Ray units to abort their writers (s)."""
+
+
 def _run(task: UnitTask, unit: WorkUnit) -> tuple[int, int]:
     try:
         return task(unit)
@@ -125,10 +129,22 @@ class RayExecutor(Executor):
             reclaim_sigterm()  # ray.init replaced it with a handler that exits without stopping the cluster
         self.remote = ray.remote(_run)
         self.task = task
+        self.in_flight: set[Any] = set()  # ObjectRefs of the units submitted and not finished
 
     def submit(self, unit: WorkUnit) -> Future:
-        return _unwrapped(self.remote.remote(self.task, unit).future())
+        ref = self.remote.remote(self.task, unit)
+        self.in_flight.add(ref)
+        future = ref.future()
+        future.add_done_callback(lambda _: self.in_flight.discard(ref))
+        return _unwrapped(future)
 
     def shutdown(self, interrupted: bool = False) -> None:
+        if interrupted and self.in_flight:
+            # units still running stop as on Ctrl-C (KeyboardInterrupt in the task: their writers abort and remove
+            # their temporary files) before the cluster goes; a killed worker would leave them behind
+            refs = list(self.in_flight)
+            for ref in refs:
+                self.ray.cancel(ref, force=False)
+            self.ray.wait(refs, num_returns=len(refs), timeout=CANCEL_WAIT_S)
         if self.started:
             self.ray.shutdown()
