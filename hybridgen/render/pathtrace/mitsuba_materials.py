@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ...input_paths import not_found
+from ...input_paths import not_found, utf8_path
 from ...errors import InputError
 from ...io.image_check import check_image_file
 from ...scene.material import ALPHA_MODES, Material
@@ -60,7 +60,7 @@ def color_texture(texture: Any, owner: str, slot: str = "base_color_texture") ->
     import mitsuba as mi
 
     if isinstance(texture, (str, Path)):
-        return {"type": "bitmap", "filename": str(_checked_path(texture, owner, slot))}
+        return {"type": "bitmap", "filename": utf8_path(_checked_path(texture, owner, slot))}
     array = np.ascontiguousarray(np.asarray(texture)[..., :3])
     if array.dtype != np.uint8 or array.ndim != 3:
         raise InputError(f"object '{owner}': {slot} must be an HxWx3/4 uint8 image")
@@ -76,7 +76,7 @@ def data_texture(texture: Any, owner: str, slot: str, *, channels: int = 1,
     import mitsuba as mi
 
     if isinstance(texture, (str, Path)) and not invert_green and threshold is None and channels == 3:
-        return {"type": "bitmap", "filename": str(_checked_path(texture, owner, slot)), "raw": True}
+        return {"type": "bitmap", "filename": utf8_path(_checked_path(texture, owner, slot)), "raw": True}
     if isinstance(texture, (str, Path)):
         _checked_path(texture, owner, slot)
     values = data_image(texture, owner, slot, channels)  # float32 0..1, rows top-down
