@@ -11,7 +11,10 @@ Per output kind (``SESSION.renderer.outputs``) and the color key:
 - ``segmentation``: :func:`hybridgen.bproc.segmentation.map_frame`'s keys.
 - colors: uint8 (H, W, 3) sRGB (Standard view); ``color_depth`` 16: uint16 of the linear float16 render; file
   format JPEG: the 8-bit image after a JPEG round trip at ``jpg_quality`` (what BlenderProc loads back from its
-  ``.jpg``; Blender and hybridgen both keep full chroma above quality 90).
+  ``.jpg``; Blender and hybridgen both keep full chroma above quality 90). With ``alpha`` (Cycles' transparent
+  film) a fourth channel: full where a surface covers the pixel centre, 0 where the camera ray meets only the
+  world, and there RGB 0 too (a straight-alpha PNG of Cycles' premultiplied film). Cycles' alpha is the pixel's
+  coverage; hybridgen's is the pixel centre's, so an edge pixel is opaque with the world's light blended in.
 
 Stereo frames (values with a leading axis of 2: left, right) give every image a leading axis of 2 as BlenderProc's
 data dict holds them; ``instance_attribute_maps`` of a stereo frame is one list over both eyes.
@@ -31,6 +34,14 @@ BACKGROUND_DEPTH = 1e10
 """Cycles' Z pass where a pixel sees no surface (m)."""
 
 
+def _with_alpha(colors: np.ndarray, background: np.ndarray) -> np.ndarray:
+    """RGBA of RGB ``colors``: alpha the dtype's maximum, 0 with RGB 0 where ``background`` (H, W) is True."""
+    full = np.iinfo(colors.dtype).max
+    rgba = np.concatenate([colors, np.full(colors.shape[:2] + (1,), full, dtype=colors.dtype)], axis=2)
+    rgba[background] = 0
+    return rgba
+
+
 def _colors(values: dict[str, Any]) -> np.ndarray:
     settings = SESSION.renderer
     if settings.color_depth == 16 and "colors_hdr" in values:
@@ -48,14 +59,14 @@ def _colors(values: dict[str, Any]) -> np.ndarray:
 
 
 def _convert_eye(values: dict[str, Any], table: np.ndarray, cam2world: np.ndarray, meshes: Sequence[Any],
-                 ray_lengths: np.ndarray) -> dict[str, Any]:
+                 ray_lengths: np.ndarray, alpha: bool) -> dict[str, Any]:
     """One eye's values -> BlenderProc's values by output kind (``colors``: the color image)."""
     from ..io.hdf5_blenderproc import encode_normals
     from ..render.tonemap import to_srgb8
 
     outputs = SESSION.renderer.outputs
     converted: dict[str, Any] = {}
-    instances = table[np.asarray(values["instance_segmaps"])] if outputs else None
+    instances = table[np.asarray(values["instance_segmaps"])] if "instance_segmaps" in values else None
     background = instances == 0 if instances is not None else None
     for kind, options in outputs.items():
         if kind in ("depth", "distance"):
@@ -74,6 +85,8 @@ def _convert_eye(values: dict[str, Any], table: np.ndarray, cam2world: np.ndarra
             converted[kind] = map_frame(instances, options["map_by"], options["default_values"], meshes)
     if "colors" in values:
         converted["colors"] = _colors(values)
+        if alpha:
+            converted["colors"] = _with_alpha(converted["colors"], background)
     return converted
 
 
@@ -97,9 +110,10 @@ def _merge_eyes(left: dict[str, Any], right: dict[str, Any]) -> dict[str, Any]:
 
 
 def convert_frame(values: dict[str, Any], table: np.ndarray, cam2world: np.ndarray, meshes: Sequence[Any],
-                  ray_lengths: np.ndarray, stereo: bool) -> dict[str, Any]:
-    """One frame's values (stereo: each with a leading axis of 2) -> BlenderProc's values by output kind."""
+                  ray_lengths: np.ndarray, stereo: bool, alpha: bool = False) -> dict[str, Any]:
+    """One frame's values (stereo: each with a leading axis of 2) -> BlenderProc's values by output kind;
+    ``alpha``: RGBA colors (transparent film)."""
     if not stereo:
-        return _convert_eye(values, table, cam2world, meshes, ray_lengths)
+        return _convert_eye(values, table, cam2world, meshes, ray_lengths, alpha)
     eyes = [{key: value[eye] for key, value in values.items()} for eye in (0, 1)]
-    return _merge_eyes(*(_convert_eye(eye, table, cam2world, meshes, ray_lengths) for eye in eyes))
+    return _merge_eyes(*(_convert_eye(eye, table, cam2world, meshes, ray_lengths, alpha) for eye in eyes))

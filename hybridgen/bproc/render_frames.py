@@ -11,7 +11,7 @@ the outputs were enabled and ``colors`` (the ``output_key``) last:
 
 - ``colors``: uint8 (H, W, 3), sRGB (hybridgen's Standard view; BlenderProc 2.8's default is Filmic: a
   notice says so), uint16 with ``set_output_format(color_depth=16)``, JPEG-round-tripped with ``file_format``
-  JPEG.
+  JPEG; (H, W, 4) with a transparent film (alpha from the instance map at pixel centres).
 - ``depth``: float32 (H, W), m along the optical axis; background 1e10 (Cycles' Z pass), or with antialiasing
   the mist range (10000 m) as depth.
 - ``distance``: float32 (H, W), m from the camera centre; background the mist range, or 1e10 as distance.
@@ -102,10 +102,11 @@ def _groups(frames: list[int]) -> list[list[int]]:
     return groups
 
 
-def _label_request(outputs: dict[str, Any]) -> Any:
+def _label_request(outputs: dict[str, Any], alpha: bool) -> Any:
+    """The label passes the outputs need (the instance map also for the colors' alpha); None: none."""
     import hybridgen as hg
 
-    if not outputs:
+    if not outputs and not alpha:
         return None
     return hg.LabelRequest(depth="depth" in outputs or "distance" in outputs, distance="distance" in outputs,
                            normals="normals" in outputs, map_by=["instance"], albedo="diffuse" in outputs)
@@ -146,11 +147,12 @@ def _scene(frames: list[int], meshes: list[MeshObject]) -> tuple[Any, np.ndarray
     return scene, table
 
 
-def _render_group(frames: list[int], meshes: list[MeshObject], color: bool) -> list[tuple[dict[str, Any], np.ndarray]]:
+def _render_group(frames: list[int], meshes: list[MeshObject], color: bool,
+                  alpha: bool) -> list[tuple[dict[str, Any], np.ndarray]]:
     import hybridgen as hg
 
     settings = SESSION.renderer
-    request = _label_request(settings.outputs)
+    request = _label_request(settings.outputs, alpha)
     scene, table = _scene(frames, meshes)
     sink = hg.MemorySink()
     if color:
@@ -168,8 +170,9 @@ def _render_group(frames: list[int], meshes: list[MeshObject], color: bool) -> l
     return [(values, table) for values in sink.frames]
 
 
-def render_frames(output_key: str | None, load_keys: set[str] | None, return_data: bool) -> dict[str, list[Any]]:
-    """See the module documentation."""
+def render_frames(output_key: str | None, load_keys: set[str] | None, return_data: bool,
+                  alpha: bool = False) -> dict[str, list[Any]]:
+    """See the module documentation; ``alpha``: the colors get an alpha channel (transparent film)."""
     frames = list(range(SESSION.frame_start, SESSION.frame_end))
     if not frames:
         raise InputError("No camera poses have been registered, therefore nothing can be rendered. A camera pose "
@@ -184,12 +187,12 @@ def render_frames(output_key: str | None, load_keys: set[str] | None, return_dat
 
         notice(f"colors use the Standard sRGB view; BlenderProc renders with Blender's '{view}' view transform "
                "(its look tables are not reproduced): set_output_format(view_transform='Standard') matches exactly")
-    rendered = [pair for group in _groups(frames) for pair in _render_group(group, meshes, output_key is not None)]
+    rendered = [pair for group in _groups(frames) for pair in _render_group(group, meshes, output_key is not None, alpha)]
     ray_lengths = current_intrinsics().pixel_ray_lengths()
     data: dict[str, list[Any]] = {}
     for frame, (values, table) in zip(frames, rendered):
         converted = convert_frame(values, table, SESSION.camera.pose.at(frame), meshes, ray_lengths,
-                                  SESSION.camera.stereo)
+                                  SESSION.camera.stereo, alpha)
         for kind, options in SESSION.renderer.outputs.items():
             if kind == "segmentation":
                 if "segmap" in keys:

@@ -68,10 +68,12 @@ def set_output_format(file_format: str | None = None, color_depth: int | None = 
     """What ``colors`` holds: ``file_format`` PNG (exact) or JPEG (the image after a JPEG round trip at
     ``jpg_quality``, as BlenderProc loads its ``.jpg`` back); ``color_depth`` 8 (uint8) or 16 (uint16, PNG only);
     ``view_transform`` Standard, or Filmic / AgX, which hybridgen renders as Standard with a notice (Blender's
-    look tables are not reproduced; :mod:`hybridgen.bproc.render_frames`). Transparency stops with one line."""
+    look tables are not reproduced; :mod:`hybridgen.bproc.render_frames`). ``enable_transparency`` (Cycles'
+    transparent film): a PNG's colors get an alpha channel, 0 (and RGB 0) where the camera sees the world, which
+    still lights the scene (:mod:`hybridgen.bproc.frame_outputs`)."""
     settings = SESSION.renderer
-    if enable_transparency:
-        fail("bproc.renderer.set_output_format(enable_transparency=True)", "colors have no alpha channel")
+    if enable_transparency is not None:
+        settings.transparent = bool(enable_transparency)
     if view_transform is not None and view_transform not in VIEW_TRANSFORMS:
         fail(f"bproc.renderer.set_output_format(view_transform={view_transform!r})",
              f"views: {', '.join(VIEW_TRANSFORMS)}")
@@ -158,10 +160,14 @@ def render(output_dir: str | None = None, file_prefix: str = "rgb_", output_key:
            load_keys: set[str] | None = None, return_data: bool = True,
            keys_with_alpha_channel: set[str] | None = None, verbose: bool = False) -> dict[str, list[Any]]:
     """Render every frame of ``frame_start..frame_end``: ``{key: [one array per frame]}`` (see the module
-    documentation of :mod:`hybridgen.bproc.render_frames`)."""
-    if keys_with_alpha_channel:
-        fail("bproc.renderer.render(keys_with_alpha_channel=...)", "colors have no alpha channel")
-    return render_frames(output_key, load_keys, return_data)
+    documentation of :mod:`hybridgen.bproc.render_frames`). The colors keep their alpha channel when the film is
+    transparent (``set_output_format(enable_transparency=True)``, PNG) and ``output_key`` is in
+    ``keys_with_alpha_channel`` (default then: ``{"colors"}``), as BlenderProc loads its RGBA files."""
+    settings = SESSION.renderer
+    if keys_with_alpha_channel is None:
+        keys_with_alpha_channel = {"colors"} if settings.transparent else set()
+    alpha = settings.transparent and settings.file_format == "PNG" and output_key in keys_with_alpha_channel
+    return render_frames(output_key, load_keys, return_data, alpha)
 
 
 def accept_speed_setting(*_args: Any, **_kwargs: Any) -> None:

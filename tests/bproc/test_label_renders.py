@@ -1,7 +1,7 @@
 """bproc.renderer's extra renders against analytic truth: optical flow of a floor under a known camera motion
 (BlenderProc's signs: forward to the next frame, y down unless blender_image_coordinate_style), NOCS of a rotated
 cube (0.5 p + 0.5 of the local point, alpha 1 on the object), stereo pairs (the right eye's disparity fx b / z),
-and set_output_format's colors (JPEG round trip, 16-bit, view transforms)."""
+and set_output_format's colors (JPEG round trip, 16-bit, view transforms, a transparent film's alpha)."""
 from __future__ import annotations
 
 import numpy as np
@@ -103,5 +103,22 @@ def test_output_formats_of_colors(bproc) -> None:  # noqa: F811
     bproc.renderer.set_output_format(view_transform="Filmic")  # rendered as Standard with a notice
     with pytest.raises(Exception, match="not supported"):
         bproc.renderer.set_output_format(view_transform="False Color")
-    with pytest.raises(Exception, match="not supported"):
-        bproc.renderer.set_output_format(enable_transparency=True)
+
+
+def test_transparent_film_gives_alpha_where_surfaces_are(bproc) -> None:  # noqa: F811
+    bproc.object.create_primitive("PLANE", size=2)  # x, y in -1..1 at z = 0
+    bproc.camera.add_camera_pose(_down(0.3, 0.0, 4.0))
+    bproc.renderer.set_max_amount_of_samples(2)
+    bproc.renderer.set_output_format(enable_transparency=True)
+    rgba = bproc.renderer.render()["colors"][0]
+    K = bproc.camera.get_intrinsics_as_K_matrix()
+    v, u = np.mgrid[0:24, 0:32]
+    x, y = 0.3 + (u - K[0, 2]) / K[0, 0] * 4.0, -(v - K[1, 2]) / K[1, 1] * 4.0  # pixel centres on z = 0
+    covered = (np.abs(x) < 1) & (np.abs(y) < 1)
+    assert rgba.shape == (24, 32, 4) and rgba.dtype == np.uint8 and 0 < covered.sum() < covered.size
+    assert np.array_equal(rgba[..., 3], np.where(covered, 255, 0))
+    assert not rgba[~covered].any() and rgba[covered][:, :3].any()
+    # BlenderProc loads the alpha of the keys asked for only; a JPEG film has none
+    assert bproc.renderer.render(keys_with_alpha_channel=set())["colors"][0].shape == (24, 32, 3)
+    bproc.renderer.set_output_format(file_format="JPEG")
+    assert bproc.renderer.render()["colors"][0].shape == (24, 32, 3)
