@@ -31,6 +31,7 @@ TOOLS = Path(__file__).resolve().parent
 sys.path.insert(0, str(TOOLS))
 
 from check_blenderproc_configs import example_configs, make_standins  # noqa: E402
+from bproc_dataset_standins import copy_resources, dataset_arg, make_dataset_standins, run_lines  # noqa: E402
 
 REPO = TOOLS.parent
 RUN_LINE = re.compile(r"blenderproc run (examples/\S+/main\.py)([^\n`]*)")
@@ -43,7 +44,7 @@ def readme_args(script: Path, root: Path) -> list[str]:
     readme = script.parent / "README.md"
     if not readme.is_file():
         return []
-    matches = list(RUN_LINE.finditer(readme.read_text(errors="replace")))
+    matches = list(RUN_LINE.finditer(run_lines(readme.read_text(errors="replace"))))
     wanted = script.relative_to(root).as_posix()
     same = [m for m in matches if m.group(1) == wanted]
     if not same:  # a README naming its script under another folder (nocs: examples/datasets/nocs/main.py)
@@ -72,6 +73,9 @@ def resolve_placeholder(arg: str, work: Path) -> str:
 
 def resolve_arg(arg: str, root: Path, work: Path, output: Path) -> str:
     """The checkout's file, a temporary output folder, or a stand-in (see the module documentation)."""
+    mapped = dataset_arg(arg, work)  # a dataset the README names (tools/bproc_dataset_standins.py)
+    if mapped is not None:
+        return mapped
     if arg.startswith("<") and arg.endswith(">"):
         arg = resolve_placeholder(arg, work)
     if arg.startswith("-") or re.fullmatch(r"[-+]?\d+(\.\d+)?", arg):
@@ -133,6 +137,8 @@ def main() -> None:
         for index, color in enumerate(((200, 60, 60), (60, 160, 90))):  # material_manipulation's textures
             Image.new("RGB", (16, 16), color).save(work / "images" / f"material_manipulation_sample_texture{index}.jpg")
         scripts = sorted(p for p in (root / "examples").rglob("main.py") if ns.only in str(p))
+        copy_resources(ns.path, ns.tag, root)
+        make_dataset_standins(work, "\n".join(p.read_text(errors="replace") for p in scripts), root)
         counts = {"runs": 0, "fails": 0}
         for script in scripts:
             status, detail, seconds = run_one(script, root, work, ns.timeout, ns.max_samples)

@@ -1,87 +1,26 @@
-"""``bproc.loader``: mesh files into mesh objects (BlenderProc's ObjectLoader), through
-:func:`hybridgen.load_objects`.
-
-As Blender 4's importers read them (BlenderProc 2.8 runs Blender 4.2): an OBJ's objects (one per ``o``) keep
-the file's Y-up vertices and get the axis turn as their pose (rotation_euler (90 deg, 0, 0), as Blender's
-OBJ importer sets it); PLY and STL are taken as stored (Z-up) with one default material (``ply_material``
-showing the vertex colors, ``stl_material``); glTF/GLB are turned Z-up in the vertices, as Blender's glTF
-importer does. Every object gets the custom property ``model_path``. An OBJ object with several materials is
-one mesh object with one material slot per material (hybridgen renders one part per slot).
+"""``bproc.loader``: files and datasets into ``bproc.types`` objects (BlenderProc's loaders), one file per
+family, every name re-exported here: :mod:`~hybridgen.bproc.loader_object` (``load_obj``),
+:mod:`~hybridgen.bproc.loader_blend` (``load_blend``), :mod:`~hybridgen.bproc.loader_bop` (``load_bop_objs``,
+``load_bop_scene``, ``load_bop_intrinsics``), :mod:`~hybridgen.bproc.loader_datasets` (ShapeNet, Pix3D, IKEA,
+AMASS, Replica, SceneNet, 3D-FRONT, Matterport3D), :mod:`~hybridgen.bproc.loader_materials` (CC and Poly Haven
+materials, textures, Haven HDRIs) and :mod:`~hybridgen.bproc.loader_urdf` (``load_urdf``). SUNCG (withdrawn by
+its authors) and Replica's segmented meshes raise one line naming the call.
 """
 from __future__ import annotations
 
-import os
-from typing import Any
+from .loader_blend import load_blend
+from .loader_bop import load_bop_intrinsics, load_bop_objs, load_bop_scene
+from .loader_datasets import (load_AMASS, load_front3d, load_ikea, load_matterport3d, load_pix3d, load_replica,
+                              load_scenenet, load_shapenet)
+from .loader_materials import (get_random_world_background_hdr_img_path_from_haven, load_ccmaterials, load_haven_mat,
+                               load_texture)
+from .loader_object import load_obj
+from .loader_urdf import load_urdf
+from .types.unsupported import module_getattr
 
-from ..errors import InputError
-from ..scene.frames import Y_UP_TO_Z_UP
-from ..scene.material import Material as SceneMaterial
-from .types import Material, MeshObject
-from .types.unsupported import fail, module_getattr
+__all__ = ["get_random_world_background_hdr_img_path_from_haven", "load_AMASS", "load_blend", "load_bop_intrinsics",
+           "load_bop_objs", "load_bop_scene", "load_ccmaterials", "load_front3d", "load_haven_mat", "load_ikea",
+           "load_matterport3d", "load_obj", "load_pix3d", "load_replica", "load_scenenet", "load_shapenet",
+           "load_texture", "load_urdf"]
 
-IGNORED_OBJ_OPTIONS = {"validate_meshes"}
-"""Blender importer options that change nothing hybridgen renders."""
-
-
-def _group_parts(parts: list[Any]) -> list[list[Any]]:
-    """Consecutive parts of one Blender object (same name: hybridgen splits an object per material)."""
-    groups: list[list[Any]] = []
-    for part in parts:
-        if groups and groups[-1][0].name == part.name and "material_part" in part.attributes:
-            groups[-1].append(part)
-        else:
-            groups.append([part])
-    return groups
-
-
-def _slots(group: list[Any], own: dict[str, Material], default: str | None) -> list[Material]:
-    """One bproc material per distinct hybridgen material of the file (shared between its objects)."""
-    slots = []
-    for part in group:
-        scene_material: SceneMaterial = part.material
-        key = default or scene_material.name
-        if key not in own:
-            if default is not None:
-                scene_material = SceneMaterial(name=default, base_color_from_vertices=part.vertex_colors is not None)
-            own[key] = Material(key, scene_material)
-        slots.append(own[key])
-    return slots
-
-
-def load_obj(filepath: str, cached_objects: dict[str, list[MeshObject]] | None = None,
-             **kwargs: Any) -> list[MeshObject]:
-    """The mesh objects of an OBJ, PLY, STL, glTF or GLB file (see the module documentation)."""
-    import hybridgen as hg
-
-    path = str(filepath)
-    if not os.path.exists(path):
-        raise InputError(f"The given filepath does not exist: {path}")
-    if cached_objects is not None:
-        if path in cached_objects:
-            return [obj.duplicate() for obj in cached_objects[path]]  # type: ignore[misc]
-        cached_objects[path] = load_obj(path, None, **kwargs)
-        return cached_objects[path]
-    unknown = set(kwargs) - IGNORED_OBJ_OPTIONS
-    if unknown:
-        fail(f"bproc.loader.load_obj({', '.join(sorted(unknown))}=...)")
-    suffix = os.path.splitext(path)[1].lower()
-    if suffix not in (".obj", ".ply", ".stl", ".glb", ".gltf"):
-        fail(f"bproc.loader.load_obj of a '{suffix}' file", "OBJ, PLY, STL, glTF and GLB are")
-    parts = hg.load_objects(path, up_axis="Z" if suffix in (".obj", ".ply", ".stl") else "auto")
-    default = {".ply": "ply_material", ".stl": "stl_material"}.get(suffix)
-    turn = Y_UP_TO_Z_UP if suffix == ".obj" else None
-    own: dict[str, Material] = {}
-    objects = []
-    for group in _group_parts(parts):
-        pose = group[0].local2world if turn is None else group[0].local2world @ turn
-        obj = MeshObject(group[0].name, group, _slots(group, own, default), pose)
-        obj.set_cp("model_path", path)
-        objects.append(obj)
-    return objects
-
-
-__getattr__ = module_getattr("loader", [
-    "load_AMASS", "load_blend", "load_bop_objs", "load_bop_scene", "load_bop_intrinsics", "load_ccmaterials",
-    "load_front3d", "load_haven_mat", "load_ikea", "load_matterport3d", "load_pix3d", "load_replica",
-    "load_replica_segmented_mesh", "load_scenenet", "load_shapenet", "load_suncg", "load_texture",
-    "get_random_world_background_hdr_img_path_from_haven", "load_urdf"])
+__getattr__ = module_getattr("loader", ["load_replica_segmented_mesh", "load_suncg"])

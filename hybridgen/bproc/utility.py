@@ -7,6 +7,7 @@ from types import TracebackType
 
 
 from ..logs import LOGGER
+from .label_id_mapping import LabelIdMapping, resolve_resource  # noqa: F401 - bproc.utility names
 from .session import SESSION
 from .types.unsupported import module_getattr
 
@@ -61,5 +62,4 @@ class BlockStopWatch:
         LOGGER.info("#### Finished - %s (took %.3f seconds) ####", self.block_name, time.perf_counter() - self.start)
 
 
-__getattr__ = module_getattr("utility", ["resolve_resource", "UndoAfterExecution", "LabelIdMapping",
-                                         "generate_random_pattern_img"])
+__getattr__ = module_getattr("utility", ["UndoAfterExecution", "generate_random_pattern_img"])

@@ -47,12 +47,16 @@ _LINEAR_MAPS = {"roughness": "roughness_texture", "metallic": "metallic_texture"
 @dataclass
 class BlendContent:
     """What :func:`load_blend` read: mesh objects, lights and the world (None when the file has none), plus
-    the empties' names and poses (``{name: local2world}``)."""
+    the empties' names and poses (``{name: local2world}``), the parent links and the render-hidden objects."""
 
     objects: list[MeshObject] = field(default_factory=list)
     lights: list[Light] = field(default_factory=list)
     world: dict[str, Any] | None = None
     empties: dict[str, np.ndarray] = field(default_factory=dict)
+    parents: dict[str, str] = field(default_factory=dict)
+    """Blender's parent of each object that has one (child name -> parent name; both as in the file)."""
+    hidden: set[str] = field(default_factory=set)
+    """Names of the objects hidden in renders (Blender's ``hide_render``)."""
 
 
 def bpy_python() -> Path:
@@ -98,6 +102,10 @@ def _content(file: Path, scene: dict[str, Any], arrays: dict[str, np.ndarray], o
     content = BlendContent(world=_world(scene.get("world"), out, file))
     for record in scene["objects"]:
         pose = np.asarray(record["matrix_world"], dtype=np.float64)
+        if record.get("parent"):
+            content.parents[record["name"]] = str(record["parent"])
+        if record.get("hidden"):
+            content.hidden.add(record["name"])
         if "light" in record:
             content.lights.append(_light(record, pose))
         elif "arrays" in record:

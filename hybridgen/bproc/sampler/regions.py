@@ -30,14 +30,16 @@ def _face_frame(corners: np.ndarray, face: Sequence[int]) -> tuple[np.ndarray, n
     base = corners[face[0]]
     first, second = corners[face[1]] - base, corners[face[3]] - base
     normal = np.cross(first, second)
-    return base, first, second, normal / np.linalg.norm(normal)
+    length = np.linalg.norm(normal)
+    return base, first, second, normal / length if length > 0 else normal  # a flat box's side faces: zero
 
 
 def _upper_face(obj: Any, up: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The face of ``obj``'s bounding box whose outward normal is closest to ``up`` (the first on a tie)."""
     corners = np.asarray(obj.get_bound_box(), dtype=np.float64)
     frames = [_face_frame(corners, face) for face in _BOX_FACES]
-    angles = [math.acos(float(np.clip(frame[3].dot(up), -1.0, 1.0))) for frame in frames]
+    angles = [math.acos(float(np.clip(frame[3].dot(up), -1.0, 1.0))) if frame[3].any() else math.inf
+              for frame in frames]  # a degenerate face (a plane's bounding box has no height) is never chosen
     return frames[int(np.argmin(angles))]
 
 
