@@ -14,6 +14,7 @@ import numpy as np
 from ..errors import InputError
 from ..scene.primitives import make_primitive
 from .bvh_tree import create_bvh_tree_multi_objects, scene_ray_cast
+from .face_slicer import extract_floor, slice_faces_with_normals
 from .physics import simulate_physics, simulate_physics_and_fix_final_poses
 from .placement import sample_poses, sample_poses_on_surface
 from .types import Entity, MeshObject
@@ -21,9 +22,9 @@ from .types.mesh_object import get_all_mesh_objects
 from .types.unsupported import fail, module_getattr
 
 __all__ = ["compute_poi", "convert_to_entities", "convert_to_meshes", "create_bvh_tree_multi_objects", "create_empty",
-           "create_primitive", "delete_multiple", "disable_all_rigid_bodies", "get_all_mesh_objects", "merge_objects",
-           "sample_poses", "sample_poses_on_surface", "scene_ray_cast", "simulate_physics",
-           "simulate_physics_and_fix_final_poses"]
+           "create_primitive", "delete_multiple", "disable_all_rigid_bodies", "extract_floor", "get_all_mesh_objects",
+           "merge_objects", "sample_poses", "sample_poses_on_surface", "scene_ray_cast", "simulate_physics",
+           "simulate_physics_and_fix_final_poses", "slice_faces_with_normals"]
 
 SHAPES = {"CUBE": ("cube", "Cube"), "PLANE": ("plane", "Plane"), "SPHERE": ("sphere", "Sphere"),
           "CYLINDER": ("cylinder", "Cylinder"), "CONE": ("cone", "Cone")}
@@ -110,5 +111,5 @@ def compute_poi(objects: Sequence[MeshObject]) -> np.ndarray:
 
 
 __getattr__ = module_getattr("object", [
-    "extract_floor", "slice_faces_with_normals", "replace_objects", "create_from_blender_mesh",
+    "replace_objects", "create_from_blender_mesh",
     "create_with_empty_mesh", "create_from_point_cloud"])

@@ -16,20 +16,10 @@ from ..config.blenderproc import custom_properties
 from ..config.registry import register_module
 from ..config.schema import Param, positive
 from ..run.context import RunContext
+from ..scene.face_slicing import split_faces
 from ..scene.mesh_object import MeshObject
 from .base import Role
 from .selecting import SelectingModule
-
-
-def split_faces(obj: MeshObject, keep: np.ndarray, name: str) -> MeshObject:
-    """A new object of ``obj``'s faces where ``keep`` is True (unused vertices dropped; same pose, material)."""
-    faces = obj.faces[keep]
-    used, remapped = np.unique(faces, return_inverse=True)
-    return MeshObject(
-        name=name, vertices=obj.vertices[used], faces=remapped.reshape(-1, 3),
-        vertex_normals=None if obj.vertex_normals is None else obj.vertex_normals[used],
-        uvs=None if obj.uvs is None else np.asarray(obj.uvs)[used], material=obj.material,
-        category_id=obj.category_id, attributes=dict(obj.attributes), local2world=obj.local2world.copy())
 
 
 def floor_faces(obj: MeshObject, angle_deg: float, height: float, upwards: bool) -> np.ndarray:

@@ -36,6 +36,8 @@ class MeshGeometry:
         parts are unchanged (collision checks cache per array)."""
         key = tuple((id(part.vertices), id(part.faces)) for part in self.parts)
         cached = self.__dict__.get("_joined")
+        if not self.parts:
+            return np.zeros((0, 3)), np.zeros((0, 3), np.int64)
         if cached is None or cached[0] != key:
             offsets = np.cumsum([0] + [len(part.vertices) for part in self.parts])
             vertices = np.concatenate([part.vertices for part in self.parts])

@@ -3,8 +3,10 @@ parts (BlenderProc's MeshObjectUtility).
 
 A Blender object may hold several materials; a hybridgen mesh holds one, so a mesh object is a list of parts
 (``parts``, one per material of the file) whose geometry is in the object's local frame (metres). Material slots
-are ``bproc.types.Material`` objects; part ``i`` renders with slot ``min(i, slots - 1)`` as Blender clamps a
-face's material index, and with Blender's default grey surface when there is no slot. A render poses every part
+are ``bproc.types.Material`` objects; part ``i`` renders with slot ``min(part_slots[i], slots - 1)`` (its
+material index, ``i`` unless faces were split off) as Blender clamps a face's material index, and with Blender's
+default grey surface when there is no slot. A mesh whose faces all went to another object has no parts (Blender's
+empty mesh: nothing renders, its bound box is the origin). A render poses every part
 at the object's ``matrix_world`` of the frame (:meth:`MeshObject.scene_parts`).
 """
 from __future__ import annotations
@@ -43,6 +45,8 @@ class MeshObject(Entity, MeshGeometry, RigidBodyMixin):
             raise InputError(f"mesh object '{name}' has no geometry")
         super().__init__(name, local2world)
         self.parts: list[ScenePart] = list(parts)
+        self.part_slots: list[int] = list(range(len(self.parts)))
+        """The material index of each part."""
         self._slots: list[Material | None] = list(slots)
 
     # --- materials ----------------------------------------------------------------------------------------
@@ -77,18 +81,23 @@ class MeshObject(Entity, MeshGeometry, RigidBodyMixin):
         """The hybridgen material part ``index`` renders with."""
         if not self._slots:
             return DEFAULT_SURFACE
-        slot = self._slots[min(index, len(self._slots) - 1)]
+        number = self.part_slots[index] if index < len(self.part_slots) else index
+        slot = self._slots[min(number, len(self._slots) - 1)]
         return DEFAULT_SURFACE if slot is None else slot.blender_obj
 
     # --- geometry -----------------------------------------------------------------------------------------
     def local_vertices(self) -> np.ndarray:
         """(V, 3) every part's vertices in the local frame, metres."""
+        if not self.parts:
+            return np.zeros((0, 3))
         return np.concatenate([part.vertices for part in self.parts])
 
     def get_bound_box(self, local_coords: bool = False) -> np.ndarray:
         """(8, 3) corners of the local axis-aligned box in Blender's order; world coordinates unless
         ``local_coords``."""
         vertices = self.local_vertices()
+        if not len(vertices):
+            vertices = np.zeros((1, 3))
         low, high = vertices.min(axis=0), vertices.max(axis=0)
         corners = np.where(BOUND_BOX_CORNERS == 1, high, low)
         if local_coords:
@@ -197,6 +206,7 @@ class MeshObject(Entity, MeshGeometry, RigidBodyMixin):
         super()._copy_state_from(other)
         assert isinstance(other, MeshObject)
         self.parts = [copy.copy(part) for part in other.parts]
+        self.part_slots = list(other.part_slots)
         self._slots = list(other._slots)
         self._rigid_body = copy.copy(other._rigid_body)
 
