@@ -217,12 +217,41 @@ class MeshObject(Entity, MeshGeometry, RigidBodyMixin):
     edit_mode: Callable[..., Any] = unsupported_method("MeshObject", "edit_mode")
     object_mode: Callable[..., Any] = unsupported_method("MeshObject", "object_mode")
     scale_uv_coordinates: Callable[..., Any] = unsupported_method("MeshObject", "scale_uv_coordinates")
-    add_uv_mapping: Callable[..., Any] = unsupported_method("MeshObject", "add_uv_mapping")
     add_displace_modifier: Callable[..., Any] = unsupported_method("MeshObject", "add_displace_modifier")
     add_modifier: Callable[..., Any] = unsupported_method("MeshObject", "add_modifier")
     add_geometry_nodes: Callable[..., Any] = unsupported_method("MeshObject", "add_geometry_nodes")
     add_auto_smooth_modifier: Callable[..., Any] = unsupported_method("MeshObject", "add_auto_smooth_modifier")
     clear_custom_splitnormals: Callable[..., Any] = unsupported_method("MeshObject", "clear_custom_splitnormals")
+
+    def add_uv_mapping(self, projection: str, overwrite: bool = False) -> None:
+        """Texture coordinates by Blender's ``cube``, ``cylinder`` or ``sphere`` projection of all faces
+        (:mod:`hybridgen.scene.uv_projection`; the pose's rotation and scale now orient the cylinder and sphere),
+        unless the object has coordinates already and not ``overwrite``. ``smart`` raises one line."""
+        from ...scene.uv_projection import PROJECTIONS, corner_vertices, project_uvs
+
+        if projection == "smart":
+            unsupported_method("MeshObject", "add_uv_mapping('smart')", "cube, cylinder and sphere are")()
+        if projection not in PROJECTIONS:
+            raise InputError(f"Unknown projection: '{projection}'. Please use 'cube', 'cylinder', 'smart' or "
+                             "'sphere'.")
+        if self.has_uv_mapping() and not overwrite or not self.parts:
+            return
+        vertices, faces = self.local_mesh()
+        corner_uvs = project_uvs(projection, vertices, faces, self.get_local2world_mat())
+        start = 0
+        for index, part in enumerate(self.parts):
+            count = len(part.faces)
+            source, uvs, new_faces = corner_vertices(part.faces, corner_uvs[start:start + count])
+            start += count
+            twin = copy.copy(part)
+            for derived in ("face_normals", "is_closed"):
+                twin.__dict__.pop(derived, None)
+            twin.vertices, twin.faces, twin.uvs = part.vertices[source], new_faces, uvs
+            if part.vertex_normals is not None:
+                twin.vertex_normals = part.vertex_normals[source]
+            if part.vertex_colors is not None:
+                twin.vertex_colors = part.vertex_colors[source]
+            self.parts[index] = twin
 
     def has_uv_mapping(self) -> bool:
         """Whether every part has texture coordinates."""
