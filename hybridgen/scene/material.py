@@ -23,8 +23,9 @@ class Material:
     PBR maps (file path or HxW[xC] uint8 array, read as data, not sRGB; the first channel of a gray map):
 
     - ``roughness_texture`` / ``metallic_texture`` / ``alpha_texture`` / ``specular_texture`` replace their
-      value. ``specular`` has Blender's Principled meaning: the dielectric reflectance at normal incidence
-      is 0.08 x specular (0.5 -> 4 %, the F0 of glass-like IOR 1.5).
+      value. ``specular`` is Blender 4's ``Specular IOR Level``: the dielectric reflectance at normal incidence is
+      ((ior - 1) / (ior + 1))^2 x 2 x specular, so 0.5 keeps the IOR's own (4 % at Blender 4.2's default IOR 1.5;
+      the same as Blender 3's ``Specular`` 0.5, whose 0.08 x specular this was before; docs/principled_bsdf.md).
     - ``emission_texture``: an sRGB color image replacing ``emission``'s RGB (as an image linked to the
       Principled BSDF's Emission input); the surface emits texture (decoded to linear) x
       ``emission_strength`` W sr^-1 m^-2 per texel.
@@ -59,7 +60,7 @@ class Material:
     emission: tuple[float, float, float] = (0.0, 0.0, 0.0)
     emission_strength: float = 0.0
     transmission: float = 0.0
-    ior: float = 1.45
+    ior: float = 1.5  # Blender 4.2's Principled BSDF default (Blender 3's was 1.45)
     alpha: float = 1.0
     base_color_from_vertices: bool = False  # the object's vertex_colors are the base color (RGB)
     roughness_texture: Any = None
