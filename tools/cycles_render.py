@@ -1,6 +1,8 @@
 """Blender Cycles worker for the color benchmarks: renders an exported scene (tools/cycles_export.py) keypoint by
 keypoint, on request.
 
+Over 300 lines: one process inside Blender builds the scene and answers render requests, with its EXR reader.
+
 Runs inside its own virtual environment (``bpy`` from PyPI needs Python 3.11 and numpy < 2), started by
 tools/cycles_worker.py, which creates ``.venv-bpy`` on demand::
 
