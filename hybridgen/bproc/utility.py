@@ -10,6 +10,7 @@ from ..logs import LOGGER
 from .label_id_mapping import LabelIdMapping, resolve_resource  # noqa: F401 - bproc.utility names
 from .session import SESSION
 from .types.unsupported import module_getattr
+from .undo import UndoAfterExecution  # noqa: F401 - a bproc.utility name
 
 
 def resolve_path(path: str) -> str:
@@ -62,4 +63,4 @@ class BlockStopWatch:
         LOGGER.info("#### Finished - %s (took %.3f seconds) ####", self.block_name, time.perf_counter() - self.start)
 
 
-__getattr__ = module_getattr("utility", ["UndoAfterExecution", "generate_random_pattern_img"])
+__getattr__ = module_getattr("utility", ["generate_random_pattern_img"])

@@ -23,6 +23,7 @@ from ...scene.shading import shade
 from ..session import SESSION
 from .entity import Entity, compose, vector3
 from .material import Material
+from .mesh_editing import MeshEditing, transformed_part
 from .mesh_geometry import MeshGeometry
 from .rigid_body import RigidBodyMixin
 from .unsupported import unsupported_method
@@ -33,9 +34,10 @@ DEFAULT_SURFACE = SceneMaterial(name="blender_default_surface")
 """What Blender renders a mesh without material with: grey 0.8 Principled, roughness 0.5."""
 
 
-class MeshObject(Entity, MeshGeometry, RigidBodyMixin):
+class MeshObject(Entity, MeshGeometry, MeshEditing, RigidBodyMixin):
     """A mesh object; ``parts`` are hybridgen meshes in its local frame, ``_slots`` its material slots. Geometric
-    queries (BVH trees, ray casts) and the rigid body come from the mixins."""
+    queries (BVH trees, ray casts), mesh edits (UV projection, joining) and the rigid body come from the
+    mixins."""
 
     TYPE = "MESH"
 
@@ -112,17 +114,7 @@ class MeshObject(Entity, MeshGeometry, RigidBodyMixin):
 
     def _transform_parts(self, matrix: np.ndarray) -> None:
         """Apply a local 4x4 to every part's vertices (and its normals)."""
-        linear = matrix[:3, :3]
-        normal_matrix = np.linalg.inv(linear).T
-        for index, part in enumerate(self.parts):
-            twin = copy.copy(part)
-            twin.__dict__.pop("face_normals", None)
-            twin.__dict__.pop("is_closed", None)
-            twin.vertices = part.vertices @ linear.T + matrix[:3, 3]
-            if part.vertex_normals is not None:
-                normals = part.vertex_normals @ normal_matrix.T
-                twin.vertex_normals = normals / np.linalg.norm(normals, axis=1, keepdims=True)
-            self.parts[index] = twin
+        self.parts = [transformed_part(part, matrix) for part in self.parts]
 
     def persist_transformation_into_mesh(self, location: bool = True, rotation: bool = True,
                                          scale: bool = True) -> None:
@@ -213,7 +205,6 @@ class MeshObject(Entity, MeshGeometry, RigidBodyMixin):
     get_mesh: Callable[..., Any] = unsupported_method("MeshObject", "get_mesh", "there is no Blender mesh")
     mesh_as_bmesh: Callable[..., Any] = unsupported_method("MeshObject", "mesh_as_bmesh", "there is no bmesh")
     update_from_bmesh: Callable[..., Any] = unsupported_method("MeshObject", "update_from_bmesh")
-    join_with_other_objects: Callable[..., Any] = unsupported_method("MeshObject", "join_with_other_objects")
     edit_mode: Callable[..., Any] = unsupported_method("MeshObject", "edit_mode")
     object_mode: Callable[..., Any] = unsupported_method("MeshObject", "object_mode")
     scale_uv_coordinates: Callable[..., Any] = unsupported_method("MeshObject", "scale_uv_coordinates")
@@ -222,36 +213,6 @@ class MeshObject(Entity, MeshGeometry, RigidBodyMixin):
     add_geometry_nodes: Callable[..., Any] = unsupported_method("MeshObject", "add_geometry_nodes")
     add_auto_smooth_modifier: Callable[..., Any] = unsupported_method("MeshObject", "add_auto_smooth_modifier")
     clear_custom_splitnormals: Callable[..., Any] = unsupported_method("MeshObject", "clear_custom_splitnormals")
-
-    def add_uv_mapping(self, projection: str, overwrite: bool = False) -> None:
-        """Texture coordinates by Blender's ``cube``, ``cylinder`` or ``sphere`` projection of all faces
-        (:mod:`hybridgen.scene.uv_projection`; the pose's rotation and scale now orient the cylinder and sphere),
-        unless the object has coordinates already and not ``overwrite``. ``smart`` raises one line."""
-        from ...scene.uv_projection import PROJECTIONS, corner_vertices, project_uvs
-
-        if projection == "smart":
-            unsupported_method("MeshObject", "add_uv_mapping('smart')", "cube, cylinder and sphere are")()
-        if projection not in PROJECTIONS:
-            raise InputError(f"Unknown projection: '{projection}'. Please use 'cube', 'cylinder', 'smart' or "
-                             "'sphere'.")
-        if self.has_uv_mapping() and not overwrite or not self.parts:
-            return
-        vertices, faces = self.local_mesh()
-        corner_uvs = project_uvs(projection, vertices, faces, self.get_local2world_mat())
-        start = 0
-        for index, part in enumerate(self.parts):
-            count = len(part.faces)
-            source, uvs, new_faces = corner_vertices(part.faces, corner_uvs[start:start + count])
-            start += count
-            twin = copy.copy(part)
-            for derived in ("face_normals", "is_closed"):
-                twin.__dict__.pop(derived, None)
-            twin.vertices, twin.faces, twin.uvs = part.vertices[source], new_faces, uvs
-            if part.vertex_normals is not None:
-                twin.vertex_normals = part.vertex_normals[source]
-            if part.vertex_colors is not None:
-                twin.vertex_colors = part.vertex_colors[source]
-            self.parts[index] = twin
 
     def has_uv_mapping(self) -> bool:
         """Whether every part has texture coordinates."""
