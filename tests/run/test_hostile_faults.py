@@ -25,25 +25,13 @@ from hybridgen.io.atomic import name_max
 from hybridgen.io.integrity import verify
 from hybridgen.io.output_lock import LOCK_NAME, output_lock
 from hybridgen.run.staged_output import staging_folder_name
+from tests.run.test_hostile_paths import CONFIG as PATHS_CONFIG
 
 REPO = Path(__file__).resolve().parents[2]
 
-CONFIG = """
-global: {all: {output_dir: "<args:0>"}}
-modules:
-  - name: main.Initializer
-    config: {seed: 3, number_of_scenes: SCENES}
-  - name: loader.PrimitiveLoader
-    config: {shape: cube, size: 0.6, name: box, category_id: 2}
-  - name: camera.CameraLoader
-    config:
-      intrinsics: {resolution_x: WIDTH, resolution_y: HEIGHT}
-      cam_poses: [{location: [3, -3, 2], rotation: {format: look_at, value: [0, 0, 0]}}]
-  - name: renderer.SegMapRenderer
-    config: {render_normals: NORMALS}
-  - name: writer.Hdf5Writer
-    config: WRITER
-"""
+CONFIG = (PATHS_CONFIG.replace("resolution_x: 8, resolution_y: 6", "resolution_x: WIDTH, resolution_y: HEIGHT")
+          .replace("render_normals: false", "render_normals: NORMALS") + "    config: WRITER\n")
+"""tests/run/test_hostile_paths.py's scene with its size, normals and writer options left open."""
 
 CUBE_OBJ = b"""mtllib MTL
 o cube
