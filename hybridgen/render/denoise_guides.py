@@ -59,7 +59,8 @@ class DenoiseGuides:
 
     def _box(self, image: np.ndarray) -> np.ndarray:
         f = self.factor
-        image = np.nan_to_num(image, nan=0.0, posinf=0.0, neginf=0.0)
+        if not np.isfinite(image).all():  # a copy only where a value needs replacing
+            image = np.nan_to_num(image, nan=0.0, posinf=0.0, neginf=0.0)
         if self.filter_width > 0:
             return filter_supersampled(image, f, self.filter_width)
         blocks = image.reshape(image.shape[0] // f, f, image.shape[1] // f, f, -1)

@@ -49,6 +49,23 @@ def test_supersampled_filter_conserves_energy_and_reduces_to_the_box():
     assert weights.sum() == pytest.approx(1.0) and np.allclose(weights, weights[::-1])
 
 
+def test_supersampled_filter_is_the_weighted_sum_around_each_pixel():
+    # more output rows than one block of the summation (pixel_filter.ROW_BLOCK): every block and its edges
+    rng = np.random.default_rng(5)
+    f, rows, cols = 3, pixel_filter.ROW_BLOCK * 2 + 5, 7
+    fine = rng.random((rows * f, cols * f, 2)).astype(np.float32)
+    reach = int(np.ceil(1.5 * f))
+    taps = np.arange(-reach, reach + f)
+    w = pixel_filter.pixel_weights(1.5, (taps + 0.5) / f - 0.5)
+    padded = np.pad(fine, ((reach, reach), (reach, reach), (0, 0)), mode="edge").astype(np.float64)
+    expected = np.empty((rows, cols, 2))
+    for r in range(rows):
+        for c in range(cols):
+            window = padded[r * f:r * f + len(taps), c * f:c * f + len(taps)]
+            expected[r, c] = np.einsum("i,j,ijk->k", w, w, window)
+    np.testing.assert_allclose(pixel_filter.filter_supersampled(fine, f, 1.5), expected, rtol=1e-6, atol=1e-7)
+
+
 @pytest.mark.parametrize("filter_width", [1.5, 0.0])
 def test_rendered_edge_follows_the_filters_cumulative_profile(filter_width):
     """Looking straight down at an emitting half-plane x < 0 (radiance 1, black elsewhere) whose edge runs
