@@ -103,8 +103,8 @@ def disable_all_rigid_bodies() -> None:
 
 def compute_poi(objects: Sequence[MeshObject]) -> np.ndarray:
     """BlenderProc's point of interest (world, m): of the objects' world bound box centres, the one closest to
-    their mean."""
-    if not objects:
+    their mean. ``objects`` may be any sequence (a list, a numpy array of objects)."""
+    if len(objects) == 0:
         raise InputError("compute_poi needs at least one object")
     centres = np.array([obj.get_bound_box().mean(axis=0) for obj in objects])
     return centres[np.argmin(np.linalg.norm(centres - centres.mean(axis=0), axis=1))]

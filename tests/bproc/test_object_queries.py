@@ -77,3 +77,14 @@ def test_light_surface_makes_materials_emissive(bproc) -> None:  # noqa: F811
     assert other.get_materials()[0] is shared and shared.blender_obj.emission_strength == 0
     assert copy.blender_obj.emission_strength == 5.0 and copy.blender_obj.emission == (1.0, 0.5, 0.25)
     assert bare.get_materials()[0].get_name() == "TextureLess_emission"
+
+
+def test_compute_poi_takes_a_list_or_an_object_array(bproc) -> None:  # noqa: F811
+    cubes = [bproc.object.create_primitive("CUBE", location=[x, 0.0, 0.5]) for x in (0.0, 1.0, 5.0)]
+    # box centres at x = 0, 1, 5; their mean x = 2: the closest centre is the cube at x = 1
+    np.testing.assert_allclose(bproc.object.compute_poi(cubes), [1.0, 0.0, 0.5])
+    picked = np.random.default_rng(0).choice(cubes, size=10)  # what BOP examples pass
+    np.testing.assert_allclose(bproc.object.compute_poi(np.array(cubes, dtype=object)), [1.0, 0.0, 0.5])
+    assert bproc.object.compute_poi(picked).shape == (3,)
+    with pytest.raises(Exception, match="at least one object"):
+        bproc.object.compute_poi(np.array([], dtype=object))
