@@ -11,8 +11,9 @@ PYTHONPATH, ``USE_EXTERNAL_BPY_MODULE=1``) and needs nothing of hybridgen; ``hyb
 
 - ``--samples N``, ``--noise-threshold X`` (0: no adaptive sampling), ``--no-denoiser``: a converged reference;
 - ``--view-transform NAME`` (BlenderProc only; hybridgen always renders Blender's ``Standard`` view);
-- ``--segmentation``: instance segmentation mapped by ``instance`` and ``name`` (``instance_segmaps`` and
-  ``instance_attribute_maps`` in the data dict) when the script enabled none, for per-object comparisons;
+- ``--add-labels``: the outputs the script did not enable among depth (``activate_antialiasing=False``, unless
+  it asked for distance), normals and instance segmentation mapped by ``instance`` and ``name``
+  (``instance_segmaps`` and ``instance_attribute_maps``), for pixel and per-object comparisons;
 - ``--frames N``: only the first N frames are rendered (``set_keyframe_render_interval``).
 
 ``--scene-dump PATH`` writes, at each render, what the camera and objects are: a JSON list with one object per
@@ -40,6 +41,7 @@ from harness import accumulating  # stdlib only: importable in the BlenderProc v
 
 STARTED = time.perf_counter()
 SEGMENTATION_MAP_BY = ["instance", "name"]
+LABEL_KINDS = ("depth", "distance", "normals", "segmentation")
 
 
 def _parse(argv: list[str]) -> argparse.Namespace:
@@ -49,7 +51,7 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     parser.add_argument("--noise-threshold", type=float)
     parser.add_argument("--no-denoiser", action="store_true")
     parser.add_argument("--view-transform")
-    parser.add_argument("--segmentation", action="store_true")
+    parser.add_argument("--add-labels", action="store_true")
     parser.add_argument("--frames", type=int)
     parser.add_argument("--profile")
     parser.add_argument("--scene-dump")
@@ -63,14 +65,15 @@ class BlenderProcEngine:
     """The real BlenderProc (``blenderproc.api.*`` as the script sees it)."""
 
     def __init__(self) -> None:
-        import blenderproc  # noqa: F401 - imported before the script, which then gets this module
+        import blenderproc  # before the script, whose own import then gets this module
 
-        self.bproc = sys.modules["blenderproc"]
+        self.bproc = blenderproc
 
-    def segmentation_enabled(self) -> bool:
+    def enabled_outputs(self) -> set[str]:
         from blenderproc.python.utility.Utility import Utility
 
-        return any("segmap" in output["key"] for output in Utility.get_registered_outputs())
+        keys = {output["key"] for output in Utility.get_registered_outputs()}
+        return {kind for kind in LABEL_KINDS if kind in keys} | ({"segmentation"} if "segmap" in keys else set())
 
     def frame_start(self) -> int:
         import bpy
@@ -95,10 +98,10 @@ class HybridgenEngine:
         spent["imports"] = time.perf_counter() - STARTED
         self.bproc = hybridgen.bproc
 
-    def segmentation_enabled(self) -> bool:
+    def enabled_outputs(self) -> set[str]:
         from hybridgen.bproc.session import SESSION
 
-        return "segmentation" in SESSION.renderer.outputs
+        return set(SESSION.renderer.outputs)
 
     def frame_start(self) -> int:
         from hybridgen.bproc.session import SESSION
@@ -158,6 +161,16 @@ def scene_state(bproc: Any, first: int) -> dict[str, Any]:
                         for obj in bproc.object.get_all_mesh_objects()}}
 
 
+def add_labels(renderer: Any, enabled: set[str]) -> None:
+    """Enables depth, normals and instance segmentation where ``enabled`` (output kinds) lacks them."""
+    if not enabled & {"depth", "distance"}:
+        renderer.enable_depth_output(activate_antialiasing=False)
+    if "normals" not in enabled:
+        renderer.enable_normals_output()
+    if "segmentation" not in enabled:
+        renderer.enable_segmentation_output(map_by=list(SEGMENTATION_MAP_BY))
+
+
 def apply_overrides(engine: Any, ns: argparse.Namespace, spent: dict[str, float]) -> None:
     """Wraps ``bproc.renderer.render`` so that the overrides are set just before each render (and the scene
     dumped)."""
@@ -174,8 +187,8 @@ def apply_overrides(engine: Any, ns: argparse.Namespace, spent: dict[str, float]
             renderer.set_denoiser(None)
         if ns.view_transform is not None and ns.engine == "blenderproc":
             renderer.set_output_format(view_transform=ns.view_transform)
-        if ns.segmentation and not engine.segmentation_enabled():
-            renderer.enable_segmentation_output(map_by=list(SEGMENTATION_MAP_BY))
+        if ns.add_labels:
+            add_labels(renderer, engine.enabled_outputs())
         if ns.frames is not None:
             start = engine.frame_start()
             engine.bproc.utility.set_keyframe_render_interval(start, start + ns.frames)

@@ -1,9 +1,10 @@
 """What a BlenderProc 2 script wrote into its output folder, read the same way for both engines
 (tools/compare_with_blenderproc.py): the file layout and the frames of its ``<i>.hdf5`` files.
 
-Layout: one entry per file, by its path relative to the folder - for HDF5 files ``{key: "dtype shape"}``, for
-images ``"dtype shape"`` of the decoded pixels, for JSON files the sorted top-level keys (or ``list[n]``),
-otherwise ``"file"``.
+Layout: one entry per file, by its path relative to the folder - for HDF5 files ``{key: "dtype shape"}`` (a byte
+string dataset as ``json <its top-level keys>`` or ``bytes``: its length is formatting, not layout), for images
+``"dtype shape"`` of the decoded pixels, for JSON files the sorted top-level keys (or ``list[n]``), otherwise
+``"file"``.
 """
 from __future__ import annotations
 
@@ -20,6 +21,23 @@ def _describe(array: np.ndarray) -> str:
     return f"{array.dtype} {tuple(array.shape)}"
 
 
+def _json_shape(data: Any) -> str:
+    if isinstance(data, dict):
+        return "json {" + ", ".join(sorted(data)) + "}"
+    if isinstance(data, list):
+        return f"json list of {_json_shape(data[0]) if data else 'nothing'}"
+    return f"json {type(data).__name__}"
+
+
+def _describe_dataset(value: Any) -> str:
+    if isinstance(value, bytes):
+        try:
+            return _json_shape(json.loads(value))
+        except ValueError:
+            return "bytes"
+    return _describe(np.asarray(value))
+
+
 def describe_file(path: Path) -> Any:
     """The layout entry of one file (see the module documentation)."""
     suffix = path.suffix.lower()
@@ -27,7 +45,7 @@ def describe_file(path: Path) -> Any:
         import h5py
 
         with h5py.File(path, "r") as h5:
-            return {key: f"{h5[key].dtype} {tuple(h5[key].shape)}" for key in sorted(h5.keys())}
+            return {key: _describe_dataset(h5[key][()]) for key in sorted(h5.keys())}
     if suffix in IMAGE_SUFFIXES:
         from PIL import Image
 
@@ -64,7 +82,7 @@ def layout_differences(ours: dict[str, Any], theirs: dict[str, Any]) -> list[str
 
 def hdf5_frames(folder: Path) -> dict[str, dict[str, Any]]:
     """Each ``<i>.hdf5`` under ``folder`` (by relative path) as ``{key: array}``; JSON text datasets
-    (``instance_attribute_maps``) decoded."""
+    (``instance_attribute_maps``, ``cam_states``, ...) decoded."""
     import h5py
 
     frames = {}
@@ -73,8 +91,11 @@ def hdf5_frames(folder: Path) -> dict[str, dict[str, Any]]:
         with h5py.File(path, "r") as h5:
             for key in h5.keys():
                 value = h5[key][()]
-                if isinstance(value, bytes) and key.endswith("attribute_maps"):
-                    value = json.loads(value)
+                if isinstance(value, bytes):
+                    try:
+                        value = json.loads(value)
+                    except ValueError:
+                        pass
                 values[key] = value
         frames[path.relative_to(folder).as_posix()] = values
     return frames
@@ -85,3 +106,21 @@ def names_by_instance(attribute_map: Any) -> dict[int, str]:
     if not isinstance(attribute_map, list):
         return {}
     return {int(record["idx"]): str(record.get("name", "")) for record in attribute_map if "idx" in record}
+
+
+def json_difference(ours: Any, theirs: Any) -> float:
+    """The largest absolute difference between the numbers of two decoded JSON values of the same structure (lists
+    of objects with a ``name`` matched by name); inf where the structure, a key or a text differs."""
+    if isinstance(ours, dict) and isinstance(theirs, dict):
+        if set(ours) != set(theirs):
+            return float("inf")
+        return max((json_difference(ours[key], theirs[key]) for key in ours), default=0.0)
+    if isinstance(ours, list) and isinstance(theirs, list):
+        if len(ours) != len(theirs):
+            return float("inf")
+        if all(isinstance(item, dict) and "name" in item for item in ours + theirs):
+            ours, theirs = (sorted(side, key=lambda item: str(item["name"])) for side in (ours, theirs))
+        return max((json_difference(a, b) for a, b in zip(ours, theirs)), default=0.0)
+    if isinstance(ours, (int, float)) and isinstance(theirs, (int, float)) and not isinstance(ours, bool):
+        return abs(float(ours) - float(theirs))
+    return 0.0 if ours == theirs else float("inf")

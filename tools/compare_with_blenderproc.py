@@ -6,9 +6,10 @@ compared: file layout, camera and object poses, depth and normals pixel by pixel
 ARGS default to the example README's ``blenderproc run`` line; an argument containing ``output`` is each engine's
 own output folder. Both engines run the unchanged script from the same extracted examples (tools/
 blenderproc_reference.py; make its venv first with ``tools/blenderproc_reference.py setup``) through
-tools/bproc_launch.py, with ``BLENDER_PROC_RANDOM_SEED=1`` and, on both, two additions: instance segmentation by
-``instance`` and ``name`` when the script enables none (the ids and the per-object regions), and BlenderProc's view
-transform set to ``Standard`` (hybridgen's colors are the Standard sRGB view; BlenderProc 2.8 defaults to Filmic).
+tools/bproc_launch.py, with ``BLENDER_PROC_RANDOM_SEED=1`` and, on both, two additions: the label outputs the script
+does not enable itself among depth, normals and instance segmentation by ``instance`` and ``name`` (the pixels, ids
+and per-object regions compared; the layout row then lists these keys too), and BlenderProc's view transform set to
+``Standard`` (hybridgen's colors are the Standard sRGB view; BlenderProc 2.8 defaults to Filmic).
 
 Rows (units: m, degrees, pixels):
 
@@ -18,6 +19,7 @@ Rows (units: m, degrees, pixels):
   (tools/bproc_metrics.py): median and 99th-percentile absolute difference, the fraction within 1 cm / 1 degree;
   normals once more without crease pixels (facet edges of flat-shaded meshes, where Cycles' antialiased pass
   blends two facets' normals and hybridgen samples the pixel centre);
+- ``*_states`` (cam_states, light_states, object_states: JSON text): the largest difference of their numbers;
 - ``<x>_segmaps``: the best one-to-one id mapping (hybridgen -> BlenderProc) and the pixels it makes agree, with
   edge pixels excluded; for instance ids, whether the mapping pairs objects of the same name;
 - color per object: mean linear RGB of hybridgen and Cycles over the same (edge-free) pixels of each object, and
@@ -42,7 +44,8 @@ sys.path.insert(0, str(TOOLS))
 import bproc_metrics as metrics  # noqa: E402
 from blenderproc_reference import (ReferenceUnavailable, example_args, examples_tree, execute,  # noqa: E402
                                    hybridgen_invocation, reference_invocation, script_path)
-from bproc_outputs import hdf5_frames, layout, layout_differences, names_by_instance  # noqa: E402
+from bproc_outputs import (hdf5_frames, json_difference, layout, layout_differences,  # noqa: E402
+                           names_by_instance)
 from harness import Table  # noqa: E402
 
 ENGINES = ("hybridgen", "blenderproc")
@@ -54,17 +57,25 @@ SEED_ENV = {"BLENDER_PROC_RANDOM_SEED": "1"}
 
 
 # --------------------------------------------------------------------------------------------- running
-def run_both(script: str, args: list[str] | None, folder: Path, timeout: float,
-             tree: Path | None = None) -> dict[str, dict[str, Any]]:
-    """Each engine's run of ``script``: ``{engine: {"output", "dump", "status", "seconds", "log"}}``."""
+def kept_run(folder: Path, engine: str) -> dict[str, Any]:
+    """A run whose output, scene dump and log are in ``folder`` (``--compare-only``, ``--reuse-blenderproc``)."""
+    return {"output": folder / f"{engine}-output", "dump": folder / f"{engine}-scene.json", "status": 0,
+            "log": folder / f"{engine}.log", "seconds": float("nan")}
+
+
+def run_both(script: str, args: list[str] | None, folder: Path, timeout: float, tree: Path | None = None,
+             engines: tuple[str, ...] = ENGINES) -> dict[str, dict[str, Any]]:
+    """Each engine's run of ``script`` (``engines``; the others' runs are read from ``folder``):
+    ``{engine: {"output", "dump", "status", "seconds", "log"}}``."""
     root = examples_tree()
-    runs = {}
-    for engine in ENGINES:
+    runs = {engine: kept_run(folder, engine) for engine in ENGINES}
+    for engine in engines:
         output, dump, log = folder / f"{engine}-output", folder / f"{engine}-scene.json", folder / f"{engine}.log"
-        output.mkdir(parents=True, exist_ok=True)
+        shutil.rmtree(output, ignore_errors=True)
+        output.mkdir(parents=True)
         engine_args = (example_args(script, root, output, folder / "inputs") if args is None
                        else [str(output) if "output" in arg else arg for arg in args])
-        launch = ["--segmentation", "--view-transform", "Standard", "--scene-dump", str(dump)]
+        launch = ["--add-labels", "--view-transform", "Standard", "--scene-dump", str(dump)]
         if engine == "hybridgen":
             invocation = hybridgen_invocation(script, engine_args, launch, root, SEED_ENV, tree)
         else:
@@ -125,15 +136,19 @@ def _id_row(key: str, match: metrics.IdMatch, names: tuple[dict[int, str], dict[
     return key, "agree" if match.agreement > 0.999 else "differ", detail
 
 
+COLOR_KEYS = ("colors", "diffuse")
+"""uint8 sRGB images compared per object: the color and, where the script asks for it, the diffuse color."""
+
+
 def color_per_object(pairs: list[tuple[dict[str, Any], dict[str, Any], np.ndarray]], mapping: dict[int, int],
-                     names: dict[int, str]) -> list[tuple[str, int, np.ndarray, np.ndarray, float]]:
+                     names: dict[int, str], key: str = "colors") -> list[tuple[str, int, Any, Any, float]]:
     """Per instance (hybridgen's id, paired by ``mapping``): (name, pixels, hybridgen's and Cycles' mean linear RGB
-    over the pixels both put on it within the frames' masks, luminance ratio)."""
+    of ``key`` over the pixels both put on it within the frames' masks, luminance ratio)."""
     sums: dict[int, np.ndarray] = {}
     for a, b, mask in pairs:
-        if "colors" not in a or "colors" not in b:
+        if key not in a or key not in b:
             continue
-        linear_a, linear_b = metrics.srgb_to_linear(a["colors"]), metrics.srgb_to_linear(b["colors"])
+        linear_a, linear_b = metrics.srgb_to_linear(a[key]), metrics.srgb_to_linear(b[key])
         for i, j in mapping.items():
             region = mask & (a["instance_segmaps"] == i) & (b["instance_segmaps"] == j)
             if i and region.any():
@@ -147,8 +162,9 @@ def color_per_object(pairs: list[tuple[dict[str, Any], dict[str, Any], np.ndarra
     return rows
 
 
-def compare_frames(ours: dict[str, dict[str, Any]], theirs: dict[str, dict[str, Any]]) -> tuple[list, list]:
-    """Rows for depth, normals, segmaps and the per-object color table of the HDF5 files both wrote."""
+def compare_frames(ours: dict[str, dict[str, Any]], theirs: dict[str, dict[str, Any]]) -> tuple[list, dict]:
+    """Rows for depth, normals, segmaps and states, and the per-object tables of COLOR_KEYS, of the HDF5 files both
+    wrote."""
     pairs = []  # (ours, theirs, comparable mask) of every file both wrote with depth
     for name in sorted(set(ours) & set(theirs)):
         a, b = ours[name], theirs[name]
@@ -178,17 +194,20 @@ def compare_frames(ours: dict[str, dict[str, Any]], theirs: dict[str, dict[str, 
         both = [(a[key][m], b[key][m]) for a, b, m in pairs if key in a and key in b]
         matches[key] = metrics.match_ids(np.concatenate([p for p, _ in both]), np.concatenate([q for _, q in both]))
         rows.append(_id_row(key, matches[key], names))
-    colors = (color_per_object(pairs, matches["instance_segmaps"].mapping, names[0])
-              if "instance_segmaps" in matches else [])
-    return rows, colors
+    for key in sorted({k for a, b, _ in pairs for k in a if k.endswith("_states") and k in b}):
+        worst = max(json_difference(a[key], b[key]) for a, b, _ in pairs if key in a and key in b)
+        rows.append((key, "equal" if worst < 1e-4 else "differ", f"max |difference| {worst:.2g} over its numbers"))
+    colors = {key: color_per_object(pairs, matches["instance_segmaps"].mapping, names[0], key)
+              for key in COLOR_KEYS if "instance_segmaps" in matches}
+    return rows, {key: table for key, table in colors.items() if table}
 
 
-def compare(runs: dict[str, dict[str, Any]]) -> tuple[list, list]:
+def compare(runs: dict[str, dict[str, Any]]) -> tuple[list, dict]:
     """All rows of one example (see the module documentation)."""
     ours, theirs = runs["hybridgen"], runs["blenderproc"]
     failed = [(engine, run) for engine, run in runs.items() if run["status"] != 0]
     if failed:
-        return [(f"{engine} run", f"fails ({run['status']})", last_line(run["log"])) for engine, run in failed], []
+        return [(f"{engine} run", f"fails ({run['status']})", last_line(run["log"])) for engine, run in failed], {}
     differences = layout_differences(layout(ours["output"]), layout(theirs["output"]))
     versions = [line for line in differences if line.split(":")[0].endswith(VERSION_KEYS)]
     others = [line for line in differences if line not in versions]
@@ -197,19 +216,20 @@ def compare(runs: dict[str, dict[str, Any]]) -> tuple[list, list]:
     rows = [("layout", ("equal" if not others else f"{len(others)} differ") + ("*" if versions else ""),
              "; ".join(others[:6]) + (" ..." if len(others) > 6 else "") + (note if versions else ""))]
     rows += compare_scenes(json.loads(ours["dump"].read_text()), json.loads(theirs["dump"].read_text()))
-    frame_rows, color_rows = compare_frames(hdf5_frames(ours["output"]), hdf5_frames(theirs["output"]))
-    return rows + frame_rows, color_rows
+    frame_rows, color_tables = compare_frames(hdf5_frames(ours["output"]), hdf5_frames(theirs["output"]))
+    return rows + frame_rows, color_tables
 
 
-def print_report(example: str, runs: dict[str, dict[str, Any]], rows: list, color_rows: list, markdown: bool) -> None:
+def print_report(example: str, runs: dict[str, dict[str, Any]], rows: list, color_tables: dict,
+                 markdown: bool) -> None:
     seconds = ", ".join(f"{engine} {run['seconds']:.1f} s" for engine, run in runs.items())
     print(f"\n{example} ({seconds})")
     table = Table([("what", "<18"), ("result", "<10"), ("detail", "<")], markdown=markdown)
     table.header()
     for row in rows:
         table.row(*row)
-    if color_rows:
-        print(f"\n{example}: color per object (mean linear RGB over the same edge-free pixels)")
+    for key, color_rows in color_tables.items():
+        print(f"\n{example}: {key} per object (mean linear RGB over the same edge-free pixels)")
         colors = Table([("object", "<22"), ("pixels", ">8d"), ("hybridgen RGB", "<22"), ("Cycles RGB", "<22"),
                         ("ratio Y", ">8.3f")], markdown=markdown)
         colors.header()
@@ -225,27 +245,28 @@ def main() -> None:
                                                 "starts with -)")
     parser.add_argument("--keep", type=Path, help="keep both engines' outputs and logs in this folder")
     parser.add_argument("--compare-only", action="store_true", help="compare the outputs already in --keep DIR")
+    parser.add_argument("--reuse-blenderproc", action="store_true",
+                        help="run hybridgen only, against BlenderProc's outputs already in --keep DIR (BlenderProc's "
+                             "runs repeat exactly: fixed seeds)")
     parser.add_argument("--timeout", type=float, default=1800.0, help="seconds per engine run (default 1800)")
     parser.add_argument("--markdown", action="store_true", help="Markdown tables")
     parser.add_argument("--hybridgen-tree", type=Path, help="run hybridgen from this source tree (e.g. a clone at "
                                                             "a commit; default: the installed checkout)")
     ns = parser.parse_args()
+    if (ns.compare_only or ns.reuse_blenderproc) and ns.keep is None:
+        parser.error("--compare-only and --reuse-blenderproc read the outputs in --keep DIR")
     script = script_path(ns.example)
     folder = ns.keep or Path(tempfile.mkdtemp(prefix="compare-bproc-"))
     try:
-        if ns.compare_only and ns.keep:
-            runs = {engine: {"output": folder / f"{engine}-output", "dump": folder / f"{engine}-scene.json",
-                             "status": 0, "log": folder / f"{engine}.log", "seconds": float("nan")}
-                    for engine in ENGINES}
-        else:
-            runs = run_both(script, ns.args or None, folder.resolve(), ns.timeout, ns.hybridgen_tree)
-        rows, color_rows = compare(runs)
+        engines = () if ns.compare_only else ("hybridgen",) if ns.reuse_blenderproc else ENGINES
+        runs = run_both(script, ns.args or None, folder.resolve(), ns.timeout, ns.hybridgen_tree, engines)
+        rows, color_tables = compare(runs)
     except ReferenceUnavailable as exc:
         raise SystemExit(str(exc)) from None
     finally:
         if ns.keep is None:
             shutil.rmtree(folder, ignore_errors=True)
-    print_report(script.removeprefix("examples/").removesuffix("/main.py"), runs, rows, color_rows, ns.markdown)
+    print_report(script.removeprefix("examples/").removesuffix("/main.py"), runs, rows, color_tables, ns.markdown)
 
 
 if __name__ == "__main__":

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from bproc_metrics import (agreement, comparable, crease_edges, depth_differences, match_ids, mean_color_per_id,
                            normal_differences, pose_difference, silhouette_edges)
-from bproc_outputs import layout_differences, names_by_instance
+from bproc_outputs import json_difference, layout_differences, names_by_instance
 
 
 def test_match_ids_finds_the_permutation_and_counts_disagreement() -> None:
@@ -107,3 +107,12 @@ def test_pose_difference_resolves_tiny_rotations() -> None:
     angle = np.radians(1e-6)
     b[:2, :2] = [[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]]
     assert pose_difference(a, b)[1] == pytest.approx(1e-6, rel=1e-3)
+
+
+def test_json_difference_matches_named_records_and_flags_structure() -> None:
+    ours = [{"name": "b", "pose": [1.0, 2.0]}, {"name": "a", "pose": [0.0, 0.0]}]
+    theirs = [{"name": "a", "pose": [0.0, 0.5]}, {"name": "b", "pose": [1.0, 2.25]}]
+    assert json_difference(ours, theirs) == 0.5
+    assert json_difference({"x": 1}, {"y": 1}) == float("inf")
+    assert json_difference({"name": "a"}, {"name": "b"}) == float("inf")
+    assert json_difference([1, 2], [1]) == float("inf")
