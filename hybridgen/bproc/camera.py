@@ -213,7 +213,7 @@ def get_camera_frustum_as_object(clip_start: float | None = None, clip_end: floa
 from .camera_validation import (decrease_interest_score, perform_obstacle_in_view_check,  # noqa: E402
                                 scene_coverage_score, visible_objects)
 
-__getattr__ = module_getattr("camera", [
-    "check_novel_pose",
-    "set_camera_parameters_from_config_file", "depth_via_raytracing", "depth_at_points_via_raytracing",
-    "pointcloud_from_depth", "project_points", "unproject_points"])
+from .camera_projection import (depth_at_points_via_raytracing, depth_via_raytracing,  # noqa: E402
+                                pointcloud_from_depth, project_points, unproject_points)
+
+__getattr__ = module_getattr("camera", ["check_novel_pose", "set_camera_parameters_from_config_file"])

@@ -22,9 +22,10 @@ from .types.mesh_object import get_all_mesh_objects
 from .types.unsupported import fail, module_getattr
 
 __all__ = ["compute_poi", "convert_to_entities", "convert_to_meshes", "create_bvh_tree_multi_objects", "create_empty",
-           "create_primitive", "delete_multiple", "disable_all_rigid_bodies", "extract_floor", "get_all_mesh_objects",
-           "merge_objects", "sample_poses", "sample_poses_on_surface", "scene_ray_cast", "simulate_physics",
-           "simulate_physics_and_fix_final_poses", "slice_faces_with_normals"]
+           "create_from_point_cloud", "create_primitive", "create_with_empty_mesh", "delete_multiple",
+           "disable_all_rigid_bodies", "extract_floor", "get_all_mesh_objects", "merge_objects", "sample_poses",
+           "sample_poses_on_surface", "scene_ray_cast", "simulate_physics", "simulate_physics_and_fix_final_poses",
+           "slice_faces_with_normals"]
 
 SHAPES = {"CUBE": ("cube", "Cube"), "PLANE": ("plane", "Plane"), "SPHERE": ("sphere", "Sphere"),
           "CYLINDER": ("cylinder", "Cylinder"), "CONE": ("cone", "Cone")}
@@ -110,6 +111,37 @@ def compute_poi(objects: Sequence[MeshObject]) -> np.ndarray:
     return centres[np.argmin(np.linalg.norm(centres - centres.mean(axis=0), axis=1))]
 
 
-__getattr__ = module_getattr("object", [
-    "replace_objects", "create_from_blender_mesh",
-    "create_with_empty_mesh", "create_from_point_cloud"])
+POINT_SPHERE_RADIUS = 0.015
+"""Radius (m) of the icosphere BlenderProc's point-cloud visualization puts on every point."""
+
+
+def create_with_empty_mesh(object_name: str, mesh_name: str | None = None) -> MeshObject:
+    """A new mesh object without geometry (it renders nothing; its bound box is the origin)."""
+    obj = MeshObject(object_name, [make_primitive("cube", 1.0)])
+    obj.parts, obj.part_slots = [], []
+    return obj
+
+
+def create_from_point_cloud(points: Any, object_name: str, add_geometry_nodes_visualization: bool = False) \
+        -> MeshObject:
+    """A mesh object whose vertices are the (N, 3) world ``points`` (rows with a NaN left out; they render
+    nothing). With ``add_geometry_nodes_visualization`` every point carries an icosahedron of radius 1.5 cm
+    (Blender's default icosphere node) with a new red material ``point_cloud_mat``, as BlenderProc's geometry
+    nodes draw them (:mod:`hybridgen.scene.point_instances`)."""
+    from ..scene.mesh_object import MeshObject as ScenePart
+    from ..scene.point_instances import instanced
+    from ..scene.primitive_meshes import icosphere
+
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    points = points[~np.isnan(points).any(axis=1)]
+    obj = create_with_empty_mesh(object_name)
+    obj.loose_vertices = points
+    if add_geometry_nodes_visualization and len(points):
+        vertices, faces = instanced(points, *icosphere(0, POINT_SPHERE_RADIUS))
+        obj.parts, obj.part_slots = [ScenePart(obj.get_name(), vertices, faces)], [0]
+        material = obj.new_material("point_cloud_mat")
+        material.set_principled_shader_value("Base Color", [1, 0, 0, 1])
+    return obj
+
+
+__getattr__ = module_getattr("object", ["replace_objects", "create_from_blender_mesh"])

@@ -49,6 +49,8 @@ class MeshObject(Entity, MeshGeometry, MeshEditing, RigidBodyMixin):
         self.parts: list[ScenePart] = list(parts)
         self.part_slots: list[int] = list(range(len(self.parts)))
         """The material index of each part."""
+        self.loose_vertices = np.zeros((0, 3))
+        """Vertices of no face (a point cloud's points), local frame, m: they count for the bound box only."""
         self._slots: list[Material | None] = list(slots)
 
     # --- materials ----------------------------------------------------------------------------------------
@@ -91,8 +93,9 @@ class MeshObject(Entity, MeshGeometry, MeshEditing, RigidBodyMixin):
     def local_vertices(self) -> np.ndarray:
         """(V, 3) every part's vertices in the local frame, metres."""
         if not self.parts:
-            return np.zeros((0, 3))
-        return np.concatenate([part.vertices for part in self.parts])
+            return np.array(self.loose_vertices, dtype=np.float64).reshape(-1, 3)
+        return np.concatenate([part.vertices for part in self.parts] + ([self.loose_vertices]
+                                                                        if len(self.loose_vertices) else []))
 
     def get_bound_box(self, local_coords: bool = False) -> np.ndarray:
         """(8, 3) corners of the local axis-aligned box in Blender's order; world coordinates unless
