@@ -191,6 +191,8 @@ def toggle_stereo(enable: bool) -> None:
 
 from .label_renders import render_nocs, render_optical_flow  # noqa: E402
 
-__getattr__ = module_getattr("renderer", ["enable_motion_blur", "render_segmap"])
+from .segmap_render import render_segmap  # noqa: E402
+
+__getattr__ = module_getattr("renderer", ["enable_motion_blur"])
 
 from .world import set_world_background  # noqa: E402 - BlenderProc exports it from bproc.renderer
