@@ -15,6 +15,7 @@ from ..errors import InputError
 from ..scene.primitives import make_primitive
 from .bvh_tree import create_bvh_tree_multi_objects, scene_ray_cast
 from .face_slicer import extract_floor, slice_faces_with_normals
+from .object_replacer import replace_objects
 from .physics import simulate_physics, simulate_physics_and_fix_final_poses
 from .placement import sample_poses, sample_poses_on_surface
 from .types import Entity, MeshObject
@@ -23,7 +24,7 @@ from .types.unsupported import fail, module_getattr
 
 __all__ = ["compute_poi", "convert_to_entities", "convert_to_meshes", "create_bvh_tree_multi_objects", "create_empty",
            "create_from_point_cloud", "create_primitive", "create_with_empty_mesh", "delete_multiple",
-           "disable_all_rigid_bodies", "extract_floor", "get_all_mesh_objects", "merge_objects", "sample_poses",
+           "disable_all_rigid_bodies", "extract_floor", "get_all_mesh_objects", "merge_objects", "replace_objects", "sample_poses",
            "sample_poses_on_surface", "scene_ray_cast", "simulate_physics", "simulate_physics_and_fix_final_poses",
            "slice_faces_with_normals"]
 
@@ -144,4 +145,4 @@ def create_from_point_cloud(points: Any, object_name: str, add_geometry_nodes_vi
     return obj
 
 
-__getattr__ = module_getattr("object", ["replace_objects", "create_from_blender_mesh"])
+__getattr__ = module_getattr("object", ["create_from_blender_mesh"])
