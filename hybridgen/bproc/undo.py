@@ -46,10 +46,11 @@ def _snapshot(value: Any, blocks: set[int], seen: dict[int, Any]) -> Any:
     elif hasattr(value, "__dict__") and not isinstance(value, type):
         try:
             copied = copy.copy(value)
-        except Exception:  # an object that cannot be copied (a native handle): kept as it is
+            seen[id(value)] = copied
+            copied.__dict__ = _snapshot(value.__dict__, blocks, seen)
+        except Exception:  # an object that cannot be copied (a native handle, a read-only dict): kept as it is
+            seen[id(value)] = value
             return value
-        seen[id(value)] = copied
-        copied.__dict__ = _snapshot(value.__dict__, blocks, seen)
     else:
         copied = value
     seen[id(value)] = copied
