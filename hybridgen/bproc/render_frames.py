@@ -158,7 +158,9 @@ def _render_group(frames: list[int], meshes: list[MeshObject], color: bool,
     if color:
         cap = os.environ.get(MAX_SAMPLES_ENV)
         samples = min(settings.samples, int(cap)) if cap else settings.samples
-        trace = hg.PathTraceSettings(samples=samples, noise_threshold=settings.noise_threshold,
+        # one sample per pixel leaves nothing to adapt: Cycles renders it; hybridgen's adaptive sampling needs two
+        threshold = settings.noise_threshold if samples >= 2 else 0.0
+        trace = hg.PathTraceSettings(samples=samples, noise_threshold=threshold,
                                      max_bounces=settings.max_bounces, diffuse_bounces=settings.diffuse_bounces,
                                      glossy_bounces=settings.glossy_bounces,
                                      transmission_bounces=settings.transmission_bounces)

@@ -119,6 +119,7 @@ def test_transparent_film_gives_alpha_where_surfaces_are(bproc) -> None:  # noqa
     assert np.array_equal(rgba[..., 3], np.where(covered, 255, 0))
     assert not rgba[~covered].any() and rgba[covered][:, :3].any()
     # BlenderProc loads the alpha of the keys asked for only; a JPEG film has none
+    bproc.renderer.set_max_amount_of_samples(1)  # one sample with the default noise threshold renders, as in Cycles
     assert bproc.renderer.render(keys_with_alpha_channel=set())["colors"][0].shape == (24, 32, 3)
     bproc.renderer.set_output_format(file_format="JPEG")
     assert bproc.renderer.render()["colors"][0].shape == (24, 32, 3)
