@@ -6,6 +6,10 @@ options); PLY and STL are taken as stored (Z-up) with one default material (``pl
 colors, ``stl_material``); glTF/GLB are turned Z-up in the vertices, as Blender's glTF importer does. Every object
 gets the custom property ``model_path``. An OBJ object with several materials is one mesh object with one material
 slot per material (hybridgen renders one part per slot).
+
+An OBJ's objects are created, named and returned in Blender 4.2's order (:func:`blender_import_order`), not the
+file's: the order of ``bpy.context.selected_objects`` after the import, which BlenderProc returns, and so the
+order of ``get_all_mesh_objects`` and of the instance numbers.
 """
 from __future__ import annotations
 
@@ -73,6 +77,14 @@ def axis_turn(forward_axis: str, up_axis: str) -> np.ndarray:
     return turn
 
 
+def blender_import_order(name: str) -> bytes:
+    """Sort key of Blender 4.2's OBJ importer, which creates an import's objects sorted by their ``o`` names:
+    byte-wise on the UTF-8 name with ASCII letters lowered (C's ``tolower``: ``_`` sorts before ``a``, ``é``
+    after ``z``), no natural number order (``item10`` before ``item2``), a ``.001`` suffix plain text; equal keys
+    (``Cube`` / ``cube``) keep the file's order (measured with bpy 4.2.0; use a stable sort)."""
+    return name.encode("utf-8", "surrogateescape").lower()
+
+
 def load_obj(filepath: str, cached_objects: dict[str, list[MeshObject]] | None = None,
              **kwargs: Any) -> list[MeshObject]:
     """The mesh objects of an OBJ, PLY, STL, glTF or GLB file (see the module documentation)."""
@@ -103,7 +115,10 @@ def load_obj(filepath: str, cached_objects: dict[str, list[MeshObject]] | None =
         fail(f"bproc.loader.load_obj({', '.join(sorted(axes))}=...) of a '{suffix}' file")
     own: dict[str, Material] = {}
     objects = []
-    for group in _group_parts(parts):
+    groups = _group_parts(parts)
+    if suffix == ".obj":
+        groups.sort(key=lambda group: blender_import_order(group[0].name))
+    for group in groups:
         pose = group[0].local2world if turn is None else group[0].local2world @ turn
         obj = MeshObject(group[0].name, group, _slots(group, own, default), pose)
         obj.set_cp("model_path", path)

@@ -26,7 +26,9 @@ from .blender_camera import BlenderCamera
 if TYPE_CHECKING:
     from ..scene.camera import Intrinsics
 
-NAME_SUFFIX = re.compile(r"^(.*)\.(\d{3,})$")
+NAME_SUFFIX = re.compile(r"^(.*)\.(\d+)$")
+"""A numeric suffix Blender strips before numbering a taken name: any digits after the last dot (``a.2`` taken
+gives ``a.001``, measured with bpy 4.2.0)."""
 MAX_NAME_LENGTH = 63
 """Blender's longest data-block name (characters)."""
 
