@@ -5,7 +5,8 @@
 - OBJ: +Y up (Blender's importer: ``axis_forward=-Z, axis_up=Y``), turned to hybridgen's +Z up, and split
   by its ``o`` objects (Blender's ``split_mode`` ON). Each object is named as Blender names it: the text
   after ``o`` (faces before any ``o`` take the file's stem); sections that repeat an ``o`` name are one
-  object, as in Blender. Each object keeps its own materials.
+  object, as in Blender. Each object keeps its own materials, with the Principled values Blender 4.2's importer
+  gives their MTL values (:mod:`hybridgen.io.mtl_principled`).
 - PLY, STL, OFF: taken as stored (Blender's PLY and STL importers do not turn them).
 - glTF/GLB: +Y up by its specification, turned to +Z up as Blender's glTF importer does.
 
@@ -34,6 +35,7 @@ from ..scene.mesh_object import MeshObject
 from .image_check import check_image_file
 from .blender_names import _SENTINEL, _SENTINEL_RE, blender_name, tag_obj_objects, unique_blender_name
 from .mesh_references import is_lenient, referenced_files
+from .mtl_principled import apply_mtl_values
 from .texture_needs import check_libraries, diffuse_maps_by_material, mark_missing_textures
 
 LOADERS: dict[str, tuple[str, str]] = {
@@ -253,6 +255,7 @@ def load_objects(path: str | Path, *, name: str | None = None, category_id: int 
         objects.append(obj)
     if file_type == "obj":
         mark_missing_textures(objects, file)  # checked when an output shows base color
+        apply_mtl_values(objects, file)  # Ns, Ks, Ka, illum, Ni, d ... as Blender 4.2's importer maps them
     return objects
 
 
