@@ -31,3 +31,24 @@ def test_workers_make_a_one_scene_run_sharded(gl_context, tmp_path, run_cli, wri
     assert code == 0, err
     assert sorted(p.name for p in (tmp_path / "c/shards").glob("scene_*.hdf5")) == ["scene_000000_chunk_00000.hdf5"]
     assert (tmp_path / "c/data.hdf5").exists()
+
+
+def test_restart_of_one_shard_removes_only_its_scenes_files(tmp_path):
+    """``--restart --shard i/n`` deletes the shards of scenes s with s % n == i and the index, nothing else (a
+    mutation run found the scene filter unasserted: inverted, it deleted the other shards' finished work)."""
+    from types import SimpleNamespace
+
+    from hybridgen.run.runner import discard_outputs
+
+    shards = tmp_path / "shards"
+    shards.mkdir()
+    names = [f"scene_{s:06d}_chunk_{c:05d}.hdf5" for s in range(4) for c in range(2)]
+    for name in names:
+        (shards / name).write_bytes(b"x")
+    (tmp_path / "data.hdf5").write_bytes(b"x")
+    plan = SimpleNamespace(output_dir=tmp_path, folder="shards", file_name="data.hdf5")
+    assert discard_outputs(plan, (1, 2)) == 4 + 1  # scenes 1 and 3, two chunks each, and the index
+    assert sorted(p.name for p in shards.iterdir()) == [n for n in names if int(n[6:12]) % 2 == 0]
+    assert not (tmp_path / "data.hdf5").exists()
+    assert discard_outputs(plan) == 4  # no shard given: every remaining shard
+    assert list(shards.iterdir()) == []
