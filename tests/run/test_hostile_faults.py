@@ -130,21 +130,9 @@ def latin1_mesh(folder: Path, texture: bytes | None = None) -> bytes:
     return base + b"/caf\xe9.obj"
 
 
-MESH_CONFIG = """
-global: {all: {output_dir: "<args:0>"}}
-modules:
-  - name: main.Initializer
-    config: {seed: 3, number_of_scenes: SCENES}
-  - name: loader.ObjLoader
-    config: {path: "<args:1>", category_id: 2}
-  - name: camera.CameraLoader
-    config:
-      intrinsics: {resolution_x: 8, resolution_y: 6}
-      cam_poses: [{location: [3, -3, 2], rotation: {format: look_at, value: [0, 0, 0]}}]
-  - name: renderer.SegMapRenderer
-    config: {render_normals: false}
-  - name: writer.Hdf5Writer
-"""
+MESH_CONFIG = PATHS_CONFIG.replace("loader.PrimitiveLoader\n    config: {shape: cube, size: 0.6, name: box, category_id: 2}",
+                                   'loader.ObjLoader\n    config: {path: "<args:1>", category_id: 2}')
+"""tests/run/test_hostile_paths.py's scene with the mesh file ``<args:1>`` in place of its cube."""
 
 
 @pytest.mark.parametrize("scenes,workers", [(1, 1), (2, 2)], ids=["single", "pool"])
