@@ -7,6 +7,9 @@ One module per BlenderProc area (``types``, ``loader``, ``object``, ``camera``, 
 with ``import blenderproc`` resolving to this package (:mod:`hybridgen.bproc.script`); new scripts can
 ``import hybridgen.bproc as bproc``. Functions of BlenderProc's API that hybridgen does not implement raise one
 line naming the call (:mod:`hybridgen.bproc.types.unsupported`).
+
+May import: everything of hybridgen below it (scene, sampling, physics, io, modules, render's entry points and
+shared helpers); never the raster or path-tracing internals (docs/architecture.md).
 """
 from __future__ import annotations
 

@@ -2,6 +2,8 @@
 
 PyBullet and CoACD are optional (``pip install hybridgen[physics]``); they are imported when a simulation
 or a decomposition first needs them, with an actionable error when missing.
+
+May import: ``hybridgen.scene``, ``io.cache_folder`` (the decomposition cache) and the top-level helpers.
 """
 from __future__ import annotations
 
