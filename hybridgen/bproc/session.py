@@ -14,21 +14,18 @@ y up, looking along -z), as BlenderProc's API takes and returns them.
 """
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import InputError
+from ..io.blender_names import unique_blender_name
 from .blender_camera import BlenderCamera
 
 if TYPE_CHECKING:
     from ..scene.camera import Intrinsics
 
-NAME_SUFFIX = re.compile(r"^(.*)\.(\d+)$")
-"""A numeric suffix Blender strips before numbering a taken name: any digits after the last dot (``a.2`` taken
-gives ``a.001``, measured with bpy 4.2.0)."""
 MAX_NAME_LENGTH = 63
 """Blender's longest data-block name (characters)."""
 
@@ -145,15 +142,7 @@ class Session:
         taken = self.names.setdefault(kind, set())
         if current is not None:
             taken.discard(current)
-        wanted = str(wanted)[:MAX_NAME_LENGTH]
-        name = wanted
-        if name in taken:
-            match = NAME_SUFFIX.match(wanted)
-            base = match.group(1) if match else wanted
-            number = 1
-            while f"{base}.{number:03d}" in taken:
-                number += 1
-            name = f"{base}.{number:03d}"
+        name = unique_blender_name(str(wanted)[:MAX_NAME_LENGTH], taken)
         taken.add(name)
         return name
 

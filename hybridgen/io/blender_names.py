@@ -5,6 +5,9 @@ from __future__ import annotations
 import re
 from typing import Iterable, Iterator
 
+NAME_SUFFIX = re.compile(r"^(.*)\.(\d+)$")
+"""A numeric suffix Blender strips before numbering a taken name: any digits after the last dot (``a.2`` taken
+gives ``a.001``, measured with bpy 4.2.0)."""
 BLENDER_NAME_BYTES = 63
 """Blender truncates object names to 63 bytes."""
 
@@ -20,11 +23,13 @@ def blender_name(text: str) -> str:
 
 
 def unique_blender_name(name: str, taken: Iterable[str]) -> str:
-    """``name``, or Blender's next free ``name.001``, ``name.002`` ... when ``name`` is taken."""
-    used = set(taken)
+    """``name``, or Blender's next free ``base.001``, ``base.002`` ... when ``name`` is taken (``base``: ``name``
+    without its :data:`NAME_SUFFIX`)."""
+    used = taken if isinstance(taken, (set, frozenset)) else set(taken)
     if name not in used:
         return name
-    base = re.sub(r"\.\d{3}$", "", name)
+    match = NAME_SUFFIX.match(name)
+    base = match.group(1) if match else name
     number = 1
     while f"{base}.{number:03d}" in used:
         number += 1
