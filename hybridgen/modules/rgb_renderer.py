@@ -6,7 +6,6 @@ from typing import Any
 from ..config.registry import register_module
 from ..config.schema import Param, positive
 from ..io.renamed_sink import renamed_sinks
-from ..io.texture_needs import require_base_colors
 from ..render.passes import color_keys
 from ..render.pathtrace.mitsuba_variant import choose_variant
 from ..render.pathtrace.path_trace import PathTraceSettings
@@ -116,7 +115,6 @@ class RgbRenderer(Module):
                     + (f", indirect clamp {settings.clamp_indirect}" if settings.clamp_indirect else "")
                     + (", denoised" if cfg["denoise"] else ""))
         sinks = renamed_sinks(context.sinks, cfg["output_keys"])
-        require_base_colors(scene.objects)  # color shows every base color: its textures must exist
         context.frames_rendered += render_color(
             scene, sinks, settings, labels=request if wants_labels else None, seed=context.scene_seed,
             variant=variant, hdr=cfg["output_hdr"], denoise=cfg["denoise"], keep_raw=cfg["output_raw"],

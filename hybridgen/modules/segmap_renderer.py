@@ -7,7 +7,6 @@ from ..config.registry import register_module
 from ..config.schema import Param
 from ..io.blenderproc_segmap import SegmapSink, apply_default_values, segmap_plan
 from ..io.renamed_sink import renamed_sinks
-from ..io.texture_needs import require_base_colors
 from ..render.raster.label_request import parse_map_by
 from ..render.raster.render_labels import render_labels
 from ..render.raster.threaded_labels import auto_render_threads
@@ -63,8 +62,6 @@ class SegMapRenderer(Module):
         if threads == "auto":
             threads = auto_render_threads(context.scene.triangle_count, len(context.keypoint_indices()))
         request = label_request(config)
-        if request.albedo:
-            require_base_colors(context.scene.objects)  # the albedo pass shows base color
         context.frames_rendered += render_labels(context.scene, sinks, request,
                                                  default_category_id=context.default_category_id,
                                                  progress=context.progress,
