@@ -10,6 +10,11 @@ evaluated meshes (modifiers applied), triangulated, as one vertex per triangle c
 ``<i>_uvs`` (3T, 2) of the active UV map, ``<i>_material`` (T,) slot index). Materials are read from a
 Principled BSDF feeding the output (values and the image linked to an input); images packed in the file are
 written into OUT_DIR.
+
+Subdivision Surface (and Multires) modifiers are evaluated at the level a render uses, not the viewport's:
+their ``render_levels`` (``OPTIONS["render_levels"]`` replaces it: an int for every object, a dict by object
+name, as BlenderProc's Rock Essentials loader sets it), capped by ``OPTIONS["simplify_subdivision_render"]`` (BlenderProc's renderer sets
+the scene's Simplify to 3 by default; 0 means no cap).
 """
 from __future__ import annotations
 
@@ -157,10 +162,30 @@ def _world(out_dir: str) -> dict | None:
     return out
 
 
+def _render_subdivision(options: dict) -> None:
+    """Set every Subdivision Surface / Multires modifier's viewport level to what a render evaluates (module doc)."""
+    cap = int(options.get("simplify_subdivision_render", 0))
+    given = options.get("render_levels")
+    given = {} if given is None else given
+    for obj in bpy.data.objects:
+        for modifier in obj.modifiers:
+            if modifier.type not in ("SUBSURF", "MULTIRES"):
+                continue
+            level = given if isinstance(given, int) else given.get(obj.name)
+            if level is not None and modifier.type == "SUBSURF":
+                modifier.render_levels = int(level)
+            level = min(modifier.render_levels, cap) if cap > 0 else modifier.render_levels
+            if modifier.type == "SUBSURF":
+                modifier.levels = level
+            else:
+                modifier.levels = min(level, modifier.total_levels)
+
+
 def main(blend: str, out_dir: str, options: dict) -> None:
     bpy.ops.wm.open_mainfile(filepath=blend)
     pattern = re.compile(options["entities"]) if options.get("entities") else None
     types = {t.upper() for t in options.get("obj_types", ["mesh", "empty"])}
+    _render_subdivision(options)
     depsgraph = bpy.context.evaluated_depsgraph_get()
     objects, arrays = [], {}
     for obj in bpy.context.scene.objects:

@@ -40,6 +40,8 @@ REPO = Path(__file__).resolve().parents[2]
 DEFAULT_BPY_PYTHON = REPO / ".venv-bpy" / "bin" / "python"
 DUMP_SCRIPT = Path(__file__).with_name("blend_dump.py")
 TIMEOUT_S = 600.0
+SIMPLIFY_SUBDIVISION_RENDER = 3
+"""BlenderProc's ``DefaultConfig.simplify_subdivision_render``: the renderer caps subdivision levels at 3."""
 _LINEAR_MAPS = {"roughness": "roughness_texture", "metallic": "metallic_texture", "specular": "specular_texture",
                 "alpha": "alpha_texture", "normal": "normal_texture"}
 
@@ -72,15 +74,21 @@ def bpy_python() -> Path:
 
 
 def load_blend(path: str | Path, *, obj_types: Sequence[str] = ("mesh", "empty", "light"),
-               entities: str | None = None) -> BlendContent:
+               entities: str | None = None, render_levels: int | dict[str, int] | None = None,
+               simplify_subdivision_render: int = SIMPLIFY_SUBDIVISION_RENDER) -> BlendContent:
     """Read ``path`` (a .blend file) through Blender (module doc). ``obj_types``: the Blender object types to
     read (``mesh``, ``light``, ``empty``; BlenderProc's BlendLoader reads mesh and empty by default);
-    ``entities``: a regular expression object names must match in full."""
+    ``entities``: a regular expression object names must match in full. Subdivision Surface modifiers are
+    evaluated at their render level, ``render_levels`` (an int: every object's; a dict: ``{name: level}``)
+    replacing an object's, capped at
+    ``simplify_subdivision_render`` (BlenderProc's renderer default 3; 0: no cap) - the mesh BlenderProc renders."""
     file = Path(path)
     if not file.is_file():
         raise InputError(not_found(".blend file", file))
     python = bpy_python()
-    options = {"obj_types": [str(t).lower() for t in obj_types], "entities": entities}
+    options = {"obj_types": [str(t).lower() for t in obj_types], "entities": entities,
+               "render_levels": render_levels if isinstance(render_levels, int) else dict(render_levels or {}),
+               "simplify_subdivision_render": simplify_subdivision_render}
     with tempfile.TemporaryDirectory(prefix="hybridgen-blend-") as out:
         command = [str(python), str(DUMP_SCRIPT), str(file.resolve()), out, json.dumps(options)]
         try:

@@ -116,3 +116,25 @@ def test_blenderprocs_blend_loader_module(fixture_blend, tmp_path):
     # looking straight down from 8 m: the box's top (2 m high, class 7) in the middle, the ground around it
     assert segmap[12, 16, 1] == 7 and segmap[0, 0, 1] == 1
     assert states["Box"]["source"] == "blend" and states["Box"]["category_id"] == 7
+
+
+@needs_bpy
+def test_subdivision_is_evaluated_at_render_levels_capped_as_blenderproc_renders(tmp_path):
+    """A rock with a Subdivision Surface modifier at viewport level 1 and render level 2 (an icosahedron's 20
+    triangles -> 60 quads per level 1, x4 per further level, 2 triangles per quad)."""
+    import json
+
+    blend = tmp_path / "Rocks_Test_Small.blend"
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps({"blends": {str(blend): {"objects": ["Rock_Test_Small001"]}}}))
+    done = subprocess.run([str(_bpy_python()), str(REPO / "tools" / "make_rock_essentials_standin.py"), str(spec)],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+
+    def triangles(**options) -> int:
+        return len(blend_loader.load_blend(blend, obj_types=["mesh"], **options).objects[0].faces)
+
+    assert triangles() == 20 * 3 * 4 * 2  # render level 2, not the viewport's 1
+    assert triangles(render_levels=3) == 20 * 3 * 16 * 2
+    assert triangles(render_levels={"Rock_Test_Small001": 5}) == 20 * 3 * 16 * 2  # capped at 3
+    assert triangles(render_levels=4, simplify_subdivision_render=0) == 20 * 3 * 64 * 2

@@ -1,0 +1,65 @@
+"""Write stand-in Rock Essentials packs with Blender's ``bpy`` (run with the bpy venv's Python, e.g. ``.venv-bpy``).
+
+    .venv-bpy/bin/python tools/make_rock_essentials_standin.py SPEC.json
+
+Rock Essentials (blendermarket.com) is a paid asset pack; BlenderProc 1.x's ``rock_essentials`` example reads
+its .blend files and ground textures. SPEC.json names the .blend files a config asks for: ``{"blends": {PATH:
+{"objects": [names], "count": N, "node_group": bool}}}`` (the ground textures are plain images:
+tools/check_blenderproc_configs.py writes them). Each .blend gets one mesh per
+name (plus ``Rock_<stem>NNN`` up to ``count`` when names are not given): a noisy icosphere of ~1 m (metres, Z up)
+with a Subdivision Surface modifier named ``Subsurf`` (viewport level 1, render level 2, as the pack's rocks
+have), a Principled material and the pack's ``01) High Detail Mode`` custom property; ``node_group`` adds an
+empty shader node group ``PBR Rock Shader`` (the ground constructor appends it).
+"""
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import bpy  # type: ignore[import-not-found]
+import numpy as np
+
+
+def _rock(name: str, index: int) -> None:
+    bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=1, radius=0.5, location=(0.0, 0.0, 0.0))
+    rock = bpy.context.active_object
+    rock.name = name
+    rock.data.name = name
+    rng = np.random.default_rng(index)
+    for vertex in rock.data.vertices:  # a lumpy rock, not a ball
+        vertex.co *= float(rng.uniform(0.8, 1.2))
+    modifier = rock.modifiers.new("Subsurf", "SUBSURF")
+    modifier.levels, modifier.render_levels = 1, 2
+    rock["01) High Detail Mode"] = False
+    material = bpy.data.materials.new(f"{name}_material")
+    material.use_nodes = True
+    principled = material.node_tree.nodes["Principled BSDF"]
+    principled.inputs["Base Color"].default_value = (0.35, 0.3, 0.25, 1.0)
+    principled.inputs["Roughness"].default_value = 0.8
+    rock.data.materials.append(material)
+
+
+def _blend(path: Path, spec: dict) -> None:
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    names = list(spec.get("objects") or [])
+    stem = path.stem[len("Rocks_"):] if path.stem.startswith("Rocks_") else path.stem
+    count = max(int(spec.get("count", 0)), len(names), 1)
+    names += [f"Rock_{stem}{i:03d}" for i in range(1, count + 1) if f"Rock_{stem}{i:03d}" not in names]
+    for index, name in enumerate(names[:count]):
+        _rock(name, index)
+    if spec.get("node_group"):
+        group = bpy.data.node_groups.new("PBR Rock Shader", "ShaderNodeTree")
+        group.use_fake_user = True
+    path.parent.mkdir(parents=True, exist_ok=True)
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+
+
+def main(spec_file: Path) -> None:
+    spec = json.loads(spec_file.read_text())
+    for path, blend in spec.get("blends", {}).items():
+        _blend(Path(path), blend)
+
+
+if __name__ == "__main__":
+    main(Path(sys.argv[1]))
