@@ -6,6 +6,8 @@ from typing import Any
 
 import numpy as np
 
+from .dust import Dust
+
 TEXTURE_SLOTS = ("base_color_texture", "roughness_texture", "metallic_texture", "alpha_texture",
                  "normal_texture", "displacement_texture", "specular_texture", "emission_texture")
 """The material's image inputs, all sampled with the mesh UVs."""
@@ -49,6 +51,8 @@ class Material:
     - ``missing_files``: the diffuse textures (MTL ``map_Kd``) the mesh file names for this material that do not
       exist. Only outputs that show base color need them (:mod:`hybridgen.io.texture_needs`); setting
       ``base_color`` or ``base_color_texture`` through a config clears them.
+    - ``dust``: dust films over the material, innermost first (:mod:`hybridgen.scene.dust`; BlenderProc's
+      ``add_dust``); empty for none.
     """
 
     name: str = "default"
@@ -76,6 +80,7 @@ class Material:
     emission_hidden_from_camera: bool = False
     missing_files: tuple[str, ...] = ()  # base-color files the mesh names that do not exist (texture_needs)
     extra: dict[str, Any] = field(default_factory=dict)
+    dust: tuple[Dust, ...] = ()
 
     @property
     def cuts_out(self) -> bool:
