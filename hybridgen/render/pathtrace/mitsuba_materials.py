@@ -18,6 +18,7 @@ The BSDF is built inside out:
   exactly as the analytic tilted normal (Cycles softens diffuse closures with Chiang et al. 2019's term
   instead: the two differ only where light grazes the geometric surface);
 - ``twosided`` for opaque materials (Mitsuba's BSDFs are one-sided; Blender's are not);
+- :mod:`.dust_mix`'s dust film over all that for a material with ``dust`` (BlenderProc's ``add_dust``);
 - ``mask`` for alpha < 1 or an alpha texture (fractional opacity; CLIP materials get their alpha
   thresholded at 0.5 per texel). Camera and bounce rays pass masked parts; shadow rays of Mitsuba's
   ``path`` integrator do not (no transparent shadows: a cut-out casts a full shadow, unlike Cycles).
@@ -186,10 +187,11 @@ VERTEX_COLOR_ATTRIBUTE = "vertex_color"
 """Name of the mesh attribute holding per-vertex linear RGB (``vertex_`` prefix: interpolated over faces)."""
 
 
-def bsdf_dict(material: Material, owner: str, *, vertex_colors: bool = False) -> dict[str, Any]:
+def bsdf_dict(material: Material, owner: str, *, vertex_colors: bool = False, uvs: bool = True) -> dict[str, Any]:
     """Mitsuba BSDF of ``material`` (see the module docstring for the nesting); with ``vertex_colors`` (the
     mesh carries :data:`VERTEX_COLOR_ATTRIBUTE`) and the material's ``base_color_from_vertices``, the base
-    color is that attribute (a base-color texture still wins, as a linked image in Blender)."""
+    color is that attribute (a base-color texture still wins, as a linked image in Blender). ``uvs``: the mesh
+    has texture coordinates (dust patterns read them, :mod:`.dust_mix`)."""
     from . import principled_material
 
     blender = principled_material.enabled()  # hybridgen's Principled BSDF (JIT variants)
@@ -225,6 +227,10 @@ def bsdf_dict(material: Material, owner: str, *, vertex_colors: bool = False) ->
     if material.transmission == 0 and not (blender and bsdf_is_plugin(bsdf)):
         # Mitsuba's opaque BSDFs are one-sided; Blender (and real meshes with mixed windings) need both sides.
         bsdf = {"type": "twosided", "material": bsdf}
+    if material.dust:  # dust films over the two-sided BSDF, under alpha
+        from .dust_mix import wrap
+
+        bsdf = wrap(bsdf, material, owner, uvs=uvs)
     clip = 0.5 if material.alpha_mode == "CLIP" else None
     if material.alpha_texture is not None:
         opacity: Any = data_texture(material.alpha_texture, owner, "alpha_texture", threshold=clip)
@@ -245,7 +251,7 @@ def bsdf_is_plugin(bsdf: dict[str, Any]) -> bool:
     return bsdf.get("type") == PLUGIN_NAME
 
 
-def loaded_bsdf(material: Material, owner: str, *, vertex_colors: bool = False,
+def loaded_bsdf(material: Material, owner: str, *, vertex_colors: bool = False, uvs: bool = True,
                 cache: dict[Any, Any] | None = None) -> Any:
     """The Mitsuba BSDF object of ``material``; with ``cache`` (one per scene build), equal materials get the
     same object, so their textures are read and held once however many shapes use them."""
@@ -254,8 +260,8 @@ def loaded_bsdf(material: Material, owner: str, *, vertex_colors: bool = False,
     from ..shared_geometry import material_key
 
     if cache is None:
-        return mi.load_dict(bsdf_dict(material, owner, vertex_colors=vertex_colors))
-    key = (material_key(material), vertex_colors and material.base_color_from_vertices)
+        return mi.load_dict(bsdf_dict(material, owner, vertex_colors=vertex_colors, uvs=uvs))
+    key = (material_key(material), vertex_colors and material.base_color_from_vertices, bool(material.dust) and uvs)
     if key not in cache:
-        cache[key] = mi.load_dict(bsdf_dict(material, owner, vertex_colors=vertex_colors))
+        cache[key] = mi.load_dict(bsdf_dict(material, owner, vertex_colors=vertex_colors, uvs=uvs))
     return cache[key]

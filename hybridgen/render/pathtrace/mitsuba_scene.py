@@ -61,13 +61,13 @@ def mesh_shape(obj: MeshObject, *, back_side: bool = False, sampling_weight: flo
 
     props = mi.Properties()
     colored = obj.vertex_colors is not None and obj.material.base_color_from_vertices
-    props["bsdf"] = loaded_bsdf(obj.material, obj.name, vertex_colors=colored, cache=bsdfs)
+    has_uv = obj.uvs is not None and len(obj.uvs) == len(obj.vertices)
+    props["bsdf"] = loaded_bsdf(obj.material, obj.name, vertex_colors=colored, uvs=has_uv, cache=bsdfs)
     radiance = emitted_radiance(obj)
     if np.any(radiance > 0):
         props["emitter"] = mi.load_dict({"type": "area", "radiance": radiance_texture(obj),
                                          "sampling_weight": float(sampling_weight)})
     smooth = obj.vertex_normals is not None
-    has_uv = obj.uvs is not None and len(obj.uvs) == len(obj.vertices)
     name = obj.name + (".back" if back_side else "")
     mesh = mi.Mesh(name, len(obj.vertices), len(obj.faces), props=props, has_vertex_normals=smooth,
                    has_vertex_texcoords=has_uv)
