@@ -304,7 +304,24 @@ def dataset_standins(text: str, work: Path) -> dict[int, str]:
         out.update({i: str(textures) for i in _args_of(text, "texture_folder")})
     out.update(room_dataset_standins(text, work))
     out.update(amass_standin(text, work))
+    if "loader.RockEssentialsRockLoader" in text or "constructor.RockEssentialsGroundConstructor" in text:
+        out.update(rock_essentials_standin(text, work))
     return out
+
+
+def rock_essentials_standin(text: str, work: Path) -> dict[int, str]:
+    """The Rock Essentials packs the config names (stand-in .blend files written by Blender, when the bpy venv
+    exists) as its ``<args:0>``."""
+    from make_rock_essentials_standin import config_standins
+
+    from hybridgen.errors import SystemSetupError
+    from hybridgen.io.blend_loader import bpy_python
+
+    try:
+        python = bpy_python()
+    except SystemSetupError:
+        return {}  # the loader then says, in one line, how to get bpy
+    return {0: str(config_standins(text, work / "rock_essentials", python))}
 
 
 def room_dataset_standins(text: str, work: Path) -> dict[int, str]:

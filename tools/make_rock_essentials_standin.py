@@ -2,6 +2,9 @@
 
     .venv-bpy/bin/python tools/make_rock_essentials_standin.py SPEC.json
 
+From hybridgen's venv, :func:`config_standins` reads a BlenderProc config that uses the pack's modules and
+writes everything it names under a folder (the .blend files through the bpy venv, the ground textures here).
+
 Rock Essentials (blendermarket.com) is a paid asset pack; BlenderProc 1.x's ``rock_essentials`` example reads
 its .blend files and ground textures. SPEC.json names the .blend files a config asks for: ``{"blends": {PATH:
 {"objects": [names], "count": N, "node_group": bool}}}`` (the ground textures are plain images:
@@ -14,14 +17,18 @@ empty shader node group ``PBR Rock Shader`` (the ground constructor appends it).
 from __future__ import annotations
 
 import json
+import subprocess
 import sys
 from pathlib import Path
 
-import bpy  # type: ignore[import-not-found]
 import numpy as np
+
+ARG0 = "<args:0>/"
 
 
 def _rock(name: str, index: int) -> None:
+    import bpy  # type: ignore[import-not-found]
+
     bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=1, radius=0.5, location=(0.0, 0.0, 0.0))
     rock = bpy.context.active_object
     rock.name = name
@@ -41,6 +48,8 @@ def _rock(name: str, index: int) -> None:
 
 
 def _blend(path: Path, spec: dict) -> None:
+    import bpy  # type: ignore[import-not-found]
+
     bpy.ops.wm.read_factory_settings(use_empty=True)
     names = list(spec.get("objects") or [])
     stem = path.stem[len("Rocks_"):] if path.stem.startswith("Rocks_") else path.stem
@@ -59,6 +68,54 @@ def main(spec_file: Path) -> None:
     spec = json.loads(spec_file.read_text())
     for path, blend in spec.get("blends", {}).items():
         _blend(Path(path), blend)
+
+
+def _texture(path: Path) -> None:
+    """A small image for a ground map, by the pack's file-name convention (COL color, DISP16 16-bit height,
+    NRM a flat normal map, others 8-bit gray)."""
+    from PIL import Image
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    y, x = np.mgrid[0:32, 0:32]
+    wave = 0.5 + 0.5 * np.sin(x / 3.0) * np.cos(y / 4.0)
+    upper = path.name.upper()
+    if "DISP16" in upper:
+        Image.fromarray((wave * 65535).astype(np.uint16)).save(path)
+    elif "NRM" in upper:
+        Image.new("RGB", (32, 32), (128, 128, 255)).save(path)
+    elif "COL" in upper:
+        Image.fromarray(np.stack([wave * 120 + 60, wave * 100 + 50, wave * 80 + 40], -1).astype(np.uint8)).save(path)
+    else:
+        Image.fromarray((wave * 200 + 20).astype(np.uint8)).save(path)
+
+
+def config_standins(text: str, root: Path, bpy_python: Path) -> Path:
+    """Write under ``root`` the packs (.blend files, with the object names asked for) and ground textures a
+    BlenderProc config's ``<args:0>/...`` paths name; returns ``root`` (the config's ``<args:0>``)."""
+    import yaml
+
+    config = yaml.safe_load(text)
+    blends: dict[str, dict] = {}
+    for module in config.get("modules", []):
+        for batch in module.get("config", {}).get("batches", []):
+            if str(batch.get("path", "")).startswith(ARG0):
+                blends[str(root / batch["path"][len(ARG0):])] = {"objects": batch.get("objects", []),
+                                                                 "count": 3}
+        for tile in module.get("config", {}).get("tiles", []):
+            if tile and str(tile.get("shader_path", "")).startswith(ARG0):
+                blends.setdefault(str(root / tile["shader_path"][len(ARG0):]), {})["node_group"] = True
+        for texture in module.get("config", {}).get("textures", []):
+            folder = str(texture.get("path", ""))
+            if folder.startswith(ARG0):
+                for name in texture.get("images", {}).values():
+                    _texture(root / (folder[len(ARG0):] + name))
+    spec = root / "rock_essentials_spec.json"
+    root.mkdir(parents=True, exist_ok=True)
+    spec.write_text(json.dumps({"blends": blends}))
+    done = subprocess.run([str(bpy_python), __file__, str(spec)], capture_output=True, text=True, timeout=600)
+    if done.returncode != 0:
+        raise RuntimeError("writing Rock Essentials stand-ins failed: " + (done.stderr.strip().splitlines() or ["?"])[-1])
+    return root
 
 
 if __name__ == "__main__":

@@ -15,6 +15,11 @@ def srgb_encode(linear: np.ndarray) -> np.ndarray:
     return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4, dtype=np.float32) - 0.055)
 
 
+def srgb_decode(values: np.ndarray) -> np.ndarray:
+    """Linear values of sRGB-encoded values in 0..1 (IEC 61966-2-1; the inverse of :func:`srgb_encode`)."""
+    return np.where(values <= 0.04045, values / 12.92, ((values + 0.055) / 1.055) ** 2.4)
+
+
 def to_srgb8(linear: np.ndarray) -> np.ndarray:
     """uint8 sRGB image of a linear RGB image."""
     return np.rint(srgb_encode(linear) * 255.0).astype(np.uint8)

@@ -32,6 +32,9 @@ class RunContext:
     outputs: list[Path] = field(default_factory=list)
     frames_rendered: int = 0
     attributes: dict[str, Any] = field(default_factory=dict)
+    module_state: dict[str, Any] = field(default_factory=dict)
+    """What a module leaves for later modules of the scene (never written out): e.g. the Rock Essentials
+    ground tiles' modifier stacks, which the texture sampler re-evaluates (``rock_essentials_ground``)."""
     progress: Callable[[int, str], Any] | None = None
     log: Log = field(default=no_log)  # log(message) or log(message, "warning"), see hybridgen.logs
     cleanups: list[Callable[[], None]] = field(default_factory=list)

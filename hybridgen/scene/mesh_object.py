@@ -125,6 +125,17 @@ class MeshObject:
         """(2, 3) axis-aligned box of the vertices in the local frame, metres."""
         return np.stack([self.vertices.min(axis=0), self.vertices.max(axis=0)])
 
+    def set_geometry(self, vertices: np.ndarray, faces: np.ndarray, uvs: np.ndarray | None = None,
+                     vertex_normals: np.ndarray | None = None) -> None:
+        """Replace the mesh (local frame, metres) - a modifier evaluated again - dropping what was derived from the
+        old one (face normals, closedness); ``vertex_normals`` None: flat-shaded. Vertex colors are dropped."""
+        self.vertices = np.ascontiguousarray(vertices, dtype=np.float64).reshape(-1, 3)
+        self.faces = np.ascontiguousarray(faces, dtype=np.int64).reshape(-1, 3)
+        self.uvs, self.vertex_normals, self.vertex_colors = uvs, vertex_normals, None
+        for name in ("face_normals", "is_closed"):
+            self.__dict__.pop(name, None)
+        self.validate()
+
     def world_vertices(self) -> np.ndarray:
         """(V, 3) vertices in world coordinates."""
         return self.vertices @ self.local2world[:3, :3].T + self.local2world[:3, 3]

@@ -19,7 +19,6 @@ ALIASES = {
 }
 """BlenderProc module name -> the hybridgen module that does its work (keys translated below)."""
 
-_EXPORT = "export the scene to glTF/GLB or OBJ (e.g. with Blender: File > Export) and load it with loader.ObjLoader"
 _DATASET = "convert its meshes to OBJ/glTF/PLY and load them with loader.ObjLoader"
 UNAVAILABLE = {
     "loader.SuncgLoader": f"the SUNCG dataset was withdrawn by its authors and is not distributed; {_DATASET}",
@@ -27,10 +26,6 @@ UNAVAILABLE = {
                               "with a selector for the lamp objects",
     "camera.SuncgCameraSampler": "samples cameras inside SUNCG rooms (a withdrawn dataset); use "
                                  "camera.CameraSampler with proximity_checks",
-    "loader.RockEssentialsRockLoader": "reads Blender .blend rock packs; " + _EXPORT,
-    "constructor.RockEssentialsGroundConstructor": "builds Blender node-displaced ground; use "
-                                                   "loader.PrimitiveLoader (plane) with a texture",
-    "materials.RockEssentialsTextureSampler": "samples Blender node textures; use manipulators.MaterialManipulator",
     "writer.StereoGlobalMatchingWriter": "stereo depth by SGM is not implemented; renderer.RgbRenderer with "
                                          "stereo: true writes exact per-eye depth instead",
     "loader.VisNormalImage": "a debugging view of Blender's normal images; view hybridgen's normals with "

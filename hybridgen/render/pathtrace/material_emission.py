@@ -15,11 +15,7 @@ from ...errors import InputError
 from ...scene.material import Material
 from ...scene.mesh_object import MeshObject
 from ..material_textures import data_image
-
-
-def srgb_decode(values: np.ndarray) -> np.ndarray:
-    """Linear values of sRGB-encoded values in 0..1 (IEC 61966-2-1)."""
-    return np.where(values <= 0.04045, values / 12.92, ((values + 0.055) / 1.055) ** 2.4)
+from ..tonemap import srgb_decode
 
 
 def emission_image(material: Material, owner: str) -> np.ndarray | None:
