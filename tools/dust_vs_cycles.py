@@ -112,9 +112,11 @@ def render_cycles(objects: list[dict[str, Any]], scene: Any, mode: str, spp: int
         raise SystemExit(f"Cycles failed: {(done.stderr or done.stdout).strip().splitlines()[-3:]}")
     mi.set_variant("llvm_ad_rgb")
     bitmap = mi.Bitmap(str(work / f"{mode}.exr"))
-    if bitmap.pixel_format() != mi.Bitmap.PixelFormat.MultiChannel:  # the Combined layer alone
-        return {"Combined": np.asarray(bitmap, np.float64)}
-    return {name.split(".")[-1]: np.asarray(part, np.float64) for name, part in bitmap.split()}
+    values, names = np.asarray(bitmap, np.float64), [field.name for field in bitmap.struct_()]
+    channels = {name.split(".", 1)[1]: values[..., i] for i, name in enumerate(names)}  # "Combined.R", "UV.U" ...
+    wanted = {"Combined": "RGBA", "UV": "UV", "Normal": "XYZ", "Position": "XYZ"}
+    return {layer: np.stack([channels[f"{layer}.{c}"] for c in letters], -1) for layer, letters in wanted.items()
+            if f"{layer}.{letters[0]}" in channels}
 
 
 def object_masks(scene: Any, margin: float = 0.85) -> tuple[dict[str, np.ndarray], np.ndarray]:
@@ -195,7 +197,7 @@ def report_weights(objects: list[dict[str, Any]], look_scene: Any, passes: dict[
     origin = look_scene.camera.keypoints[0][:3, 3]
     hit = passes["Combined"][..., 3] > 0.5
     theirs, points = passes["Combined"][..., 0][hit], passes["Position"][hit]
-    normal, uv = passes["Normal"][hit], passes["UV"][hit][:, :2]
+    normal, uv = passes["Normal"][hit], passes["UV"][hit]
     ours = hybridgen_weights(hybridgen_scene(objects, size, weight_mode=True), origin, points)
     view = points - origin
     view /= np.linalg.norm(view, axis=1, keepdims=True)
@@ -226,8 +228,9 @@ def report_weights(objects: list[dict[str, Any]], look_scene: Any, passes: dict[
         table = {"about": "Cycles (bpy 4.2) dust weights of BlenderProc's add_dust at sample points: tools/dust_vs_cycles.py",
                  "strength": [strengths[o] for o in owner[keep]],
                  "scale": [{o["name"]: o["dust"][0][1] for o in objects}[o] for o in owner[keep]],
-                 "uv": uv[keep].round(7).tolist(), "normal": normal[keep].round(7).tolist(),
-                 "view": view[keep].round(7).tolist(), "w": theirs[keep].round(7).tolist()}
+                 **{key: [[float(f"{c:.9g}") for c in np.atleast_1d(row)] if np.ndim(row) else float(f"{row:.9g}")
+                          for row in values[keep]]
+                    for key, values in (("uv", uv), ("normal", normal), ("view", view), ("w", theirs))}}
         store.write_text(json.dumps(table) + "\n")
         print(f"stored {len(keep)} points in {store}")
 
