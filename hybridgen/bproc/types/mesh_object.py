@@ -25,6 +25,7 @@ from .entity import Entity, compose, vector3
 from .material import Material
 from .mesh_editing import MeshEditing, transformed_part
 from .mesh_geometry import MeshGeometry
+from .modifiers import MeshModifiers
 from .rigid_body import RigidBodyMixin
 from .unsupported import unsupported_method
 
@@ -34,10 +35,10 @@ DEFAULT_SURFACE = SceneMaterial(name="blender_default_surface")
 """What Blender renders a mesh without material with: grey 0.8 Principled, roughness 0.5."""
 
 
-class MeshObject(Entity, MeshGeometry, MeshEditing, RigidBodyMixin):
+class MeshObject(Entity, MeshGeometry, MeshEditing, MeshModifiers, RigidBodyMixin):
     """A mesh object; ``parts`` are hybridgen meshes in its local frame, ``_slots`` its material slots. Geometric
-    queries (BVH trees, ray casts), mesh edits (UV projection, joining) and the rigid body come from the
-    mixins."""
+    queries (BVH trees, ray casts), mesh edits (UV projection, joining), modifiers (subdivision, displacement,
+    solidify) and the rigid body come from the mixins."""
 
     TYPE = "MESH"
 
@@ -211,8 +212,6 @@ class MeshObject(Entity, MeshGeometry, MeshEditing, RigidBodyMixin):
     edit_mode: Callable[..., Any] = unsupported_method("MeshObject", "edit_mode")
     object_mode: Callable[..., Any] = unsupported_method("MeshObject", "object_mode")
     scale_uv_coordinates: Callable[..., Any] = unsupported_method("MeshObject", "scale_uv_coordinates")
-    add_displace_modifier: Callable[..., Any] = unsupported_method("MeshObject", "add_displace_modifier")
-    add_modifier: Callable[..., Any] = unsupported_method("MeshObject", "add_modifier")
     add_geometry_nodes: Callable[..., Any] = unsupported_method("MeshObject", "add_geometry_nodes")
     add_auto_smooth_modifier: Callable[..., Any] = unsupported_method("MeshObject", "add_auto_smooth_modifier")
     clear_custom_splitnormals: Callable[..., Any] = unsupported_method("MeshObject", "clear_custom_splitnormals")
