@@ -94,16 +94,16 @@ def _final(a: Any, b: Any, c: Any) -> Any:
 
 
 def hash_uint3(kx: Any, ky: Any, kz: Any) -> Any:
-    """lookup3 hash of three uint32 arrays (wrapping arithmetic)."""
-    return _final(kx + _SEED3, ky + _SEED3, kz + _SEED3)
+    """lookup3 hash of three uint32 arrays (wrapping arithmetic; NumPy scalars wrap too, without a warning)."""
+    with np.errstate(over="ignore"):
+        return _final(kx + _SEED3, ky + _SEED3, kz + _SEED3)
 
 
 def _hash_float2_to_float(x: float, y: float) -> float:
     """Hash of two float32 bit patterns as a float32 in [0, 1] (for the distortion offsets)."""
     words = [np.array([struct.unpack("<I", struct.pack("<f", v))[0]], np.uint32) for v in (x, y)]
     with np.errstate(over="ignore"):
-        c = _final(words[0] + np.uint32(_SEED2), words[1] + np.uint32(_SEED2),
-                   np.array([_SEED2], np.uint32))
+        c = _final(words[0] + np.uint32(_SEED2), words[1] + np.uint32(_SEED2), np.array([_SEED2], np.uint32))
     return float(np.float32(c[0]) * np.float32(1.0 / _MASK))
 
 
