@@ -3,8 +3,8 @@ MeshObjectUtility / EntityUtility).
 
 ``create_primitive`` makes Blender's primitives with Blender's default sizes (``CUBE``/``PLANE`` ``size`` 2 m,
 ``SPHERE`` ``radius`` 1 m, ``CYLINDER``/``CONE`` ``radius`` 1 m and ``depth`` 2 m), flat-shaded and without a
-material slot, as ``bpy.ops.mesh.primitive_*_add`` does. The sphere is hybridgen's icosphere where Blender's
-is a UV sphere (same radius, different facets)."""
+material slot, as ``bpy.ops.mesh.primitive_*_add`` does; the plane has Blender's UV map (0..1 along x and y), the
+others none. The sphere is hybridgen's icosphere where Blender's is a UV sphere (same radius, different facets)."""
 from __future__ import annotations
 
 from typing import Any, Sequence
@@ -47,6 +47,8 @@ def create_primitive(shape: str, **kwargs: Any) -> MeshObject:
     if kind in ("cube", "plane"):
         size = float(kwargs.get("size", 2.0))
         part = make_primitive(kind, size)
+        if kind == "plane":  # Blender's UV map of its plane: (x / size + 0.5, y / size + 0.5)
+            part.uvs = part.vertices[:, :2] / size + 0.5
     else:
         radius = float(kwargs.get("radius", 1.0))
         part = make_primitive(kind, 2 * radius)
