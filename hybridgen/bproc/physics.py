@@ -40,15 +40,16 @@ def _shape(obj: MeshObject, body: RigidBody) -> tuple[str, SceneMesh]:
     active = body.type == "ACTIVE"
     if body.convex_decomposition:
         return "convex_decomposition", mesh
-    if body.collision_shape == "CONVEX_HULL" or (body.collision_shape == "MESH" and not active):
+    if body.collision_shape == "CONVEX_HULL":
         return ("convex_hull" if active else "mesh"), mesh
+    if body.collision_shape == "MESH":
+        return "mesh", mesh  # active: every triangle collides (Blender's GImpact), hybridgen.physics.mesh_body
     if body.collision_shape == "BOX":
         low, high = mesh.bounds_local
         corners = np.array([[x, y, z] for x in (low[0], high[0]) for y in (low[1], high[1]) for z in (low[2], high[2])])
         box = SceneMesh(obj.get_name(), corners, BOX_FACES, local2world=mesh.local2world)
         return ("convex_hull" if np.all(high - low > 0) or active else "mesh"), box
-    why = {"MESH": "hybridgen's Bullet bodies cannot be moving triangle meshes",
-           "COMPOUND": "call build_convex_decomposition_collision_shape first"}.get(body.collision_shape, "")
+    why = {"COMPOUND": "call build_convex_decomposition_collision_shape first"}.get(body.collision_shape, "")
     fail(f"bproc.types.MeshObject.enable_rigidbody(active={active}, collision_shape='{body.collision_shape}')", why)
 
 

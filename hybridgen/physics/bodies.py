@@ -8,6 +8,7 @@ import numpy as np
 from ..errors import InputError
 from ..scene.frames import make_pose
 from ..scene.mesh_object import MeshObject
+from .mesh_body import triangle_geometry
 from .settings import PhysicsSettings
 from .shapes import SHAPES, CollisionGeometry, collision_geometry
 
@@ -68,13 +69,12 @@ SHAPE_ATTRIBUTE = "collision_shape"
 
 
 def shape_of(obj: MeshObject, default: str, active: bool) -> str:
-    """The collision shape kind of ``obj``: its ``collision_shape`` attribute, else ``default``."""
+    """The collision shape kind of ``obj``: its ``collision_shape`` attribute, else ``default``. ``mesh`` for an
+    active object is its triangles as a compound (:mod:`hybridgen.physics.mesh_body`)."""
     kind = obj.attributes.get(SHAPE_ATTRIBUTE, default)
-    allowed = [k for k in SHAPES if k != "mesh" or not active]
-    if kind not in allowed:
+    if kind not in SHAPES:
         role = "active" if active else "passive"
-        raise InputError(f"{role} object '{obj.name}': collision_shape {kind!r} is not one of {', '.join(allowed)}"
-                         + (" (Bullet has no moving triangle meshes)" if kind == "mesh" else ""))
+        raise InputError(f"{role} object '{obj.name}': collision_shape {kind!r} is not one of {', '.join(SHAPES)}")
     return str(kind)
 
 
@@ -83,7 +83,10 @@ def active_body(obj: MeshObject, settings: PhysicsSettings) -> Body:
     rotation, linear = split_linear(obj.local2world[:3, :3])
     kind = shape_of(obj, settings.collision_shape, active=True)
     try:
-        geometry = collision_geometry(obj.vertices, obj.faces, kind, linear, settings.decomposition)
+        if kind == "mesh":
+            geometry = triangle_geometry(obj.vertices, obj.faces, linear, needs_volume=settings.mass is None)
+        else:
+            geometry = collision_geometry(obj.vertices, obj.faces, kind, linear, settings.decomposition)
     except InputError as exc:
         raise InputError(f"active object '{obj.name}': {exc}") from None
     mass = settings.mass if settings.mass is not None else settings.density * geometry.volume

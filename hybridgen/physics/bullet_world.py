@@ -76,7 +76,8 @@ class BulletWorld:
         return path
 
     def shape(self, geometry: CollisionGeometry, parts: list[tuple[np.ndarray, np.ndarray]]) -> int:
-        """A collision shape: a static triangle mesh, one convex hull, or a compound of convex hulls."""
+        """A collision shape: a static triangle mesh, one convex hull, or a compound of convex hulls (also one
+        per triangle of a moving mesh, :mod:`hybridgen.physics.mesh_body`)."""
         pb, cid = self.pb, self.client
         try:
             if geometry.kind == "mesh":
