@@ -22,7 +22,8 @@ from ..errors import InputError, SystemSetupError
 from ..io.cache_folder import cache_path, cache_root, write_entry
 
 SHAPES = ("convex_hull", "convex_decomposition", "auto", "mesh")
-"""Collision shape kinds: ``mesh`` (the exact triangles) is only possible for passive (static) objects."""
+"""Collision shape kinds: ``mesh`` is the exact triangles - Bullet's static triangle mesh for passive objects; for
+active ones :mod:`hybridgen.physics.mesh_body` builds a compound of the triangles (Blender's GImpact)."""
 
 AUTO_FILL_RATIO = 0.95
 """``auto`` for active objects: the convex hull when a watertight mesh fills at least this fraction of its

@@ -3,9 +3,10 @@ what :mod:`hybridgen.bproc.physics` hands to hybridgen's PyBullet simulation.
 
 Values are Blender's: ``mass`` in kg (default: the bound box volume in m^3 times ``mass_factor``, as BlenderProc
 computes it), ``collision_margin`` in m, ``friction`` Bullet's Coulomb coefficient, damping the fraction of
-velocity lost per second. Collision shapes: ``CONVEX_HULL``, ``MESH`` (passive objects), ``BOX`` (the object's bound
-box), and ``COMPOUND`` after :meth:`RigidBodyMixin.build_convex_decomposition_collision_shape` (a convex decomposition
-by CoACD, where BlenderProc runs V-HACD: the parts differ, the idea is the same). ``SPHERE``, ``CAPSULE``,
+velocity lost per second. Collision shapes: ``CONVEX_HULL``, ``MESH`` (passive: Bullet's static triangle mesh;
+active: every triangle collides, as Blender's GImpact shape - :mod:`hybridgen.physics.mesh_body`), ``BOX`` (the
+object's bound box), and ``COMPOUND`` after :meth:`RigidBodyMixin.build_convex_decomposition_collision_shape` (a
+convex decomposition by CoACD, where BlenderProc runs V-HACD: the parts differ, the idea is the same). ``SPHERE``, ``CAPSULE``,
 ``CYLINDER`` and ``CONE`` raise one line when simulated.
 """
 from __future__ import annotations
