@@ -2,7 +2,8 @@
 // Albedo pass, fragment stage: linear diffuse albedo (base color, per-vertex colors interpolated linearly,
 // or the base-color texture decoded from sRGB by the sRGB8_ALPHA8 texture format and filtered bilinearly,
 // as Mitsuba's bitmap texture does). Alpha-clipped materials (alpha_mode CLIP) drop fragments whose alpha
-// (the alpha map, bilinear, or the constant) is below 0.5: the surface behind shows through.
+// (the alpha map, bilinear, or the constant) is below 0.5: the surface behind shows through. Dust films mix
+// their colors in by their weights (dust.glsl, included below by the albedo pass).
 uniform vec4 u_base_color;
 uniform bool u_textured;
 uniform bool u_vertex_colored;
@@ -11,9 +12,15 @@ uniform bool u_alpha_clip;
 uniform bool u_alpha_mapped;
 uniform float u_alpha;
 uniform sampler2D u_alpha_texture;
+uniform vec3 u_camera;   // world position of the camera (dust's view direction)
+uniform bool u_dust_uv;  // the mesh has UVs (else dust reads (0, 0), as Cycles a missing UV map)
 
 in vec2 v_uv;
 in vec3 v_color;
+in vec3 v_world;
+in vec3 v_normal;
+
+// dust.glsl
 
 layout(location = 0) out vec4 out_albedo;
 
@@ -23,5 +30,12 @@ void main() {
         if (alpha < 0.5) discard;
     }
     vec3 albedo = u_textured ? texture(u_texture, v_uv).rgb : (u_vertex_colored ? v_color : u_base_color.rgb);
+    if (u_dust_count > 0) {
+        vec3 n = normalize(v_normal);
+        vec3 to_camera = normalize(u_camera - v_world);
+        float cosine = dot(n, to_camera);
+        n = cosine < 0.0 ? -n : n;  // the normal facing the viewer, as Cycles turns it
+        albedo = dust_albedo(albedo, u_dust_uv ? v_uv : vec2(0.0), n.z, abs(cosine));
+    }
     out_albedo = vec4(albedo, 1.0);
 }

@@ -3,7 +3,8 @@
 The guide image for denoising, and a label of its own: the material's base color, or its base-color
 texture (decoded from sRGB, bilinear, repeating, as Mitsuba samples it) or the interpolated per-vertex
 colors at the surface point seen through the pixel centre; surfaces of alpha-clipped materials are cut out
-where their alpha is below 0.5. Background pixels get ``background`` (by default the world color).
+where their alpha is below 0.5; dust films mix in their colors by their weights (:mod:`.albedo_dust`).
+Background pixels get ``background`` (by default the world color).
 Textures and UVs are uploaded on first use only.
 """
 from __future__ import annotations
@@ -19,6 +20,7 @@ from ..material_textures import alpha_coverage
 from .projection import projection_from_K
 from .raster_view import RasterView
 from .shader_source import shader_source
+from .albedo_dust import ObjectDust, active_layers, no_dust
 from .label_framebuffers import release_framebuffer
 
 GL_SRGB8_ALPHA8 = 0x8C43
@@ -56,8 +58,10 @@ class AlbedoPass:
         self.view = view
         ctx = view.ctx
         self.program = compile_program(ctx, vertex_shader=shader_source("albedo.vert"),
-                                       fragment_shader=shader_source("albedo.frag"))
+                                       fragment_shader=shader_source("albedo.frag").replace(
+                                           "// dust.glsl", shader_source("dust.glsl")))
         self._draws: list[tuple[Any, Any, Any, MeshObject]] = []
+        self._dust: dict[int, ObjectDust] = {}  # draw index -> its dust layers (render/raster/albedo_dust.py)
         self._resources: list[Any] = []
         for gpu, obj in zip(view.gpu_objects, view.scene.objects):
             image = _texture_image(obj)
@@ -71,8 +75,12 @@ class AlbedoPass:
                 self._resources.append(buffer)
 
             alpha_image = _alpha_image(obj)
-            if (image is not None or alpha_image is not None) and obj.uvs is not None:
+            layers = active_layers(obj)
+            if (image is not None or alpha_image is not None or layers) and obj.uvs is not None:
                 per_vertex(np.asarray(obj.uvs), "2f", "in_uv")
+            if layers:
+                content.extend(entry for entry in gpu.content if entry[2] == "in_normal")
+                self._dust[len(self._draws)] = ObjectDust(ctx, obj, layers, self._resources)
             if image is not None:
                 texture = ctx.texture((image.shape[1], image.shape[0]), 4, image.tobytes(),
                                       internal_format=GL_SRGB8_ALPHA8)
@@ -110,8 +118,12 @@ class AlbedoPass:
         world2cam = np.linalg.inv(cam2world)
         self.program["u_projection"].write(projection_from_K(intr.K, intr.width, intr.height, intr.clip_start,
                                                              intr.clip_end).T.astype(np.float32).tobytes())
-        for vao, texture, alpha, obj in self._draws:
+        for index, (vao, texture, alpha, obj) in enumerate(self._draws):
             material = obj.material
+            if index in self._dust:
+                self._dust[index].apply(self.program, obj, cam2world)
+            elif self._dust:
+                no_dust(self.program)
             self.program["u_modelview"].write((world2cam @ obj.local2world).T.astype(np.float32).tobytes())
             self.program["u_base_color"].value = tuple(float(c) for c in material.base_color)
             self.program["u_textured"].value = texture is not None
