@@ -115,6 +115,7 @@ def main() -> None:
     scene.render.resolution_percentage = 100
     layer = scene.view_layers[0]
     layer.use_pass_uv = layer.use_pass_normal = layer.use_pass_position = weight_mode
+    layer.use_pass_diffuse_color = not weight_mode
     scene.render.image_settings.file_format = "OPEN_EXR_MULTILAYER"
     scene.render.image_settings.color_depth = "32"
     scene.render.filepath = out

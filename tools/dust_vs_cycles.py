@@ -114,7 +114,7 @@ def render_cycles(objects: list[dict[str, Any]], scene: Any, mode: str, spp: int
     bitmap = mi.Bitmap(str(work / f"{mode}.exr"))
     values, names = np.asarray(bitmap, np.float64), [field.name for field in bitmap.struct_()]
     channels = {name.split(".", 1)[1]: values[..., i] for i, name in enumerate(names)}  # "Combined.R", "UV.U" ...
-    wanted = {"Combined": "RGBA", "UV": "UV", "Normal": "XYZ", "Position": "XYZ"}
+    wanted = {"Combined": "RGBA", "UV": "UV", "Normal": "XYZ", "Position": "XYZ", "DiffCol": "RGB"}
     return {layer: np.stack([channels[f"{layer}.{c}"] for c in letters], -1) for layer, letters in wanted.items()
             if f"{layer}.{letters[0]}" in channels}
 
@@ -176,17 +176,22 @@ def main() -> None:
     objects = layout()
     with tempfile.TemporaryDirectory(prefix="dust-") as temp:
         look_scene = hybridgen_scene(objects, size, weight_mode=False)
-        cycles_look = render_cycles(objects, look_scene, "look", ns.spp, Path(temp))["Combined"][..., :3]
+        look = render_cycles(objects, look_scene, "look", ns.spp, Path(temp))
         weights = render_cycles(objects, look_scene, "weight", 1, Path(temp))
     from principled_vs_cycles import render_hybridgen
 
+    import hybridgen as hg
+    from hybridgen.render.raster.albedo_pass import AlbedoPass
+
     ours_look, _ = render_hybridgen(look_scene, "blender", ns.spp, 3)
+    ours_albedo = AlbedoPass(hg.RasterView(look_scene)).render(look_scene.camera.keypoints[0])
     masks, _ = object_masks(look_scene)
-    print(f"{'object':12s} {'Cycles mean RGB':>26s}   hybridgen / Cycles")
+    print(f"{'object':12s} {'Cycles mean RGB':>26s}   hybridgen / Cycles   albedo / Cycles' DiffCol")
     for name, mask in masks.items():
-        theirs, ours = cycles_look[mask].mean(0), ours_look[mask].mean(0)
+        theirs, ours = look["Combined"][..., :3][mask].mean(0), ours_look[mask].mean(0)
+        albedo = ours_albedo[mask].mean(0) / look["DiffCol"][mask].mean(0)
         print(f"{name:12s} {' '.join(f'{c:8.4f}' for c in theirs)}   {' '.join(f'{r:6.3f}' for r in ours / theirs)}"
-              f"   ({mask.sum()} px)")
+              f"   {' '.join(f'{r:6.3f}' for r in albedo)}   ({mask.sum()} px)")
     report_weights(objects, look_scene, weights, ns.store)
 
 
