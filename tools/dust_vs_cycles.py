@@ -9,8 +9,10 @@ scale 0.1 (0.05 on the flipped square, the dust example's), under a sun 55 degre
 runs through tools/dust_cycles_scene.py in ``.venv-blenderproc`` with BlenderProc's own ``add_dust``.
 
 Printed, per object: (1) the mean linear radiance hybridgen / Cycles per channel (both converged estimates at
-``--spp``, equal bounces, no clamp, no denoising; pixels well inside each object, from an analytic ray cast);
-(2) the dust weight w: Cycles' exact w at one sample per pixel (its BSDFs replaced by black and white emission)
+``--spp``, equal bounces, no clamp, no denoising; pixels well inside each object, from an analytic ray cast),
+and hybridgen's raster albedo over Cycles' DiffCol pass (the base's own share differs already without dust:
+hybridgen's albedo is the base color, Cycles' diffuse color what its specular layer leaves; pixel centres against
+pixel areas of a sub-pixel pattern add about 1.5 %); (2) the dust weight w: Cycles' exact w at one sample per pixel (its BSDFs replaced by black and white emission)
 against hybridgen's at the same points (rays from the camera to Cycles' Position pass, the dust BSDF's
 ``eval_diffuse_reflectance`` with a black base and a white dust color) - mean w and the share of "dusty" points
 (w >= 0.6 x strength: the flakes) on up-facing (normal z > 0.8) and side-facing (|z| < 0.35) parts, and the
