@@ -3,8 +3,12 @@
 Blender gives such a body Bullet's GImpact shape: every triangle of the mesh collides, inflated by the collision
 margin, with no volume of its own. PyBullet has no GImpact shape and takes concave triangle meshes only for
 static bodies, so hybridgen builds the same thing from what it does take: a compound with one convex piece per
-triangle (the triangle itself, inflated by the margin as Bullet inflates every convex shape) - the contact
-surface is the mesh's own triangles, holes, cavities and thin walls included (no convex decomposition).
+triangle - the contact surface is the mesh's own triangles, holes, cavities and thin walls included (no convex
+decomposition). Each piece is a prism: the triangle in front and a copy moved back against its normal, halfway
+to the mesh's surface behind it (a solidified shell: half its thickness) and at most a tenth of the mesh's size.
+Flat pieces (GImpact's triangles) let a fast body sink into a floor and stay there (measured: a 0.4 m cube
+dropped 0.6 m at Blender's 240 Hz ended 3 mm into the floor, tilted); prisms give Bullet a depth to push back
+from (the same cube rests 2.0 mm above it, the two 1 mm margins, as its convex hull does).
 
 Mass properties follow Blender: the centre of mass is the surface centroid (area-weighted; BlenderProc moves
 every rigid body's origin there before simulating) and the inertia is GImpact's - the mass shared equally by the
@@ -20,6 +24,11 @@ from .shapes import CollisionGeometry
 
 KIND = "triangles"
 """The :class:`~hybridgen.physics.shapes.CollisionGeometry` kind of such a body: one convex piece per triangle."""
+DEPTH_SHARE = 0.5
+"""A triangle's piece reaches this share of the way to the mesh's opposite side behind it."""
+MAX_DEPTH = 0.1
+"""... and at most this share of the mesh's bounding-box diagonal (also when nothing is behind it)."""
+_PRISM_FACES = np.array([[0, 1, 2], [3, 5, 4], [0, 3, 4], [0, 4, 1], [1, 4, 5], [1, 5, 2], [2, 5, 3], [2, 3, 0]])
 
 
 def _volume(vertices: np.ndarray, faces: np.ndarray) -> float:
@@ -34,6 +43,24 @@ def _volume(vertices: np.ndarray, faces: np.ndarray) -> float:
             return float(mesh.convex_hull.volume)
     except Exception:  # noqa: BLE001 - a flat or degenerate hull (qhull's errors vary): no volume
         return 0.0
+
+
+def prisms(triangles: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """One convex piece per triangle (T, 3, 3): the triangle and its copy moved back against its normal (into the
+    solid) by :data:`DEPTH_SHARE` of the distance to the mesh behind it, at most :data:`MAX_DEPTH` of the mesh's
+    size - the front face is the mesh's own triangle."""
+    from ..scene.ray_casting import RayCaster
+
+    normals = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    points = triangles.reshape(-1, 3)
+    cap = MAX_DEPTH * float(np.linalg.norm(np.ptp(points, axis=0)))
+    centres = triangles.mean(axis=1)
+    hits = RayCaster([(points, np.arange(len(points)).reshape(-1, 3))]).cast(centres - normals * (1e-9 * cap), -normals)
+    behind = np.where(hits.hit, hits.distance, np.inf)
+    depth = np.minimum(DEPTH_SHARE * behind, cap)[:, None, None]
+    backs = triangles - depth * normals[:, None, :]
+    return [(np.concatenate([front, back]), _PRISM_FACES) for front, back in zip(triangles, backs)]
 
 
 def triangle_geometry(vertices: np.ndarray, faces: np.ndarray, linear: np.ndarray | None = None,
@@ -59,5 +86,5 @@ def triangle_geometry(vertices: np.ndarray, faces: np.ndarray, linear: np.ndarra
     if volume <= 0 and needs_volume:
         raise InputError("its mesh encloses no volume and its convex hull is flat: give it a mass")
     scale = volume if volume > 0 else 1.0
-    parts = [(triangle, np.array([[0, 1, 2]])) for triangle in corners[keep]]
+    parts = prisms(corners[keep])
     return CollisionGeometry(KIND, parts, scale, centre, per_unit_mass * scale)
