@@ -7,6 +7,7 @@ import dataclasses
 import numpy as np
 
 from ..config.displacement_config import displacement_from_config
+from ..config.dust_config import dust_layer, with_dust
 from ..config.material_config import apply_material_config
 from ..config.registry import register_module
 from ..config.schema import Param
@@ -36,6 +37,9 @@ class MaterialManipulator(SelectingModule):
         Param("color_link_to_displacement", "float|null", None, "m", sampleable=True,
               doc="BlenderProc's cf_color_link_to_displacement: the material's base-color image becomes its "
                   "displacement (bump) map, scaled by this factor"),
+        Param("dust", "dict|null", None, sampleable=True,
+              doc="BlenderProc's cf_add_dust: a dust film over the material, {strength, texture_scale: 0.1, "
+                  "texture: null (generated noise) or an image path / getter.Texture} (hybridgen/scene/dust.py)"),
     )
 
     def run(self, context: RunContext) -> None:
@@ -50,6 +54,9 @@ class MaterialManipulator(SelectingModule):
             factor = self.value(context, "color_link_to_displacement")
             if factor is not None:
                 obj.material = linked_displacement(obj.material, float(factor), obj.name)
+            dust = self.value(context, "dust")
+            if dust is not None:
+                obj.material = with_dust(obj.material, dust_layer(dust, context.rng, context.scene.textures))
 
 
 def linked_displacement(material: Material, factor: float, owner: str) -> Material:

@@ -120,6 +120,12 @@ def material(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, An
                         "color (a mesh with vertex colors has it from loading); BlenderProc renders them unlit "
                         "(a Background shader)")
             continue
+        if function == "add_dust":  # {strength, texture_scale, used_dust_texture} -> dust (config/dust_config.py)
+            dust = dict(cfg.pop(key) or {})
+            if "used_dust_texture" in dust:
+                dust["texture"] = dust.pop("used_dust_texture")
+            cfg["dust"] = dust
+            continue
         if function == "switch_to_emission_shader":
             emission = cfg.pop(key) or {}
             color = emission.get("color", [1.0, 1.0, 1.0, 1.0]) if isinstance(emission, dict) else [1, 1, 1, 1]

@@ -1,0 +1,60 @@
+"""A config's dust film (``manipulators.MaterialManipulator``'s ``dust``, BlenderProc 1.x's ``cf_add_dust``) as a
+:class:`~hybridgen.scene.dust.Dust` layer on a material: ``{strength, texture_scale: 0.1, texture: null}``, where
+``texture`` is an image path or a list of them (``getter.Texture``'s result; one is drawn, as BlenderProc draws
+one of its textures) read as sRGB unless the scene's texture of that path is tagged otherwise."""
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..errors import ConfigError
+from ..scene.dust import Dust
+from ..scene.image_texture import ImageTexture
+from ..scene.material import Material
+
+KEYS = ("strength", "texture_scale", "texture")
+DATA_SPACES = ("Non-Color", "Raw", "Linear")
+"""Texture color spaces read as stored (the others as sRGB)."""
+
+
+def _number(value: Any, key: str) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        number = math.nan
+    if not math.isfinite(number):
+        raise ConfigError(f"must be a finite number, got {value!r}", key=f"dust.{key}")
+    return number
+
+
+def dust_layer(value: dict[str, Any], rng: np.random.Generator, textures: Sequence[ImageTexture] = ()) -> Dust:
+    """The layer a config's ``dust`` mapping describes (a path list is drawn from with ``rng``)."""
+    if not isinstance(value, dict) or "strength" not in value:
+        raise ConfigError("must be a mapping with strength (and texture_scale, texture)", key="dust")
+    unknown = sorted(set(value) - set(KEYS))
+    if unknown:
+        raise ConfigError(f"unknown key(s) {unknown} (known: {', '.join(KEYS)})", key="dust")
+    texture = value.get("texture")
+    if isinstance(texture, (list, tuple)):
+        if not texture:
+            raise ConfigError("is an empty list of textures", key="dust.texture")
+        texture = texture[int(rng.integers(len(texture)))]
+    srgb = True
+    if texture is not None:
+        path = Path(str(texture))
+        if not path.is_file():
+            raise ConfigError(f"no such image file: {path}", key="dust.texture")
+        spaces = [t.colorspace for t in textures if Path(t.path).resolve() == path.resolve()]
+        srgb = not spaces or spaces[0] not in DATA_SPACES
+        texture = str(path)
+    return Dust(_number(value["strength"], "strength"), _number(value.get("texture_scale", 0.1), "texture_scale"),
+                texture, srgb)
+
+
+def with_dust(material: Material, layer: Dust) -> Material:
+    """A copy of ``material`` with ``layer`` over its dust films."""
+    return dataclasses.replace(material, dust=(*material.dust, layer), extra=dict(material.extra))
