@@ -6,7 +6,8 @@ hybridgen's :class:`~hybridgen.PathTraceSettings` reads Cycles' settings; ``set_
 limits (max, diffuse, glossy, transmission; the AO, transparency and volume limits change nothing hybridgen
 renders); ``set_denoiser`` ``INTEL`` (default) or ``OPTIX`` denoise with Open Image Denoise, None renders the
 raw estimate. Settings that only change speed (threads, devices, light tree) are accepted;
-``set_simplify_subdivision_render`` gives a notice (no subdivision surfaces here). ``render()`` itself is
+``set_simplify_subdivision_render`` limits the levels of Subdivision Surface modifiers added after it (they are
+applied when added: :mod:`hybridgen.bproc.types.modifiers`). ``render()`` itself is
 :func:`hybridgen.bproc.render_frames.render_frames`; ``render_optical_flow`` and ``render_nocs`` are
 :mod:`hybridgen.bproc.label_renders`.
 """
@@ -14,7 +15,6 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..config.notices import notice
 from ..errors import InputError
 from .render_frames import render_frames
 from .session import SESSION
@@ -178,9 +178,12 @@ set_cpu_threads = set_render_devices = toggle_light_tree = enable_experimental_f
 
 
 def set_simplify_subdivision_render(simplify_subdivision_render: int) -> None:
-    """Blender's subdivision limit for renders: hybridgen's meshes have no subdivision modifiers (a notice)."""
-    notice("bproc.renderer.set_simplify_subdivision_render has no meaning in hybridgen (meshes have no "
-           "subdivision modifiers); nothing changes")
+    """Blender's Simplify limit on subdivision render levels (0: no limit; BlenderProc's init sets 3). hybridgen
+    applies a Subdivision Surface modifier when it is added, so the limit holds for modifiers added later."""
+    value = int(simplify_subdivision_render)
+    if value < 0:
+        raise InputError(f"bproc.renderer.set_simplify_subdivision_render: the limit must be at least 0, got {value}")
+    SESSION.renderer.simplify_subdivision_render = value
 
 
 def toggle_stereo(enable: bool) -> None:

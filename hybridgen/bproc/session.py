@@ -84,6 +84,8 @@ class RendererSettings:
     jpg_quality: int = 95
     transparent: bool = False
     view_transform: str = "Filmic"
+    simplify_subdivision_render: int = 3
+    """Blender's Simplify limit on Subdivision Surface render levels (0: none), read when a modifier is added."""
     outputs: dict[str, dict[str, Any]] = field(default_factory=dict)
     """Enabled label outputs by kind (``depth``, ``distance``, ``normals``, ``segmentation``, ``diffuse``):
     each kind's options (``output_key``, ``antialiasing``, ``map_by``, ``default_values`` ...)."""

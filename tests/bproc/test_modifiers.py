@@ -134,3 +134,20 @@ def test_modifier_errors_are_one_line(bproc) -> None:  # noqa: F811
     with pytest.raises(InputError, match="boundary_smooth"):
         cube.add_modifier("SUBSURF", boundary_smooth="PRESERVE_CORNERS")
     assert cube.parts[0].vertices is before  # nothing applied
+
+
+def test_simplify_limits_subdivision_levels(bproc) -> None:  # noqa: F811
+    def vertex_count(obj) -> int:
+        return len(np.unique(np.concatenate([part.vertices for part in obj.parts]), axis=0))
+
+    capped = bproc.object.create_primitive("CUBE")
+    capped.add_modifier("SUBSURF", render_levels=5)  # BlenderProc's init limits renders to 3 levels
+    assert vertex_count(capped) == 386  # Blender's cube at level 3
+    bproc.renderer.set_simplify_subdivision_render(1)
+    once = bproc.object.create_primitive("CUBE")
+    once.add_modifier("SUBSURF", render_levels=2)
+    assert vertex_count(once) == 26
+    bproc.renderer.set_simplify_subdivision_render(0)  # no limit
+    four = bproc.object.create_primitive("CUBE")
+    four.add_modifier("SUBSURF", render_levels=4)
+    assert vertex_count(four) == 6 * 16 * 16 + 2

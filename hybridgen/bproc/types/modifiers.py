@@ -7,8 +7,9 @@ Each is evaluated as Blender evaluates it for a render (:mod:`hybridgen.scene.ca
 (:mod:`hybridgen.scene.polygon_mesh`): a mesh read from an OBJ with quads or n-gons gets its polygons back from
 the triangles (:mod:`hybridgen.scene.polygon_recovery`); one from an all-triangle OBJ, PLY, STL or glTF keeps its
 triangles. Consecutive modifiers share the polygon mesh, as a modifier stack does. SUBSURF subdivides
-``render_levels`` times (what Blender renders), at most 3 (BlenderProc 2.8 sets Blender's "Simplify" limit of 3);
-``subdivision_type`` SIMPLE subdivides without smoothing.
+``render_levels`` times (what Blender renders), at most ``bproc.renderer.set_simplify_subdivision_render``'s
+limit (BlenderProc 2.8's init sets Blender's "Simplify" to 3); ``subdivision_type`` SIMPLE subdivides without
+smoothing.
 
 Differences: the modifier is applied at once, so a later change of the base mesh (a persisted transformation,
 ``set_shading_mode``) does not re-run it, and setting a modifier's attributes later changes nothing; UVs are
@@ -30,8 +31,6 @@ from .unsupported import fail
 if TYPE_CHECKING:
     from ...scene.polygon_mesh import PolygonMesh
 
-SIMPLIFY_SUBDIVISION_RENDER = 3
-"""BlenderProc 2.8's ``bproc.init`` caps render subdivision at 3 levels (Blender's Simplify)."""
 SETTINGS: dict[str, dict[str, Any]] = {
     "SUBSURF": {"levels": 1, "render_levels": 2, "subdivision_type": "CATMULL_CLARK", "use_limit_surface": True,
                 "quality": 3, "boundary_smooth": "ALL", "uv_smooth": "PRESERVE_BOUNDARIES", "use_creases": True,
@@ -137,8 +136,11 @@ def _subsurf(obj: MeshModifiers, mesh: "PolygonMesh", s: dict[str, Any], call: s
     levels = int(s["render_levels"])
     if levels < 0:
         raise InputError(f"{call}: render_levels must be at least 0, got {levels}")
+    from ..session import SESSION
+
     smooth = s["subdivision_type"] == "CATMULL_CLARK"
-    return subdivide(mesh, min(levels, SIMPLIFY_SUBDIVISION_RENDER), limit=bool(s["use_limit_surface"]) and smooth,
+    limit = SESSION.renderer.simplify_subdivision_render
+    return subdivide(mesh, min(levels, limit) if limit > 0 else levels, limit=bool(s["use_limit_surface"]) and smooth,
                      smooth=smooth)
 
 
