@@ -3,26 +3,18 @@
 rendered: :mod:`hybridgen.scene.dust`, :mod:`hybridgen.render.pathtrace.dust_mix`)."""
 from __future__ import annotations
 
-import math
 import random
 import warnings
 from typing import Any, Sequence
 
 from ..errors import InputError
-from ..scene.dust import Dust
+from ..scene.dust import DATA_SPACES, SRGB_SPACES, Dust, finite_number, reads_as_srgb
 from .types import Material
-
-SRGB_SPACES = ("sRGB",)
-DATA_SPACES = ("Non-Color", "Raw", "Linear")
-"""Image color spaces a dust texture may carry: decoded from sRGB, or read as stored."""
 
 
 def _number(value: Any, name: str) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        number = math.nan
-    if not math.isfinite(number):
+    number = finite_number(value)
+    if number is None:
         raise InputError(f"bproc.material.add_dust: {name} must be a finite number, got {value!r}")
     return number
 
@@ -34,10 +26,11 @@ def _texture(node: Any) -> tuple[str, bool]:
         raise InputError(f"bproc.material.add_dust: texture_nodes holds {node!r}, which has no image file "
                          "(textures of bproc.loader.load_texture are)")
     space = str(getattr(node, "colorspace", "sRGB"))
-    if space not in SRGB_SPACES + DATA_SPACES:
+    srgb = reads_as_srgb(space)
+    if srgb is None:
         raise InputError(f"bproc.material.add_dust: a dust texture in color space {space!r} is not supported by "
                          f"hybridgen yet (supported: {', '.join(SRGB_SPACES + DATA_SPACES)})")
-    return str(path), space in SRGB_SPACES
+    return str(path), srgb
 
 
 def add_dust(material: Material, strength: float, texture_nodes: Sequence[Any] | None = None,

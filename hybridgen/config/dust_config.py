@@ -5,28 +5,22 @@ one of its textures) read as sRGB unless the scene's texture of that path is tag
 from __future__ import annotations
 
 import dataclasses
-import math
 from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
 
 from ..errors import ConfigError
-from ..scene.dust import Dust
+from ..scene.dust import DATA_SPACES, SRGB_SPACES, Dust, finite_number, reads_as_srgb
 from ..scene.image_texture import ImageTexture
 from ..scene.material import Material
 
 KEYS = ("strength", "texture_scale", "texture")
-DATA_SPACES = ("Non-Color", "Raw", "Linear")
-"""Texture color spaces read as stored (the others as sRGB)."""
 
 
 def _number(value: Any, key: str) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        number = math.nan
-    if not math.isfinite(number):
+    number = finite_number(value)
+    if number is None:
         raise ConfigError(f"must be a finite number, got {value!r}", key=f"dust.{key}")
     return number
 
@@ -48,9 +42,12 @@ def dust_layer(value: dict[str, Any], rng: np.random.Generator, textures: Sequen
         path = Path(str(texture))
         if not path.is_file():
             raise ConfigError(f"no such image file: {path}", key="dust.texture")
-        spaces = [t.colorspace for t in textures if Path(t.path).resolve() == path.resolve()]
-        srgb = not spaces or spaces[0] not in DATA_SPACES
-        texture = str(path)
+        spaces = [t.colorspace for t in textures if Path(t.path).resolve() == path.resolve()] or ["sRGB"]
+        read = reads_as_srgb(spaces[0])
+        if read is None:
+            raise ConfigError(f"a dust texture in color space {spaces[0]!r} is not supported (supported: "
+                              f"{', '.join(SRGB_SPACES + DATA_SPACES)})", key="dust.texture")
+        srgb, texture = read, str(path)
     return Dust(_number(value["strength"], "strength"), _number(value.get("texture_scale", 0.1), "texture_scale"),
                 texture, srgb)
 

@@ -9,7 +9,8 @@ point computed as the node group BlenderProc builds computes it in Cycles:
 4. the pattern ``T``: Blender's Noise Texture (:mod:`.gradient_noise`; scale 250, detail 0, roughness 0,
    distortion 1.9) of the point ``(u, v, 0) / texture_scale`` in UV space (Texture Coordinate "UV" through a
    Mapping node of type Texture, which divides by its scale; without UVs Cycles reads (0, 0, 0): one value
-   everywhere), through a two-stop ramp: 1 (white) below 0.4, 0 (black) above 0.46, linear between - flakes.
+   everywhere), through a two-stop ramp: 1 (white) below 0.4, 0 (black) above 0.46, linear between (as Cycles'
+   256-entry ramp table, interpolated) - flakes.
    With a texture image instead, T is its linear RGB at ``(u, v) / texture_scale`` (bilinear, repeating);
 5. ``o = overlay(g, T)``: ``2 g T`` where g < 0.5, else ``1 - 2 (1 - g)(1 - T)`` (per channel; a color becomes
    a number as Cycles converts it, by Rec. 709 luminance);
@@ -22,6 +23,7 @@ material twice nests a second group around the first: the layers of :attr:`Mater
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -34,9 +36,30 @@ NOISE = {"scale": 250.0, "detail": 0.0, "roughness": 0.0, "distortion": 1.9}
 """The dust pattern's Noise Texture settings."""
 RAMP = (0.4, 0.46)
 """The pattern ramp's stops: white (dust) at and below the first, black above the second."""
+RAMP_TABLE = 256
+"""Entries of the lookup table Cycles bakes a color ramp into."""
 UP_SHARE, GAMMA = 0.8, 2.2
 LUMINANCE = (0.2126, 0.7152, 0.0722)
 """Rec. 709 luminance weights: Cycles' color -> number conversion in linear sRGB."""
+SRGB_SPACES, DATA_SPACES = ("sRGB",), ("Non-Color", "Raw", "Linear")
+"""Image color spaces a dust texture may carry: decoded from sRGB, or read as stored."""
+
+
+def finite_number(value: Any) -> float | None:
+    """``value`` as a finite float, or None when it is none."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return None
+    return number if math.isfinite(number) else None
+
+
+def reads_as_srgb(colorspace: str) -> bool | None:
+    """Whether a texture tagged ``colorspace`` is decoded from sRGB (True) or read as stored (False); None for a
+    color space dust textures do not take."""
+    if colorspace in SRGB_SPACES:
+        return True
+    return False if colorspace in DATA_SPACES else None
 
 
 @dataclass(frozen=True)
@@ -69,9 +92,22 @@ def pattern_coordinates(ops: ArrayOps, u: Any, v: Any, texture_scale: float) -> 
 def noise_pattern(ops: ArrayOps, u: Any, v: Any, texture_scale: float) -> Any:
     """Step 4 without a texture: the ramped noise (1 dust flake, 0 none) at the UV point (u, v)."""
     x, y = pattern_coordinates(ops, u, v, texture_scale)
-    value = noise_texture(ops, x, y, 0.0 * x, **NOISE)
+    return ramp(ops, noise_texture(ops, x, y, 0.0 * x, **NOISE))
+
+
+def ramp(ops: ArrayOps, value: Any) -> Any:
+    """The pattern ramp as Cycles evaluates a color ramp: its table of :data:`RAMP_TABLE` entries (the ramp at
+    i / (entries - 1)), interpolated linearly."""
     low, high = RAMP
-    return ops.clip((high - value) * (1.0 / (high - low)), 0.0, 1.0)
+    last = RAMP_TABLE - 1
+    position = ops.clip(value, 0.0, 1.0) * float(last)
+    index = ops.floor(position)
+    t = position - index
+
+    def stop(i: Any) -> Any:
+        return ops.clip((high - i * (1.0 / last)) * (1.0 / (high - low)), 0.0, 1.0)
+
+    return (1.0 - t) * stop(index) + t * stop(ops.clip(index + 1.0, 0.0, float(last)))
 
 
 def overlay(ops: ArrayOps, g: Any, pattern: Any) -> Any:

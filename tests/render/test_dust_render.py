@@ -175,3 +175,21 @@ def test_white_furnace(jit_variant: str) -> None:
     expected = 1.0 - 0.5 * _pixel_weights(scene, gray_layer)
     ratio = gray[..., 0] / plain[..., 0]
     assert np.all(ratio <= 1.0 + 1e-5) and np.abs(ratio - expected).mean() < 0.02 and ratio.min() < 0.8
+
+
+def test_scalar_variant_stops_with_one_line() -> None:
+    import mitsuba
+
+    from hybridgen.errors import InputError
+    from hybridgen.render.pathtrace.mitsuba_materials import bsdf_dict
+
+    previous = mitsuba.variant()
+    mitsuba.set_variant("scalar_rgb")
+    try:
+        with pytest.raises(InputError, match="JIT variants only") as raised:
+            bsdf_dict(Material(name="dusty", dust=(Dust(0.5),)), "square")
+        assert "\n" not in str(raised.value)
+        assert bsdf_dict(Material(name="clean", dust=(Dust(0.0),)), "square")["type"] == "twosided"
+    finally:
+        if previous:
+            mitsuba.set_variant(previous)
