@@ -96,12 +96,14 @@ def test_mix_albedo_is_the_weighted_sum_and_never_above_one(mi, mu: float) -> No
         assert np.all(albedo <= 1.0 + 4 * error)
 
 
-def _square(material: Material, size: tuple[int, int] = (48, 48)):
+def _square(material: Material, size: tuple[int, int] = (48, 48), down: bool = False):
+    """A 2 m square at z = 0 with UV 0..1 over it, wound facing up (or down), lit straight from above."""
     import hybridgen as hg
 
     vertices = np.array([[-1.0, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]])
+    faces = np.array([[0, 2, 1], [0, 3, 2]]) if down else np.array([[0, 1, 2], [0, 2, 3]])
     scene = hg.Scene()
-    scene.add(hg.MeshObject(name="square", vertices=vertices, faces=np.array([[0, 1, 2], [0, 2, 3]]),
+    scene.add(hg.MeshObject(name="square", vertices=vertices, faces=faces,
                             uvs=np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]]), material=material))
     scene.world.strength = 0.0
     scene.add_light(hg.Light("sun", "SUN", energy=3.0, local2world=np.eye(4)))
@@ -135,10 +137,12 @@ def _pixel_weights(scene, layer: Dust, sub: int = 4) -> np.ndarray:
     return total / sub ** 2
 
 
-@pytest.mark.parametrize("strength", [1.0, 0.5])
-def test_dusty_square_moves_toward_dust_by_the_weight(jit_variant: str, strength: float) -> None:
+@pytest.mark.parametrize("strength, down", [(1.0, False), (0.5, False), (1.0, True)])
+def test_dusty_square_moves_toward_dust_by_the_weight(jit_variant: str, strength: float, down: bool) -> None:
+    """(``down``: wound facing down but seen from above, the normal turned toward the viewer gets dust, as in
+    Cycles.)"""
     layer = Dust(strength, texture_scale=20.0)  # 12.5 noise cells across: flakes several pixels wide
-    scene = _square(Material(base_color=(*BASE, 1), specular=0.0, dust=(layer,)))
+    scene = _square(Material(base_color=(*BASE, 1), specular=0.0, dust=(layer,)), down=down)
     image = _render(scene, jit_variant)
     w = _pixel_weights(scene, layer)[..., None]
     irradiance = 3.0 / math.pi
