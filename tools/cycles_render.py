@@ -58,9 +58,14 @@ def _material(name: str, spec: dict, texture: np.ndarray | None = None) -> bpy.t
         surface.inputs["Specular IOR Level"].default_value = spec["specular"]
         surface.inputs["Transmission Weight"].default_value = spec.get("transmission", 0.0)
         surface.inputs["IOR"].default_value = spec.get("ior", 1.45)
-        for key, value in spec.get("extra", {}).items():  # Principled inputs beyond hybridgen's Material fields
-            name = key.replace("_", " ").title().replace("Ior", "IOR")  # coat_ior -> "Coat IOR"
-            surface.inputs[name].default_value = (*value, 1.0) if isinstance(value, list) else value
+        extra = dict(spec.get("extra", {}))  # Principled inputs beyond hybridgen's Material fields
+        if "subsurface_method" in extra:  # a node property, not an input
+            surface.subsurface_method = extra.pop("subsurface_method")
+        sockets = {socket.name: socket for socket in surface.inputs}  # unavailable ones too (Subsurface IOR)
+        for key, value in extra.items():
+            socket = sockets[key.replace("_", " ").title().replace("Ior", "IOR")]  # coat_ior -> "Coat IOR"
+            rgba = isinstance(value, list) and len(socket.default_value) == 4  # colors; Subsurface Radius is XYZ
+            socket.default_value = (*value, 1.0) if rgba else value
     if texture is not None:  # sRGB uint8 H x W x 3, sampled with the mesh's UV map
         image = bpy.data.images.new(name + "_texture", texture.shape[1], texture.shape[0], alpha=True)
         rgba = np.concatenate([texture[::-1] / 255.0, np.ones(texture.shape[:2] + (1,))], axis=-1)

@@ -23,9 +23,18 @@ Tables (dimensionless):
   energy-compensated GGX reflection lobe is F0 + (1 - F0) s: the mean over visible normals h of
   (F(h.wi, eta) - F0) / (1 - F0), counting normals whose mirror direction leaves the surface only.
 - ``fresnel_avg[z]``: 2 int F(mu, eta) mu dmu, the dielectric Fresnel's cosine-weighted average.
+- ``sheen_a[mu, rough]``, ``sheen_b``, ``sheen_R``: Blender 4.2's sheen lobe (Zeltner, Burley & Chiang 2022,
+  a linearly transformed cosine): BSDF x cosine = R D(wo) with D the cosine lobe transformed by the inverse
+  matrix [[a, 0, b], [0, a, 0], [0, 0, 1]] in the sheen frame (x: the view direction projected on the surface,
+  z: the normal), i.e. D = z a^2 / (pi ((a x + b z)^2 + a^2 y^2 + z^2)^2), and R the lobe's albedo. Axes: mu
+  and Sheen Roughness, 65 nodes each (i / 64). Fitted here (:func:`fit_sheen`) to Cycles' own lobe measured by
+  tools/principled_sheen_cycles.py (``--sheen MEASUREMENTS.npz``) on a lattice twice as fine: at each measured
+  point R is the furnace albedo and (a, b) the least-squares LTC through the lobe's values for 256 light
+  directions; each table is then the least-squares bilinear fit of those points. Without ``--sheen`` the stored
+  sheen tables are kept as they are.
 
-Usage: ``.venv/bin/python tools/principled_tables.py [--samples 128]`` (samples per axis of the stratified
-quadrature; 128 -> 16384 per node, about a minute on 2 cores).
+Usage: ``.venv/bin/python tools/principled_tables.py [--samples 128] [--sheen MEASUREMENTS.npz]`` (samples per
+axis of the stratified quadrature; 128 -> 16384 per node, about a minute on 2 cores).
 """
 from __future__ import annotations
 
@@ -147,12 +156,115 @@ def generate(n: int) -> dict[str, np.ndarray]:
     return {key: np.clip(value, 0.0, 1.0).astype(np.float32) for key, value in tables.items()}
 
 
+SHEEN_KEYS = ("sheen_a", "sheen_b", "sheen_R")
+
+
+def sheen_quad_frame(mu: np.ndarray) -> np.ndarray:
+    """The sheen frames (N, 3 axes, 3) of tools/principled_sheen_cycles.py's quads in world axes: rows x (the
+    view direction +Z projected on the quad), y = z cross x, z (the normal, tilted from +Z towards -Y by
+    acos(mu))."""
+    sin = np.sqrt(1.0 - mu * mu)
+    normal = np.stack([np.zeros_like(mu), -sin, mu], axis=1)
+    tangent = np.stack([np.zeros_like(mu), mu, sin], axis=1)
+    return np.stack([tangent, np.cross(normal, tangent), normal], axis=1)
+
+
+def sheen_frame_lights(mu: np.ndarray, directions: np.ndarray) -> np.ndarray:
+    """World ``directions`` (L, 3) in the sheen frame of each quad of view cosine ``mu`` (N,): (L, N, 3)."""
+    return np.einsum("nij,lj->lni", sheen_quad_frame(mu), directions)
+
+
+def sheen_lobe(a: np.ndarray, b: np.ndarray, light: np.ndarray) -> np.ndarray:
+    """The normalized LTC lobe D (sr^-1 x cosine) at local directions ``light`` (..., 3)."""
+    x, y, z = light[..., 0], light[..., 1], light[..., 2]
+    length2 = np.square(a * x + b * z) + np.square(a * y) + z * z
+    return np.where(z > 0, z * np.square(a / np.maximum(length2, 1e-30)) / np.pi, 0.0)
+
+
+def fit_ltc(light: np.ndarray, value: np.ndarray, albedo: float,
+            start: tuple[float, float] | None = None) -> tuple[float, float]:
+    """(a, b) of the LTC lobe whose ``albedo`` x D best fits ``value`` at ``light`` (relative least squares;
+    from ``start`` when it fits to 1e-4 of the peak, else the best of several starts)."""
+    from scipy.optimize import least_squares
+
+    up = light[:, 2] > 0
+    light, value = light[up], value[up]
+    scale = max(float(value.max()), 1e-20)
+
+    def solve(a0: float, b0: float) -> object:
+        return least_squares(lambda p: (albedo * sheen_lobe(p[0], p[1], light) - value) / scale, [a0, b0],
+                             bounds=([1e-5, -50.0], [100.0, 50.0]))
+
+    best = solve(*start) if start is not None else None
+    if best is None or np.abs(best.fun).max() > 1e-4:
+        for a0 in (0.03, 0.3, 1.0, 3.0):
+            for b0 in (-1.0, 0.0, 1.0):
+                result = solve(a0, b0)
+                if best is None or result.cost < best.cost:
+                    best = result
+    return float(best.x[0]), float(best.x[1])
+
+
+def bilinear_fit(mu: np.ndarray, rough: np.ndarray, values: np.ndarray, weights: np.ndarray,
+                 nodes: int) -> np.ndarray:
+    """The ``nodes`` x ``nodes`` table [mu, rough] whose bilinear interpolation (the BSDF's lookup) best fits
+    ``values`` at the points (``mu``, ``rough``) in weighted least squares."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.linalg import lsqr
+
+    rows, columns, entries = [], [], []
+    fy, fx = mu * (nodes - 1), rough * (nodes - 1)
+    y0, x0 = np.minimum(np.floor(fy), nodes - 2).astype(int), np.minimum(np.floor(fx), nodes - 2).astype(int)
+    ty, tx = fy - y0, fx - x0
+    for dy, wy in ((0, 1.0 - ty), (1, ty)):
+        for dx, wx in ((0, 1.0 - tx), (1, tx)):
+            rows.append(np.arange(mu.size))
+            columns.append((y0 + dy) * nodes + x0 + dx)
+            entries.append(wy * wx * weights)
+    matrix = coo_matrix((np.concatenate(entries), (np.concatenate(rows), np.concatenate(columns))),
+                        shape=(mu.size, nodes * nodes)).tocsr()
+    return lsqr(matrix, values * weights, atol=1e-12, btol=1e-12, iter_lim=100000)[0].reshape(nodes, nodes)
+
+
+SHEEN_NODES = 65
+"""Nodes per axis of the sheen tables (mu and Sheen Roughness, i / 64)."""
+
+
+def fit_sheen(path: Path) -> dict[str, np.ndarray]:
+    """The sheen tables (``sheen_a``, ``sheen_b``, ``sheen_R``, [mu, rough], :data:`SHEEN_NODES` squared) fitted
+    to Cycles' measurements in ``path`` (tools/principled_sheen_cycles.py's output; its lattice quads, role 0):
+    per measured point R is the furnace albedo and (a, b) the LTC through the lobe's values (:func:`fit_ltc`);
+    each table is the least-squares bilinear fit of those points (:func:`bilinear_fit`), a and b weighted by
+    the albedo (they shape a lobe of that weight)."""
+    data = np.load(path)
+    grid = data["role"] == 0
+    mu, rough = data["mu"][grid].astype(np.float64), data["rough"][grid].astype(np.float64)
+    albedo, value = data["albedo"][grid].astype(np.float64), data["value"][:, grid].astype(np.float64)
+    light = sheen_frame_lights(mu, data["directions"].astype(np.float64))
+    fits, start = np.zeros((mu.size, 2)), None
+    for k in range(mu.size):  # row by row along roughness: each fit starts from its neighbour's
+        start = fit_ltc(light[:, k], value[:, k], albedo[k], start if k and mu[k] == mu[k - 1] else None)
+        fits[k] = start
+    weights = albedo + 1e-4
+    tables = {"sheen_a": np.maximum(bilinear_fit(mu, rough, fits[:, 0], weights, SHEEN_NODES), 1e-5),
+              "sheen_b": bilinear_fit(mu, rough, fits[:, 1], weights, SHEEN_NODES),
+              "sheen_R": np.clip(bilinear_fit(mu, rough, albedo, np.ones_like(albedo), SHEEN_NODES), 0.0, 1.0)}
+    return {key: value.astype(np.float32) for key, value in tables.items()}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--samples", type=int, default=128, help="stratified samples per axis and node")
+    parser.add_argument("--sheen", type=Path, help="refit the sheen tables to these Cycles measurements "
+                        "(tools/principled_sheen_cycles.py) and keep every other table as stored")
     parser.add_argument("--out", type=Path, default=OUT)
     args = parser.parse_args()
-    tables = generate(args.samples)
+    with np.load(OUT) as stored:
+        tables = {key: stored[key] for key in stored.files}
+    if args.sheen is not None:
+        tables.update(fit_sheen(args.sheen))
+    else:
+        tables.update(generate(args.samples))
     np.savez_compressed(args.out, **tables)
     for key, value in tables.items():
         print(f"{key}: shape {value.shape}, range {value.min():.4f}..{value.max():.4f}")

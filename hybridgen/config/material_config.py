@@ -6,6 +6,7 @@ import math
 from typing import Any
 
 from ..errors import ConfigError
+from ..scene import principled_inputs
 from ..scene.material import ALPHA_MODES, TEXTURE_SLOTS, Material
 from ..input_paths import locate_input
 from .schema import closest
@@ -14,7 +15,9 @@ _UNIT_KEYS = ("roughness", "metallic", "specular", "transmission", "alpha")
 _COLOR_KEYS = {"base_color": (3, 4), "emission": (3, 3)}
 _TEXTURE_KEYS = TEXTURE_SLOTS
 KNOWN_KEYS = (*_UNIT_KEYS, *_COLOR_KEYS, "emission_strength", "ior", *_TEXTURE_KEYS, "name", "alpha_mode",
-              "normal_y_down", "displacement_scale", "emission_hidden_from_camera")
+              "normal_y_down", "displacement_scale", "emission_hidden_from_camera", *principled_inputs.BY_KEY)
+"""Config keys: the Material fields and the Principled inputs it keeps in ``extra`` (coat, sheen, subsurface,
+anisotropy, specular tint under Blender's names; :mod:`hybridgen.scene.principled_inputs`)."""
 
 
 def _number(value: Any, key: str) -> float:
@@ -33,11 +36,17 @@ def apply_material_config(material: Material, config: dict[str, Any]) -> Materia
     gets strength 1 (Blender's default), so the map emits as in Blender.
     """
     values: dict[str, Any] = {}
+    extra: dict[str, Any] = {}
     for key, value in config.items():
         if key not in KNOWN_KEYS:
             raise ConfigError(f"unsupported material parameter{closest(key, KNOWN_KEYS)}; supported: "
                               f"{', '.join(KNOWN_KEYS)}", key=f"material.{key}")
-        if key in _UNIT_KEYS:
+        if key in principled_inputs.BY_KEY:
+            try:
+                extra[key] = principled_inputs.checked(key, value)
+            except ValueError as error:
+                raise ConfigError(str(error), key=f"material.{key}") from None
+        elif key in _UNIT_KEYS:
             number = _number(value, key)
             if not 0.0 <= number <= 1.0:
                 raise ConfigError(f"must be in 0..1, got {value!r}", key=f"material.{key}")
@@ -85,4 +94,6 @@ def apply_material_config(material: Material, config: dict[str, Any]) -> Materia
     if "base_color" in values or values.get("base_color_texture") is not None:
         values["base_color_from_vertices"] = False
         values["missing_files"] = ()  # the mesh's own base-color files are no longer used
+    if extra:
+        values["extra"] = {**material.extra, **extra}
     return dataclasses.replace(material, **values)

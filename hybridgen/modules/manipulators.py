@@ -32,7 +32,11 @@ class MaterialManipulator(SelectingModule):
         Param("material", "dict", sampleable=True, doc="principled values: base_color, roughness, metallic, "
               "specular, transmission, ior, alpha, alpha_mode, emission, emission_strength, and maps (paths): "
               "base_color_texture, roughness_texture, metallic_texture, alpha_texture, normal_texture "
-              "(normal_y_down), displacement_texture (displacement_scale), specular_texture, emission_texture"),
+              "(normal_y_down), displacement_texture (displacement_scale), specular_texture, emission_texture; "
+              "Blender's other Principled inputs in snake case: specular_tint, anisotropic, anisotropic_rotation, "
+              "coat_weight, coat_roughness, coat_ior, coat_tint, sheen_weight, sheen_roughness, sheen_tint, "
+              "subsurface_weight, subsurface_radius, subsurface_scale, subsurface_ior, subsurface_anisotropy, "
+              "subsurface_method (docs/principled_bsdf.md)"),
         Param("randomize_color", "bool", False, doc="a uniform random base color per object"),
         Param("color_link_to_displacement", "float|null", None, "m", sampleable=True,
               doc="BlenderProc's cf_color_link_to_displacement: the material's base-color image becomes its "

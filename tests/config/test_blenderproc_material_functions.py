@@ -76,3 +76,19 @@ def test_cc_materials_are_selected_by_asset_name_patterns(tmp_path):
     for seed in range(3):
         context = run_config_text(tmp_path, text.replace('"global"', f'"seed": {seed}, "global"', 1))
         assert context.scene.by_name("Plane").material.name == "Marble003"
+
+
+def test_set_functions_reach_the_principled_inputs_of_blender_3_and_4(tmp_path):
+    """cf_set_<input> of Principled inputs the material keeps in ``extra``: Blender 4 names and the Blender 3 names
+    BlenderProc 1's configs use (Sheen, Subsurface, Clearcoat), as the Blender 4 inputs they became."""
+    material, lines = _run(tmp_path, None, {"cf_set_sheen": 0.7, "cf_set_sheen_roughness": 0.3,
+                                            "cf_set_sheen_tint": [0.9, 0.8, 0.7, 1.0],
+                                            "cf_set_subsurface_weight": 1.0, "cf_set_subsurface_radius": [1, 0.5, 0.2],
+                                            "cf_set_clearcoat": 0.4, "cf_set_coat_ior": 1.6})
+    assert material.extra == {"sheen_weight": 0.7, "sheen_roughness": 0.3, "sheen_tint": (0.9, 0.8, 0.7),
+                              "subsurface_weight": 1.0, "subsurface_radius": (1.0, 0.5, 0.2), "coat_weight": 0.4,
+                              "coat_ior": 1.6}
+    assert not [line for line in lines if "set_sheen" in line or "set_subsurface" in line]
+    # Blender 3's Sheen Tint was a 0..1 blend toward the base color: one line, naming the key
+    with pytest.raises(Exception, match="material.sheen_tint.*RGB color"):
+        _run(tmp_path, None, {"cf_set_sheen_tint": 0.5})

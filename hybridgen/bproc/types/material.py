@@ -3,6 +3,9 @@
 
 Principled BSDF inputs are named as in Blender 3 or Blender 4 (``"Specular"`` / ``"Specular IOR Level"``,
 ``"Emission"`` / ``"Emission Color"``, ``"Transmission"`` / ``"Transmission Weight"``); see :data:`INPUTS`.
+The inputs hybridgen's material model keeps in ``extra`` (coat, sheen, subsurface, anisotropy, specular tint;
+:mod:`hybridgen.scene.principled_inputs`) are taken the same way (``"Sheen Weight"`` / ``"Sheen"``,
+``"Subsurface Weight"`` / ``"Subsurface"``, ``"Coat Weight"`` / ``"Clearcoat"`` ...), as numbers or colors.
 Colors are linear RGBA in 0..1, as Blender's socket values. An image (``bpy.data.images.load(...)``, anything
 with a ``filepath``) linked to an input becomes that input's texture map. Node-level calls (``new_node``,
 ``link`` ...) have no counterpart in hybridgen's material model and raise one line naming the call.
@@ -14,6 +17,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ...errors import InputError
+from ...scene import principled_inputs
 from ...scene.material import Material as SceneMaterial
 from ..session import SESSION
 from .struct import Struct
@@ -44,8 +48,27 @@ def _is_image(value: Any) -> bool:
 def _input(input_name: str) -> tuple[str, str | None]:
     if input_name not in INPUTS:
         raise InputError(f"Principled BSDF input '{input_name}' is not supported by hybridgen yet "
-                         f"(supported: {', '.join(INPUTS)})")
+                         f"(supported: {', '.join([*INPUTS, *principled_inputs.BY_BLENDER_NAME])})")
     return INPUTS[input_name]
+
+
+def _set_extra(mat: SceneMaterial, input_name: str, value: Any) -> None:
+    """Set an input of :data:`hybridgen.scene.principled_inputs.BY_BLENDER_NAME` in ``mat.extra``."""
+    key = principled_inputs.BY_BLENDER_NAME[input_name].key
+    if _is_image(value) or hasattr(value, "is_output_socket"):
+        raise InputError(f"linking an image or a node socket to Principled BSDF input '{input_name}' is not "
+                         "supported by hybridgen yet")
+    try:
+        mat.extra[key] = principled_inputs.checked(key, list(value) if hasattr(value, "__len__") else value)
+    except ValueError as error:
+        raise InputError(f"Principled BSDF input '{input_name}' {error}") from None
+
+
+def _get_extra(mat: SceneMaterial, input_name: str) -> Any:
+    """The value of an ``extra`` input (its default when unset), colors as RGBA lists as Blender's sockets."""
+    entry = principled_inputs.BY_BLENDER_NAME[input_name]
+    value = mat.extra.get(entry.key, entry.default)
+    return [*value, 1.0] if entry.kind == "color" else list(value) if entry.kind == "vector" else value
 
 
 class Material(Struct):
@@ -76,6 +99,9 @@ class Material(Struct):
 
     def set_principled_shader_value(self, input_name: str, value: Any) -> None:
         """Set a Principled BSDF input to a number, a color (3 or 4 values; alpha 1 when 3) or an image."""
+        if input_name in principled_inputs.BY_BLENDER_NAME:
+            _set_extra(self.blender_obj, input_name, value)
+            return
         field, texture = _input(input_name)
         mat = self.blender_obj
         if _is_image(value):
@@ -98,6 +124,8 @@ class Material(Struct):
 
     def get_principled_shader_value(self, input_name: str) -> Any:
         """The input's value (colors as RGBA lists), or the linked image (an object with ``filepath``)."""
+        if input_name in principled_inputs.BY_BLENDER_NAME:
+            return _get_extra(self.blender_obj, input_name)
         field, texture = _input(input_name)
         mat = self.blender_obj
         if texture is not None and getattr(mat, texture) is not None:

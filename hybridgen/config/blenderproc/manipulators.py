@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from ...errors import ConfigError
+from ...scene.principled_inputs import BY_BLENDER_NAME
 from .common import Note, custom_properties, pop_ignored, pop_mode, take_shading
 from .selectors import selector
 
@@ -82,9 +83,12 @@ def entity(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]
     return out
 
 
+_EXTRA_NAMES = {name: entry.key for name, entry in BY_BLENDER_NAME.items()}
 _MATERIAL_VALUES = {"base_color": "base_color", "roughness": "roughness", "metallic": "metallic",
                     "specular": "specular", "ior": "ior", "alpha": "alpha", "transmission": "transmission",
-                    "emission_strength": "emission_strength", "emission": "emission"}
+                    "emission_strength": "emission_strength", "emission": "emission",
+                    # coat, sheen, subsurface, anisotropy, specular tint: Blender 4 and Blender 3 input names
+                    **{name.lower().replace(" ", "_"): key for name, key in _EXTRA_NAMES.items()}}
 
 
 def material(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]]]:

@@ -35,6 +35,7 @@ from .material_emission import emitted_radiance, radiance_texture
 from .mitsuba_instances import instanced_entries
 from .mitsuba_materials import VERTEX_COLOR_ATTRIBUTE, loaded_bsdf
 from .mitsuba_materials import rgb as _rgb
+from .principled_tangent import ATTRIBUTE as RADIAL_TANGENT, needs_radial_tangent, radial_tangents
 
 ENVMAP_TO_WORLD = np.array([[0.0, 0, 1, 0], [1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 0, 1]])
 """Lays Mitsuba's lat-long map (local +Y up, u = atan2(x, -z) / 2 pi mod 1) out as Blender's equirectangular
@@ -92,6 +93,8 @@ def mesh_shape(obj: MeshObject, *, back_side: bool = False, sampling_weight: flo
     del params  # holding traversal wrappers slows later renders (measured in scalar mode)
     if colored:
         mesh.add_attribute(VERTEX_COLOR_ATTRIBUTE, 3, jit_buffer(obj.vertex_colors, np.float32))
+    if needs_radial_tangent(obj.material):  # Blender's default anisotropy tangent (principled_tangent.py)
+        mesh.add_attribute(RADIAL_TANGENT, 3, jit_buffer(radial_tangents(obj.vertices, obj.local2world), np.float32))
     return mesh
 
 
@@ -202,7 +205,8 @@ def scene_dict(scene: Scene) -> dict[str, Any]:
         out["world"] = {**world, "sampling_weight": weights["world"]}
     bsdfs: dict[Any, Any] = {}  # equal materials share one BSDF (textures read once)
     shared, instanced = instanced_entries(scene.objects, lambda o: mesh_shape(o, bsdfs=bsdfs),
-                                          lambda o: f"object_{o.instance_id}" in weights)
+                                          lambda o: f"object_{o.instance_id}" in weights
+                                          or needs_radial_tangent(o.material))  # world-space attribute
     out.update(shared)
     for obj in scene.objects:
         key = f"object_{obj.instance_id}"

@@ -3,18 +3,20 @@ plugin, :data:`PLUGIN_NAME`.
 
 Inputs carry Blender's names (docs/principled_bsdf.md lists them with their ranges): ``base_color`` (texture),
 ``roughness``, ``metallic``, ``specular`` (Specular IOR Level; each a value or a texture), ``specular_tint``
-(RGB), ``ior``, ``transmission``, ``anisotropic``, ``anisotropic_rotation`` (turns of the tangent, Mitsuba's
-dP/du direction, around the normal), ``coat_weight``, ``coat_roughness``, ``coat_ior``, ``coat_tint`` (RGB).
+(RGB), ``ior``, ``transmission``, ``anisotropic``, ``anisotropic_rotation`` (turns of the tangent around the
+normal; the tangent is Blender's default, radial about the object's Z axis, :mod:`.principled_tangent`),
+``coat_weight``, ``coat_roughness``, ``coat_ior``, ``coat_tint`` (RGB), ``sheen_weight``, ``sheen_roughness``,
+``sheen_tint`` (RGB), ``subsurface_weight`` (its diffuse fallback).
 Roughness maps to GGX alpha = roughness^2 as in Blender. The layering is :mod:`.principled_layers`', the lobes
 :mod:`.principled_lobes`'. The BSDF is two-sided as Blender's: a hit from the back is shaded as from the
 front with the normal flipped, except that transmission then leaves the solid (relative IOR 1/IOR). Emission
 stays the scene's area emitter and alpha the ``mask`` wrapper (:mod:`.mitsuba_materials`).
 
 Sampling picks one lobe with probability proportional to its estimated albedo (Cycles' sample weights, plus
-:data:`~.principled_layers.MIN_LOBE_SHARE`), draws a direction from it (visible GGX normals, or a cosine
-lobe for the diffuse base) and returns the whole BSDF's value over the whole mixture's pdf, so ``sample``,
-``eval``, ``pdf`` and ``eval_pdf`` agree exactly. The BSDF answers ``has_attribute`` / ``eval_attribute_1``
-for ``roughness``, ``metallic`` and ``spec_trans`` (the transmission weight) as Mitsuba's ``principled`` does,
+:data:`~.principled_layers.MIN_LOBE_SHARE`), draws a direction from it (visible GGX normals, a cosine
+lobe for the diffuse base, the transformed cosine for sheen) and returns the whole BSDF's value over the whole
+mixture's pdf, so ``sample``, ``eval``, ``pdf`` and ``eval_pdf`` agree exactly. The BSDF answers
+``has_attribute`` / ``eval_attribute_1`` for ``roughness``, ``metallic`` and ``spec_trans`` (the transmission weight) as Mitsuba's ``principled`` does,
 which the path tracer's singular-surface test reads.
 
 Registered per JIT variant by :func:`register`. In ``scalar_rgb`` hybridgen keeps Mitsuba's ``principled``
@@ -84,6 +86,10 @@ def register(variant: str) -> None:
             self.coat_rough = min(max(float(props.get("coat_roughness", 0.03)), 0.0), 1.0)
             self.coat_ior = max(float(props.get("coat_ior", 1.5)), 1.0)
             self.coat_tint = color(props, "coat_tint")
+            self.sheen = max(float(props.get("sheen_weight", 0.0)), 0.0)
+            self.sheen_rough = min(max(float(props.get("sheen_roughness", 0.5)), 0.0), 1.0)
+            self.sheen_tint = color(props, "sheen_tint")
+            self.subsurface = min(max(float(props.get("subsurface_weight", 0.0)), 0.0), 1.0)
             components = [flags.DiffuseReflection | both, flags.GlossyReflection | both]
             if self.transmission > 0:
                 components.append(flags.GlossyTransmission | flags.NonSymmetric | both)
@@ -100,12 +106,28 @@ def register(variant: str) -> None:
                 spec_tint=mi.Color3f(self.spec_tint), transmission=mi.Float(min(max(self.transmission, 0.0), 1.0)),
                 aspect=mi.Float(self.aspect), coat=mi.Float(self.coat), coat_rough=mi.Float(self.coat_rough),
                 coat_ior=mi.Float(self.coat_ior), coat_tint=mi.Color3f(self.coat_tint), has_coat=self.coat > 0,
-                has_transmission=self.transmission > 0, has_coat_tint=any(c != 1.0 for c in self.coat_tint))
+                has_transmission=self.transmission > 0, has_coat_tint=any(c != 1.0 for c in self.coat_tint),
+                sheen=mi.Float(self.sheen), sheen_rough=mi.Float(self.sheen_rough),
+                sheen_tint=mi.Color3f(self.sheen_tint), subsurface=mi.Float(self.subsurface),
+                has_sheen=self.sheen > 0, has_subsurface=self.subsurface > 0)
 
-        def _frame(self, si: Any) -> Any:
-            """Rotation of local directions into the anisotropy frame (the tangent turned by the rotation)."""
+        def _frame(self, si: Any, active: Any) -> Any:
+            """Rotation of local directions into the anisotropy frame: Blender's default tangent (radial about
+            the object's Z axis, the mesh attribute :data:`~.principled_tangent.ATTRIBUTE`; Mitsuba's shading
+            tangent where a mesh has none) turned by the rotation."""
             angle = 2.0 * dr.pi * self.rotation
-            return mi.Float(dr.cos(angle)), mi.Float(dr.sin(angle))
+            c, s = mi.Float(dr.cos(angle)), mi.Float(dr.sin(angle))
+            if self.aspect >= 1.0:
+                return c, s
+            from .principled_tangent import ATTRIBUTE
+
+            radial = si.shape.eval_attribute_3(ATTRIBUTE, si, active)
+            tangent = si.sh_frame.to_local(mi.Vector3f(radial[0], radial[1], radial[2]))
+            length2 = tangent.x * tangent.x + tangent.y * tangent.y
+            found = length2 > 1e-20
+            inv = dr.rsqrt(dr.maximum(length2, 1e-20))
+            tc, ts = dr.select(found, tangent.x * inv, 1.0), dr.select(found, tangent.y * inv, 0.0)
+            return tc * c - ts * s, ts * c + tc * s
 
         def _local(self, v: Any, flip: Any, rot: Any) -> Any:
             c, s = rot
@@ -117,15 +139,15 @@ def register(variant: str) -> None:
 
         def _setup(self, si: Any, active: Any) -> tuple[Any, Any, Any, Any, Any]:
             flip = mi.Frame3f.cos_theta(si.wi) < 0.0
-            rot = self._frame(si)
+            rot = self._frame(si, active)
             wi = self._local(si.wi, flip, rot)
             inp = self._inputs(si, active)
-            return inp, layers_mod.layers(inp, dr.maximum(wi.z, 1e-6), flip), wi, flip, rot
+            return inp, layers_mod.layers(inp, wi, flip), wi, flip, rot
 
         def eval_pdf(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> tuple[Any, Any]:
             inp, lay, wi, flip, rot = self._setup(si, active)
             value, pdf = layers_mod.eval_pdf(lay, wi, self._local(wo, flip, rot), inp.has_coat,
-                                             inp.has_transmission)
+                                             inp.has_transmission, inp.has_sheen)
             ok = active & (wi.z > 0.0)
             return dr.select(ok, mi.Spectrum(value), 0.0), dr.select(ok, pdf, 0.0)
 
@@ -157,7 +179,13 @@ def register(variant: str) -> None:
                 refract = pick_glass & (u >= p_reflect) & (cos_t > 0.0)
                 wo = dr.select(refract, lobes.refract(wi, h, cos_t, lay.eta_glass), wo)
             wo = dr.select(pick_diffuse, mi.warp.square_to_cosine_hemisphere(sample2), wo)
-            value, pdf = layers_mod.eval_pdf(lay, wi, wo, inp.has_coat, inp.has_transmission)
+            if inp.has_sheen:  # the last share: sheen is sampled as a diffuse lobe (Cycles' label)
+                from . import principled_sheen as sheen
+
+                pick_sheen = sample1 >= c_spec + s[4]
+                wo = dr.select(pick_sheen, sheen.sample_sheen(lay.sheen_a, lay.sheen_b, lay.sheen_frame, sample2),
+                               wo)
+            value, pdf = layers_mod.eval_pdf(lay, wi, wo, inp.has_coat, inp.has_transmission, inp.has_sheen)
             ok = active & (wi.z > 0.0) & (pdf > 0.0) & dr.select(refract, wo.z < 0.0, wo.z > 0.0)
             bs = dr.zeros(mi.BSDFSample3f)
             bs.wo = self._world_local(wo, flip, rot)
@@ -199,6 +227,7 @@ def register(variant: str) -> None:
 
         def to_string(self) -> str:
             return (f"HybridgenPrincipled[ior={self.ior}, transmission={self.transmission}, coat={self.coat}, "
-                    f"roughness={self.roughness}, metallic={self.metallic}, specular={self.specular}]")
+                    f"sheen={self.sheen}, subsurface={self.subsurface}, roughness={self.roughness}, "
+                    f"metallic={self.metallic}, specular={self.specular}]")
 
     mi.register_bsdf(PLUGIN_NAME, lambda props: PrincipledBSDF(props))

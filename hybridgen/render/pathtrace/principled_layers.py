@@ -4,6 +4,8 @@ Blender stacks its closures top down and lets each layer darken what lies below 
 albedo from the view direction ``wi`` (Cycles' ``closure_layering_weight``); metal and transmission instead mix
 by their weights. With W the weight still left for the layers below (a color, 1 at the top):
 
+0. sheen (``sheen_weight`` > 0): the microfiber sheen lobe (:mod:`.principled_sheen`) with albedo
+   A_sheen = sheen_weight x sheen_tint x R(mu, sheen_roughness); W *= 1 - max_channel(A_sheen);
 1. coat (``coat_weight`` > 0): a dielectric GGX reflection with the coat's own IOR and roughness, weight
    ``coat_weight`` W; then W *= 1 - coat_weight A_coat and, for a coat tint, W *= lerp(1, tint^(1/cos_t),
    coat_weight) with cos_t the view direction refracted into the coat (Beer's law over the coat's thickness);
@@ -13,12 +15,14 @@ by their weights. With W the weight still left for the layers below (a color, 1 
    refraction (1 - F) sqrt(base color), weight ``transmission`` W; W *= 1 - transmission;
 4. the dielectric specular layer: GGX reflection with F0 = F0(IOR) x 2 ``specular`` (Specular IOR Level,
    0.5 = the IOR's own F0) tinted by ``specular_tint``, weight W; W *= 1 - max_channel(A_spec);
-5. Lambertian diffuse: base color x W / pi.
+5. Lambertian diffuse: base color x W / pi; with subsurface weight w, (1 - w) base color + w min(base color, 1)
+   (Cycles' BSSRDF closure falls back to this diffuse lobe with the clamped base color wherever it does no
+   random walk: radius x scale below 1e-8 per channel, and after a diffuse bounce; hybridgen never walks).
 
 Every GGX lobe is energy compensated (:func:`principled_lobes.energy_factor`). A layer's albedo A is Cycles'
 estimate: (E + F_ms (1 - E)) (F0 + (1 - F0) s) with s from the ``schlick_s`` table (the Fresnel-weighted
-fraction of the lobe's energy). Sheen and subsurface are not modelled (hybridgen's materials carry neither;
-see docs/principled_bsdf.md). Per-lane quantities are Dr.Jit values of the active variant; inputs are read by
+fraction of the lobe's energy). Random-walk subsurface scattering is not modelled (see docs/principled_bsdf.md).
+Per-lane quantities are Dr.Jit values of the active variant; inputs are read by
 :class:`~hybridgen.render.pathtrace.principled_bsdf.PrincipledBSDF`.
 """
 from __future__ import annotations
@@ -30,6 +34,7 @@ import drjit as dr
 import mitsuba as mi
 
 from . import principled_lobes as lobes
+from . import principled_sheen as sheen
 from . import principled_tables as tables
 
 MIN_LOBE_SHARE = 0.05
@@ -56,6 +61,12 @@ class Inputs:
     has_coat: bool
     has_transmission: bool
     has_coat_tint: bool
+    sheen: Any = 0.0  # Sheen Weight
+    sheen_rough: Any = 0.5  # Sheen Roughness
+    sheen_tint: Any = 1.0  # Sheen Tint (RGB)
+    subsurface: Any = 0.0  # Subsurface Weight 0..1
+    has_sheen: bool = False
+    has_subsurface: bool = False
 
 
 @dataclass
@@ -79,7 +90,12 @@ class Layers:
     eta_spec: Any
     f0_spec: Any
     diffuse_w: Any
-    shares: list[Any]  # sampling probabilities: coat, metal, glass, spec, diffuse (sum 1 where anything reflects)
+    shares: list[Any]  # sampling probabilities: coat, metal, glass, spec, diffuse[, sheen] (sum 1 where anything
+    # reflects)
+    sheen_w: Any = None  # the sheen lobe's albedo (color), with its LTC (a, b) and frame (cos, sin)
+    sheen_a: Any = None
+    sheen_b: Any = None
+    sheen_frame: Any = None
 
 
 def _average(color: Any) -> Any:
@@ -101,10 +117,17 @@ def _reflective_layer(rough: Any, mu: Any, eta: Any, f0: Any) -> tuple[Any, Any]
     return factor, factor * e * estimate
 
 
-def layers(inp: Inputs, mu: Any, backfacing: Any) -> Layers:
-    """The layer weights for a view direction at cosine ``mu`` > 0 to the (flipped) normal."""
+def layers(inp: Inputs, wi: Any, backfacing: Any) -> Layers:
+    """The layer weights for the local view direction ``wi`` (cosine to the (flipped) normal: its z > 0)."""
     white = mi.Color3f(1.0)
     weight = white
+    mu = dr.maximum(wi.z, 1e-6)
+    sheen_w, sheen_ab, share_sheen = None, (None, None), mi.Float(0.0)
+    if inp.has_sheen:
+        a, b, albedo = tables.sheen_ltc(inp.sheen_rough, mu)
+        sheen_w = inp.sheen * inp.sheen_tint * albedo
+        sheen_ab, share_sheen = (a, b), _average(sheen_w)
+        weight = weight * dr.clip(1.0 - _max(sheen_w), 0.0, 1.0)
     alpha = dr.maximum(dr.square(inp.rough), lobes.MIN_ALPHA)
     ax, ay = dr.minimum(alpha / inp.aspect, 1.0), alpha * inp.aspect
     coat_w, alpha_coat, share_coat = mi.Color3f(0.0), mi.Float(lobes.MIN_ALPHA), mi.Float(0.0)
@@ -145,14 +168,24 @@ def layers(inp: Inputs, mu: Any, backfacing: Any) -> Layers:
     share_spec = dr.select(has_spec, _average(weight * albedo), 0.0)
     weight = dr.select(has_spec, weight * dr.clip(1.0 - _max(albedo), 0.0, 1.0), weight)
     diffuse_w = weight * dr.maximum(inp.base, 0.0)
+    if inp.has_subsurface:
+        diffuse_w = weight * dr.lerp(dr.maximum(inp.base, 0.0), dr.clip(inp.base, 0.0, 1.0), inp.subsurface)
     raw = [share_coat, share_metal, share_glass, share_spec, _average(diffuse_w)]
+    if inp.has_sheen:
+        raw.append(share_sheen)
     total = raw[0] + raw[1] + raw[2] + raw[3] + raw[4]
+    if inp.has_sheen:
+        total = total + raw[5]
     floored = [dr.select(r > 0.0, r + MIN_LOBE_SHARE * total, 0.0) for r in raw]
-    norm = dr.rcp(dr.maximum(floored[0] + floored[1] + floored[2] + floored[3] + floored[4], 1e-20))
+    floored_sum = floored[0] + floored[1] + floored[2] + floored[3] + floored[4]
+    if inp.has_sheen:
+        floored_sum = floored_sum + floored[5]
+    norm = dr.rcp(dr.maximum(floored_sum, 1e-20))
     return Layers(ax=ax, ay=ay, alpha_glass=alpha, alpha_coat=alpha_coat, coat_w=coat_w, coat_ior=inp.coat_ior,
                   metal_w=metal_w, f0_metal=f0_metal, b_metal=b_metal, glass_w=glass_w, eta_glass=eta_glass,
                   f0_glass=f0_glass, tint_glass=tint_glass, spec_w=spec_w, eta_spec=eta_spec, f0_spec=f0_spec,
-                  diffuse_w=diffuse_w, shares=[f * norm for f in floored])
+                  diffuse_w=diffuse_w, shares=[f * norm for f in floored], sheen_w=sheen_w, sheen_a=sheen_ab[0],
+                  sheen_b=sheen_ab[1], sheen_frame=sheen.sheen_frame(wi) if inp.has_sheen else None)
 
 
 def glass_reflect_probability(lay: Layers, cos_hi: Any) -> tuple[Any, Any, Any]:
@@ -162,7 +195,8 @@ def glass_reflect_probability(lay: Layers, cos_hi: Any) -> tuple[Any, Any, Any]:
     return _average(f) / dr.maximum(_average(f + t), 1e-20), f, t
 
 
-def eval_pdf(lay: Layers, wi: Any, wo: Any, has_coat: bool, has_transmission: bool) -> tuple[Any, Any]:
+def eval_pdf(lay: Layers, wi: Any, wo: Any, has_coat: bool, has_transmission: bool,
+             has_sheen: bool = False) -> tuple[Any, Any]:
     """(BSDF x |cos(wo)| as RGB, pdf of :meth:`PrincipledBSDF.sample`) for local ``wi`` (upper) and ``wo``."""
     refl, refl_pdf, cos_hi = lobes.reflection(wi, wo, lay.ax, lay.ay)
     value = lay.spec_w * lobes.fresnel_remapped(cos_hi, lay.eta_spec, lay.f0_spec) * refl
@@ -182,4 +216,8 @@ def eval_pdf(lay: Layers, wi: Any, wo: Any, has_coat: bool, has_transmission: bo
         p_reflect_t, _, t = glass_reflect_probability(lay, t_cos)
         value += lay.glass_w * (f * g_refl + t * g_refr)
         pdf += lay.shares[2] * (p_reflect * g_pdf + (1.0 - p_reflect_t) * t_pdf)
+    if has_sheen:
+        lobe = sheen.sheen_lobe(lay.sheen_a, lay.sheen_b, lay.sheen_frame, wo)
+        value += lay.sheen_w * lobe
+        pdf += lay.shares[5] * lobe
     return value, pdf

@@ -8,7 +8,15 @@ The material's values and maps feed Blender's inputs as BlenderProc's material l
 ``transmission`` -> Transmission Weight; each map replaces its value per texel. Inputs the scene model has no
 field for are read from ``material.extra`` under Blender's names in snake case (:data:`EXTRA_INPUTS`):
 ``specular_tint`` (RGB), ``anisotropic``, ``anisotropic_rotation``, ``coat_weight``, ``coat_roughness``,
-``coat_ior``, ``coat_tint`` (RGB). They need this BSDF: ``scalar_rgb`` (Mitsuba's ``principled``) rejects them.
+``coat_ior``, ``coat_tint`` (RGB), ``sheen_weight``, ``sheen_roughness``, ``sheen_tint`` (RGB),
+``subsurface_weight``, ``subsurface_radius`` (RGB, m), ``subsurface_scale`` (m), ``subsurface_ior``,
+``subsurface_anisotropy``, ``subsurface_method`` (the node's property, one of :data:`SUBSURFACE_METHODS`). They
+need this BSDF: ``scalar_rgb`` (Mitsuba's ``principled``) rejects them.
+
+Subsurface renders as Cycles' diffuse fallback of its BSSRDF (:mod:`.principled_layers`): the radius, scale,
+IOR and anisotropy only shape Cycles' random walk, which hybridgen does not trace, so they are checked and
+kept on the material (BlenderProc's and Cycles' exports read them) but do not reach the BSDF
+(:data:`RANDOM_WALK_ONLY`; docs/principled_bsdf.md has the measured difference).
 """
 from __future__ import annotations
 
@@ -17,11 +25,15 @@ from typing import Any
 
 from ...errors import InputError
 from ...scene.material import Material
+from ...scene.principled_inputs import COLOR_KEYS, DEFAULTS, SUBSURFACE_METHODS, checked
 
-EXTRA_INPUTS = {"specular_tint": (1.0, 1.0, 1.0), "anisotropic": 0.0, "anisotropic_rotation": 0.0,
-                "coat_weight": 0.0, "coat_roughness": 0.03, "coat_ior": 1.5, "coat_tint": (1.0, 1.0, 1.0)}
-"""Principled inputs a material may carry in ``extra`` (Blender 4.2's defaults)."""
-COLOR_INPUTS = ("specular_tint", "coat_tint")
+EXTRA_INPUTS = DEFAULTS
+"""Principled inputs a material may carry in ``extra`` (Blender 4.2's defaults;
+:mod:`hybridgen.scene.principled_inputs` has their Blender names and ranges)."""
+COLOR_INPUTS = COLOR_KEYS
+RANDOM_WALK_ONLY = ("subsurface_radius", "subsurface_scale", "subsurface_ior", "subsurface_anisotropy",
+                    "subsurface_method")
+"""Inputs that only shape Cycles' random-walk subsurface scattering (not passed to the BSDF)."""
 ENV_VARIABLE = "HYBRIDGEN_PRINCIPLED"
 """``mitsuba`` renders principled materials with Mitsuba's ``principled`` (Disney 2015) in every variant,
 ``blender`` with hybridgen's Principled BSDF in the JIT variants (default: :data:`DEFAULT_MODEL`)."""
@@ -38,20 +50,16 @@ def enabled() -> bool:
 
 
 def extra_inputs(material: Material, owner: str) -> dict[str, Any]:
-    """The checked ``extra`` inputs of ``material`` (only :data:`EXTRA_INPUTS` names, finite values)."""
+    """The checked ``extra`` inputs of ``material`` (:func:`hybridgen.scene.principled_inputs.checked`)."""
     unknown = sorted(set(material.extra) - set(EXTRA_INPUTS))
     if unknown:
         raise InputError(f"object '{owner}': material '{material.name}' has unsupported parameter(s) {unknown}")
     values: dict[str, Any] = {}
     for name, value in material.extra.items():
         try:
-            number = [float(v) for v in value][:3] if name in COLOR_INPUTS else float(value)
-        except (TypeError, ValueError):
-            number = None
-        if number is None or (name in COLOR_INPUTS and len(number) != 3):
-            raise InputError(f"object '{owner}': material '{material.name}' {name} must be "
-                             f"{'an RGB triple' if name in COLOR_INPUTS else 'a number'}, got {value!r}")
-        values[name] = number
+            values[name] = checked(name, value)
+        except ValueError as error:
+            raise InputError(f"object '{owner}': material '{material.name}' {name} {error}") from None
     return values
 
 
@@ -68,5 +76,6 @@ def plugin_dict(material: Material, owner: str, base: dict[str, Any], roughness:
                             "specular": specular, "ior": float(material.ior),
                             "transmission": float(material.transmission)}
     for name, value in extra_inputs(material, owner).items():
-        bsdf[name] = mi.ScalarColor3f(value) if name in COLOR_INPUTS else value
+        if name not in RANDOM_WALK_ONLY:
+            bsdf[name] = mi.ScalarColor3f(value) if name in COLOR_INPUTS else value
     return bsdf

@@ -7,7 +7,9 @@ reads its own tables (so both renderers compensate the same roughness and angle 
 
 All functions take and return Dr.Jit values of the active variant (``mi.Float``): ``rough`` is Blender's
 Roughness input (GGX alpha = rough^2; for anisotropic lobes sqrt(sqrt(alpha_x alpha_y))), ``mu`` the cosine
-between the view direction and the normal, ``z`` the IOR coordinate sqrt(|eta - 1| / (eta + 1)).
+between the view direction and the normal, ``z`` the IOR coordinate sqrt(|eta - 1| / (eta + 1)). The sheen
+tables (:func:`sheen_ltc`) are fitted by the same tool to Cycles' own sheen lobe, measured with
+tools/principled_sheen_cycles.py (Blender 4.2), not integrated.
 """
 from __future__ import annotations
 
@@ -130,3 +132,11 @@ def fresnel_interpolation(rough: Any, mu: Any, eta: Any) -> Any:
 def fresnel_average(eta: Any) -> Any:
     """2 int F(mu, eta) mu dmu of the dielectric Fresnel reflectance (eta > 1)."""
     return lookup_1d("fresnel_avg", ior_coordinate(eta))
+
+
+def sheen_ltc(rough: Any, mu: Any) -> tuple[Any, Any, Any]:
+    """(a, b, R) of Blender 4.2's sheen lobe at Sheen Roughness ``rough`` and view cosine ``mu``: the lobe's
+    "BSDF x cosine" is R D with D the cosine lobe linearly transformed by the inverse matrix
+    [[a, 0, b], [0, a, 0], [0, 0, 1]] (Zeltner, Burley & Chiang 2022) and R its albedo; tables fitted by
+    tools/principled_tables.py to Cycles' measured lobe."""
+    return lookup_2d("sheen_a", rough, mu), lookup_2d("sheen_b", rough, mu), lookup_2d("sheen_R", rough, mu)

@@ -1,0 +1,46 @@
+"""bproc Material.set/get_principled_shader_value for the Principled inputs hybridgen keeps in the material's
+``extra`` (coat, sheen, subsurface, anisotropy, specular tint): Blender 4.2's names and defaults (read from its
+node with bpy 4.2.0: Sheen Roughness 0.5, Subsurface Radius (1, 0.2, 0.1), Subsurface Scale 0.05, Subsurface IOR
+1.4, Coat Roughness 0.03), the Blender 3 names as the inputs they became, one-line errors for what cannot be set."""
+from __future__ import annotations
+
+import pytest
+
+from hybridgen.errors import InputError
+from writer_session import bproc  # noqa: F401 - the fixture
+
+
+def test_extra_inputs_by_blender_4_and_3_names(bproc) -> None:  # noqa: F811
+    material = bproc.material.create("cloth")
+    assert material.get_principled_shader_value("Sheen Weight") == 0.0
+    assert material.get_principled_shader_value("Sheen Roughness") == 0.5
+    assert material.get_principled_shader_value("Sheen Tint") == [1.0, 1.0, 1.0, 1.0]
+    assert material.get_principled_shader_value("Subsurface Radius") == [1.0, 0.2, 0.1]
+    assert material.get_principled_shader_value("Subsurface Scale") == 0.05
+    assert material.get_principled_shader_value("Subsurface IOR") == 1.4
+    assert material.get_principled_shader_value("Coat Roughness") == 0.03
+    material.set_principled_shader_value("Sheen Weight", 0.8)
+    material.set_principled_shader_value("Sheen Tint", [0.5, 0.4, 0.3, 1.0])
+    material.set_principled_shader_value("Subsurface", 1)  # Blender 3's name of Subsurface Weight
+    material.set_principled_shader_value("Subsurface Radius", (2.0, 1.0, 0.5))
+    material.set_principled_shader_value("Clearcoat", 0.25)  # Blender 3's Coat Weight
+    assert material.blender_obj.extra == {"sheen_weight": 0.8, "sheen_tint": (0.5, 0.4, 0.3),
+                                          "subsurface_weight": 1.0, "subsurface_radius": (2.0, 1.0, 0.5),
+                                          "coat_weight": 0.25}
+    assert material.get_principled_shader_value("Sheen") == 0.8
+    assert material.get_principled_shader_value("Sheen Tint") == [0.5, 0.4, 0.3, 1.0]
+    assert material.get_principled_shader_value("Coat Weight") == 0.25
+    assert material.duplicate().blender_obj.extra == material.blender_obj.extra
+
+
+def test_what_cannot_be_set_is_one_line(bproc) -> None:  # noqa: F811
+    material = bproc.material.create("cloth")
+    with pytest.raises(InputError, match="'Sheen Tint' takes an RGB color"):  # Blender 3's float tint
+        material.set_principled_shader_value("Sheen Tint", 0.5)
+    with pytest.raises(InputError, match="'Subsurface Radius' must be >= 0"):
+        material.set_principled_shader_value("Subsurface Radius", [1.0, -0.1, 0.0])
+    with pytest.raises(InputError, match="'Sheen Weight' must be a finite number"):
+        material.set_principled_shader_value("Sheen Weight", float("nan"))
+    with pytest.raises(InputError, match="Subsurface Color' is not supported"):  # Blender 3 only, no Blender 4 input
+        material.set_principled_shader_value("Subsurface Color", [1.0, 0.0, 0.0, 1.0])
+    assert material.blender_obj.extra == {}

@@ -1,0 +1,165 @@
+"""The Principled material sweeps tools/principled_vs_cycles.py renders in hybridgen and Cycles: their materials,
+the sphere-grid scenes, the small test views and the per-object masks (analytic ray casts).
+
+The scene: rows of :data:`COLUMNS` spheres (0.36 m across) over a grey Lambertian floor, each sphere one material
+of a sweep (:data:`GROUPS`), lit either by a sun (3 W/m^2, 50 degrees above the horizon) under a uniform grey-blue
+sky (``sun``), or by the generated sky HDRI of tools/color_quality.py with its small bright sun (``hdri``).
+Units: metres, linear RGB.
+"""
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+SWEEP: list[tuple[str, tuple[float, float, float], dict[str, Any]]] = [
+    # (name, base color, Material fields / Principled extras)
+    ("red_s0", (0.8, 0.1, 0.1), dict(roughness=0.4, specular=0.0)),
+    ("red_s05_r02", (0.8, 0.1, 0.1), dict(roughness=0.2, specular=0.5)),
+    ("red_s05_r06", (0.8, 0.1, 0.1), dict(roughness=0.6, specular=0.5)),
+    ("red_s1_r03", (0.8, 0.1, 0.1), dict(roughness=0.3, specular=1.0)),
+    ("blue_s05_r04", (0.05, 0.1, 0.4), dict(roughness=0.4, specular=0.5)),
+    ("white_s05_r05", (0.9, 0.9, 0.85), dict(roughness=0.5, specular=0.5)),
+    ("grey_s05_r09", (0.5, 0.5, 0.5), dict(roughness=0.9, specular=0.5)),
+    ("grey_s1_r01", (0.5, 0.5, 0.5), dict(roughness=0.1, specular=1.0)),
+    ("dark_s05_r03", (0.03, 0.03, 0.03), dict(roughness=0.3, specular=0.5)),
+    ("gold_m1_r03", (1.0, 0.77, 0.34), dict(roughness=0.3, metallic=1.0)),
+    ("grey_m1_r06", (0.6, 0.6, 0.6), dict(roughness=0.6, metallic=1.0)),
+    ("copper_m1_r1", (0.95, 0.64, 0.54), dict(roughness=1.0, metallic=1.0)),
+    ("green_m05_r04", (0.2, 0.7, 0.3), dict(roughness=0.4, metallic=0.5)),
+    ("red_coat", (0.8, 0.1, 0.1), dict(roughness=0.5, specular=0.5, extra=dict(coat_weight=1.0, coat_roughness=0.1))),
+    ("blue_coat_tint", (0.1, 0.2, 0.6), dict(roughness=0.6, specular=0.5,
+                                             extra=dict(coat_weight=0.7, coat_roughness=0.3, coat_tint=(1.0, 0.8, 0.5)))),
+    ("glass_r02", (1.0, 1.0, 1.0), dict(roughness=0.2, transmission=1.0, ior=1.5)),
+    ("green_glass_r05", (0.3, 0.9, 0.4), dict(roughness=0.5, transmission=1.0, ior=1.45)),
+    ("aniso_metal", (0.9, 0.9, 0.9), dict(roughness=0.4, metallic=1.0, extra=dict(anisotropic=0.8))),
+]
+SWEEP_LAYERS: list[tuple[str, tuple[float, float, float], dict[str, Any]]] = [
+    # sheen (Blender 4's microfiber sheen) and subsurface (hybridgen: Cycles' diffuse fallback; Cycles: its walk)
+    ("red_sheen1_r05", (0.8, 0.1, 0.1), dict(roughness=0.5, specular=0.5, extra=dict(sheen_weight=1.0))),
+    ("velvet_sheen1_r03", (0.05, 0.02, 0.1), dict(roughness=0.7, specular=0.0, extra=dict(
+        sheen_weight=1.0, sheen_roughness=0.3, sheen_tint=(0.9, 0.7, 1.0)))),
+    ("blue_sheen05_r08", (0.1, 0.2, 0.6), dict(roughness=0.6, specular=0.5, extra=dict(
+        sheen_weight=0.5, sheen_roughness=0.8, sheen_tint=(1.0, 0.9, 0.7)))),
+    ("black_sheen1_r02", (0.0, 0.0, 0.0), dict(roughness=0.5, specular=0.0, extra=dict(
+        sheen_weight=1.0, sheen_roughness=0.2))),
+    ("gold_coat_sheen", (0.6, 0.45, 0.15), dict(roughness=0.4, specular=0.5, extra=dict(
+        coat_weight=1.0, coat_roughness=0.2, sheen_weight=1.0, sheen_roughness=0.4))),
+    ("skin_ss1_r0", (0.8, 0.5, 0.4), dict(roughness=0.5, specular=0.5, extra=dict(
+        subsurface_weight=1.0, subsurface_scale=0.0))),
+    ("skin_ss05_rw", (0.8, 0.5, 0.4), dict(roughness=0.5, specular=0.5, extra=dict(subsurface_weight=0.5))),
+    ("skin_ss1_rw", (0.8, 0.5, 0.4), dict(roughness=0.5, specular=0.5, extra=dict(subsurface_weight=1.0))),
+    ("skin_ss1_burley", (0.8, 0.5, 0.4), dict(roughness=0.5, specular=0.5, extra=dict(
+        subsurface_weight=1.0, subsurface_method="BURLEY"))),
+    ("skin_ss1_amass", (0.8, 0.5, 0.4), dict(roughness=0.5, specular=0.003, extra=dict(
+        subsurface_weight=1.0, subsurface_scale=0.2, subsurface_ior=2.5, subsurface_method="RANDOM_WALK_SKIN"))),
+]
+GROUPS = {"principled": SWEEP, "layers": SWEEP_LAYERS}
+"""The sweeps, each rendered as a scene of its own (``--group``): the first sweep of issue 32 and the sheen /
+subsurface one."""
+COLUMNS, SPACING, DIAMETER = 6, 0.46, 0.36
+LIGHTINGS = ("sun", "hdri")
+
+
+TEST_OBJECTS = ("red_s1_r03", "white_s05_r05", "grey_m1_r06", "copper_m1_r1")
+"""The spheres of the small test view (``--store``; tests/render/test_principled_vs_cycles.py): objects whose
+color Mitsuba's principled got 7-55 % wrong."""
+
+
+TEST_LAYER_OBJECTS = ("red_sheen1_r05", "velvet_sheen1_r03", "gold_coat_sheen", "skin_ss1_r0")
+"""The spheres of the second test view (sheen over a dielectric, over a near-black base, over a coat; subsurface
+without a radius, which Cycles renders with its diffuse fallback as hybridgen does)."""
+
+
+def sweep(names: tuple[str, ...] | None = None,
+          group: str = "principled") -> list[tuple[str, tuple[float, float, float], dict[str, Any]]]:
+    """The entries of the sweep ``group`` (:data:`GROUPS`), or those named ``names`` (of any group), in that
+    order."""
+    if names is None:
+        return list(GROUPS[group])
+    entries = {entry[0]: entry for entries in GROUPS.values() for entry in entries}
+    return [entries[name] for name in names]
+
+
+def sphere_centers(count: int) -> list[tuple[float, float, float]]:
+    """World centres (m) of ``count`` spheres: rows of :data:`COLUMNS` along x, row 0 nearest the camera (-y)."""
+    columns = min(COLUMNS, count)
+    rows = math.ceil(count / columns)
+    return [((i % columns - (columns - 1) / 2) * SPACING, (i // columns - (rows - 1) / 2) * SPACING, DIAMETER / 2)
+            for i in range(count)]
+
+
+def build_scene(lighting: str, width: int, height: int, workdir: Path,
+                names: tuple[str, ...] | None = None, group: str = "principled") -> Any:
+    """The sweep scene of ``group`` (or only the spheres ``names``, in one row, framed closer) under
+    ``lighting`` (:data:`LIGHTINGS`) at ``width`` x ``height`` px."""
+    import hybridgen as hg
+
+    scene = hg.Scene()
+    floor = hg.make_primitive("plane", 6.0, name="floor", category_id=1, color=(0.5, 0.5, 0.5))
+    floor.material.specular = 0.0
+    scene.add(floor)
+    entries = sweep(names, group)
+    for index, ((name, color, values), center) in enumerate(zip(entries, sphere_centers(len(entries)))):
+        ball = hg.make_primitive("sphere", DIAMETER, name=name, category_id=index + 2, color=color,
+                                 local2world=hg.object_pose(list(center)))
+        for key, value in values.items():
+            if key == "extra":
+                ball.material.extra = dict(value)
+            else:
+                setattr(ball.material, key, value)
+        scene.add(ball)
+    if lighting == "sun":
+        scene.world.color, scene.world.strength = (0.3, 0.35, 0.45), 1.0
+        scene.add_light(hg.Light("sun", "SUN", energy=3.0,
+                                 local2world=hg.object_pose([0, 0, 5], [math.radians(40), 0, math.radians(30)])))
+    else:
+        sys.path.insert(0, str(REPO / "tools"))
+        from color_quality import sky_hdri
+
+        scene.world.hdri_path = str(sky_hdri(workdir / "sky.exr"))
+        scene.world.strength, scene.world.hdri_rotation = 1.0, 0.3
+    scene.camera.intrinsics = hg.Intrinsics.from_fov(0.75, width, height, clip_start=0.01)
+    location = [0.0, -2.6, 1.9] if names is None else [0.0, -1.9, 1.1]
+    scene.camera.add_keypoint(hg.look_at(location, [0.0, 0.05, 0.1]))
+    return scene
+
+
+def object_masks(scene: Any, names: tuple[str, ...] | None = None, margin: float = 0.8,
+                 group: str = "principled") -> dict[str, np.ndarray]:
+    """Per object name, the pixels (bool H x W) whose centre ray first hits it, spheres only where the ray passes
+    within ``margin`` x radius of the centre (away from silhouettes and from the tessellation's edge)."""
+    intr = scene.camera.intrinsics
+    pose = scene.camera.keypoints[0]
+    v, u = np.mgrid[0:intr.height, 0:intr.width].astype(np.float64)
+    rays = np.stack([u, v, np.ones_like(u)], axis=-1) @ np.linalg.inv(intr.K).T @ pose[:3, :3].T
+    rays /= np.linalg.norm(rays, axis=-1, keepdims=True)
+    origin = pose[:3, 3]
+    distance = np.full(u.shape, np.inf)
+    owner = np.full(u.shape, -1)
+    inner = np.zeros(u.shape, bool)
+    radius = DIAMETER / 2
+    entries = sweep(names, group)
+    for index, center in enumerate(sphere_centers(len(entries))):
+        oc = origin - np.asarray(center)
+        b = rays @ oc
+        closest2 = oc @ oc - b * b
+        t = -b - np.sqrt(np.maximum(radius * radius - closest2, 0.0))
+        hit = (closest2 < radius * radius) & (t > 0) & (t < distance)
+        distance[hit], owner[hit] = t[hit], index + 1
+        inner[hit] = closest2[hit] < (margin * radius) ** 2
+    t_floor = -origin[2] / np.minimum(rays[..., 2], -1e-9)
+    floor = (rays[..., 2] < 0) & (t_floor < distance) & (np.abs(origin[0] + t_floor * rays[..., 0]) < 2.5)
+    masks = {"floor": floor}
+    for index, (name, _, _) in enumerate(entries):
+        masks[name] = (owner == index + 1) & inner & ~floor
+    return masks
+
+
+def object_means(image: np.ndarray, masks: dict[str, np.ndarray]) -> dict[str, list[float]]:
+    """Mean linear RGB of ``image`` over each mask."""
+    return {name: image[mask].astype(np.float64).mean(axis=0).tolist() for name, mask in masks.items()}
