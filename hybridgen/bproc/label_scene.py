@@ -28,6 +28,11 @@ def merged_mesh(obj: MeshObject, frame: int) -> "ScenePart":
     from ..scene.mesh_object import MeshObject as ScenePart
 
     parts = obj.scene_parts(frame)
+    if not parts:  # a mesh object without geometry (a URDF link): a 1 micrometre triangle at its origin, which
+        # covers no pixel centre (BlenderProc's empty mesh has no pixels either)
+        speck = np.array([[0.0, 0.0, 0.0], [1e-6, 0.0, 0.0], [0.0, 1e-6, 0.0]])
+        return ScenePart(name=obj.get_name(), vertices=speck, faces=np.array([[0, 1, 2]]),
+                         local2world=obj.world_matrix(frame))
     if len(parts) == 1:
         return parts[0]
     offsets = np.cumsum([0] + [len(part.vertices) for part in parts[:-1]])

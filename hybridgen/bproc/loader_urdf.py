@@ -7,12 +7,13 @@ element or ``<link>_visual`` / ``<link>_collision``, scaled by the element's siz
 ``get_size_from_geometry`` scales it (the largest mesh scale; for boxes and cylinders their largest dimension,
 on top of the dimensions - BlenderProc's behaviour); a visual's ``<material>`` becomes its only material
 (shared by name, white when the URDF gives no color, a ``<texture>`` as base color image). Every link has an
-``<link>_inertial`` 3 cm cube when it has an ``<inertial>``. Each link is a :class:`Link` entity at its
-zero-pose world matrix holding its objects as children; collision and inertial objects are hidden. The robot is
-a :class:`URDFObject` (an entity named after the robot) holding the links.
-
-hybridgen has no armature: the joint-space calls (forward and inverse kinematics, bone controllers) raise one
-line naming the call; ``get_all_local2world_mats`` gives the links' joint frames (BlenderProc: its bones').
+``<link>_inertial`` 3 cm cube at the link's frame when it has an ``<inertial>`` (its origin kept, not applied, as
+BlenderProc does). Each link is a :class:`Link` entity at its zero-pose world matrix; the robot is a
+:class:`URDFObject` (an entity named after the robot, BlenderProc's armature) parenting the links and their
+objects, with BlenderProc's bones for every joint (:mod:`hybridgen.bproc.urdf_rig`) that move the objects
+(:mod:`hybridgen.bproc.urdf_object`); collision and inertial objects are hidden. ``weight_distribution`` changes
+nothing here (every object follows one bone rigidly, BlenderProc's default ``rigid``); ``fk_offset`` and
+``ik_offset`` place the FK and IK bones (m), which only moves where BlenderProc's IK controller sits.
 """
 from __future__ import annotations
 
@@ -25,6 +26,7 @@ from ..io.urdf import Element, Robot, mesh_file, read_urdf
 from .loader_support import to_mesh_objects
 from .types import Material, MeshObject
 from .urdf_object import Inertial, Link, URDFObject
+from .urdf_rig import build_rig
 from .utility import resolve_path
 
 __all__ = ["Inertial", "Link", "URDFObject", "load_urdf"]
@@ -99,17 +101,17 @@ def _element_object(robot: Robot, element: Element, name: str, link_pose: np.nda
 
 def load_urdf(urdf_file: str, weight_distribution: str = "rigid", fk_offset: Any = None,
               ik_offset: Any = None) -> URDFObject:
-    """The robot of ``urdf_file`` at its zero pose (module doc). ``weight_distribution``, ``fk_offset`` and
-    ``ik_offset`` shape BlenderProc's armature, which hybridgen does not build; they change nothing rendered."""
+    """The robot of ``urdf_file`` at its zero pose (module doc)."""
     from .object import create_primitive
 
     if weight_distribution not in ("envelope", "automatic", "rigid"):
         raise InputError(f"bproc.loader.load_urdf: weight_distribution must be envelope, automatic or rigid, got "
                          f"{weight_distribution!r}")
     robot = read_urdf(resolve_path(urdf_file))
-    urdf_object = URDFObject(robot.name, [], robot)  # first, as BlenderProc's armature: a link of its name is .001
-    materials: dict[str, Material] = {}
-    links: list[Link] = []
+    armature, rigs = build_rig(robot, fk_offset, ik_offset)
+    urdf_object = URDFObject(robot.name, [], robot, armature)  # first, as BlenderProc's armature: a link of its
+    materials: dict[str, Material] = {}                            # name is then .001
+    by_name: dict[str, Link] = {}
     for spec in robot.links:
         pose = robot.link_poses[spec.name]
         visuals = [_element_object(robot, e, f"{spec.name}_visual", pose, materials) for e in spec.visuals]
@@ -120,22 +122,38 @@ def load_urdf(urdf_file: str, weight_distribution: str = "rigid", fk_offset: Any
             _bake_scale(cube, np.full(3, INERTIAL_SIZE / 2))
             inertial = Inertial(f"{spec.name}_inertial", cube.parts, spec.inertial.mass, spec.inertial.inertia,
                                 spec.inertial.origin)
-            inertial.set_local2world_mat(pose @ spec.inertial.origin)
+            inertial.set_local2world_mat(pose)
             cube.delete()
         link = Link(spec.name, pose)
         link.visuals, link.collisions, link.inertial = visuals, collisions, inertial
+        link.visual_local2link_mats = [e.origin.copy() for e in spec.visuals]
+        link.collision_local2link_mats = [e.origin.copy() for e in spec.collisions]
+        link.inertial_local2link_mat = None if inertial is None else np.eye(4)
+        link.armature, link.owner = armature, urdf_object
         joint = robot.joint_of(spec.name)
         if joint is not None:
-            link.joint_type, link.joint_name = joint.type, joint.name
-        for obj in link.get_all_objs():
-            obj.set_parent(link)
-        links.append(link)
-    by_name = {spec.name: link for spec, link in zip(robot.links, links)}
-    for joint in robot.joints:
-        child, parent = by_name.get(joint.child), by_name.get(joint.parent)
-        if child is not None and parent is not None:
-            child.link_parent, parent.link_child = parent, child
-            child.set_parent(parent)
-    urdf_object.links = links
+            link.joint_type, link.joint_name, link.rig = joint.type, joint.name, rigs.get(joint.name)
+        if link.rig is not None:
+            link.link2bone_mat = np.linalg.inv(pose) @ armature.pose(link.rig.deform.name)
+        for obj in [link, *link.get_all_objs()]:
+            obj.set_parent(urdf_object)
+        by_name[spec.name] = link
+    _link_neighbours(robot, by_name)
+    urdf_object.links = [by_name[spec.name] for spec in robot.links]
+    urdf_object.all_links = list(urdf_object.links)
     urdf_object.hide_links_and_collision_inertial_objs()
     return urdf_object
+
+
+def _link_neighbours(robot: Robot, links: dict[str, Link]) -> None:
+    """Each link's parent and (last) child link, walking the joints from the root as BlenderProc does."""
+    children = {joint.child for joint in robot.joints}
+
+    def walk(parent_name: str) -> None:
+        for joint in (j for j in robot.joints if j.parent == parent_name):
+            links[joint.child].link_parent, links[parent_name].link_child = links[parent_name], links[joint.child]
+            walk(joint.child)
+
+    for spec in robot.links:
+        if spec.name not in children:
+            walk(spec.name)

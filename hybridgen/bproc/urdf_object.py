@@ -1,124 +1,79 @@
-"""``bproc.types``-style classes of a loaded URDF robot (BlenderProc's URDFObject, Link and Inertial) without
-Blender's armature: links are entities at their zero pose holding their visual, collision and inertial objects as
-children; the joint-space calls (forward and inverse kinematics, bone controllers) raise one line naming the call.
-:func:`hybridgen.bproc.loader_urdf.load_urdf` builds them."""
+"""``bproc.types.URDFObject``: a loaded URDF robot with BlenderProc's armature (its URDFUtility), built by
+:func:`hybridgen.bproc.loader_urdf.load_urdf`.
+
+The robot is an entity (BlenderProc's armature object) that parents its links and their objects; moving it moves
+the whole robot. Its joints' bones (:mod:`hybridgen.bproc.urdf_rig`) are posed by forward kinematics
+(``set_rotation_euler_fk``: one link, or every revolute joint when ``link`` is None) or inverse kinematics
+(``create_ik_bone_controller`` then ``set_location_ik`` / ``set_rotation_euler_ik``), each call keying the
+bones at ``frame`` (BlenderProc's ``_set_keyframe``: the frame range grows by one when ``frame`` is past its
+end). After every change each link's visual, collision and inertial objects are posed by their joint's deform
+bone - the current pose and the pose at every keyed frame - so that frame ``f`` renders the pose keyed at ``f``
+in color and labels. ``get_all_local2world_mats`` gives each jointed link's deform bone pose (4x4, world, m;
+the bone's Y axis along the joint axis, as Blender's bones), ``frame`` (hybridgen's addition) the pose keyed
+there. ``has_reached_ik_pose`` compares the IK constraint bone and the controller now with their offset when the
+controller was made (metres, radians).
+"""
 from __future__ import annotations
 
-from typing import Any, Callable
+from contextlib import contextmanager
+from typing import Any, Iterator
 
 import numpy as np
 
 from ..errors import InputError
 from ..io.urdf import Robot
+from ..logs import log_line
+from .armature import Armature
+from .bone import Bone
+from .bone_math import quaternion_angle
+from .session import SESSION
 from .types import Entity, MeshObject
-from .types.unsupported import unsupported_method
+from .urdf_link import Inertial, Link
+from .urdf_poser import ObjectPoser
+from .urdf_rig import SCENE_FRAME
 
-
-def _urdf_method(name: str) -> Callable[..., Any]:
-    return unsupported_method("URDFObject", name, "hybridgen has no armature")
-
-
-class Inertial(MeshObject):
-    """A link's inertial element: a hidden cube with the link's ``mass`` (kg) and 3x3 ``inertia``."""
-
-    def __init__(self, name: str, parts: list[Any], mass: float, inertia: np.ndarray, origin: np.ndarray) -> None:
-        super().__init__(name, parts)
-        self._mass, self._inertia, self._origin_mat = float(mass), np.array(inertia), np.array(origin)
-
-    def get_mass(self) -> float:
-        return self._mass
-
-    def set_mass(self, mass: float) -> None:
-        self._mass = float(mass)
-
-    def get_inertia(self) -> np.ndarray:
-        return self._inertia.copy()
-
-    def set_inertia(self, inertia: Any) -> None:
-        self._inertia = np.asarray(inertia, dtype=np.float64).reshape(3, 3)
-
-
-class Link(Entity):
-    """A URDF link: its visuals, collisions and inertial (children of it), its joint's type and neighbours."""
-
-    def __init__(self, name: str, local2world: np.ndarray) -> None:
-        super().__init__(name, local2world)
-        self.visuals: list[MeshObject] = []
-        self.collisions: list[MeshObject] = []
-        self.inertial: Inertial | None = None
-        self.joint_type: str | None = None
-        self.joint_name: str | None = None
-        self.link_parent: Link | None = None
-        self.link_child: Link | None = None
-
-    def get_visuals(self) -> list[MeshObject]:
-        return list(self.visuals)
-
-    def get_collisions(self) -> list[MeshObject]:
-        return list(self.collisions)
-
-    def get_inertial(self) -> Inertial | None:
-        return self.inertial
-
-    def get_all_objs(self) -> list[MeshObject]:
-        """Visuals, collisions and the inertial."""
-        return self.visuals + self.collisions + ([self.inertial] if self.inertial is not None else [])
-
-    def get_joint_type(self) -> str | None:
-        return self.joint_type
-
-    def get_link_parent(self) -> "Link | None":
-        return self.link_parent
-
-    def get_link_child(self) -> "Link | None":
-        return self.link_child
-
-    def get_visual_local2world_mats(self, parent2world_matrix: Any = None) -> list[np.ndarray] | None:
-        return [v.get_local2world_mat() for v in self.visuals] or None
-
-    def get_collision_local2world_mats(self, parent2world_matrix: Any = None) -> list[np.ndarray] | None:
-        return [c.get_local2world_mat() for c in self.collisions] or None
-
-    def get_inertial_local2world_mat(self, parent2world_matrix: Any = None) -> np.ndarray | None:
-        return None if self.inertial is None else self.inertial.get_local2world_mat()
-
-    def hide(self, hide_object: bool = True) -> None:
-        """Hide the link and its objects."""
-        super().hide(hide_object)
-        for obj in self.get_all_objs():
-            obj.hide(hide_object)
-
-    set_rotation_euler_fk: Callable[..., Any] = unsupported_method("Link", "set_rotation_euler_fk",
-                                                                   "hybridgen has no armature")
-    set_rotation_euler_ik: Callable[..., Any] = unsupported_method("Link", "set_rotation_euler_ik",
-                                                                   "hybridgen has no armature")
-    set_location_ik: Callable[..., Any] = unsupported_method("Link", "set_location_ik", "hybridgen has no armature")
-    create_ik_bone_controller: Callable[..., Any] = unsupported_method("Link", "create_ik_bone_controller",
-                                                                       "hybridgen has no armature")
-    get_joint_rotation: Callable[..., Any] = unsupported_method("Link", "get_joint_rotation",
-                                                                "hybridgen has no armature")
+__all__ = ["Inertial", "Link", "URDFObject"]
 
 
 class URDFObject(Entity):
-    """A loaded URDF robot: ``links`` in the file's order (BlenderProc's URDFObject, without its armature)."""
+    """A loaded URDF robot: ``links`` in the file's order (module documentation)."""
 
-    def __init__(self, name: str, links: list[Link], robot: Robot) -> None:
+    def __init__(self, name: str, links: list[Link], robot: Robot, armature: Armature | None = None) -> None:
         super().__init__(name)
         self.links = links
         self.xml_tree = robot
+        self.armature = armature if armature is not None else Armature()
+        self.all_links: list[Link] = list(links)
+        self.fk_ik_mode: str | None = None
         self.ik_link: Link | None = None
+        self.ik_constraint_bone: Bone | None = None
+        self.ik_controller_bone: Bone | None = None
+        self.ik_bone_offset: np.ndarray | None = None
+        self._poser = ObjectPoser()
+        self._batch = 0
 
+    @contextmanager
+    def _batched(self) -> Iterator[None]:
+        """Changes inside pose the objects once, at the end."""
+        self._batch += 1
+        try:
+            yield
+        finally:
+            self._batch -= 1
+        self.refresh_objects()
+
+    # --- parts --------------------------------------------------------------------------------------------
     def get_all_urdf_objs(self) -> list[Entity]:
         return [obj for link in self.links for obj in [link, *link.get_all_objs()]]
 
     def get_all_collision_objs(self) -> list[MeshObject]:
-        return [obj for link in self.links for obj in link.collisions]
+        return [obj for obj in self.get_all_urdf_objs() if "collision" in obj.get_name()]
 
     def get_all_inertial_objs(self) -> list[Inertial]:
-        return [link.inertial for link in self.links if link.inertial is not None]
+        return [obj for obj in self.get_all_urdf_objs() if isinstance(obj, Inertial)]
 
     def get_all_visual_objs(self) -> list[MeshObject]:
-        return [obj for link in self.links for obj in link.visuals]
+        return [obj for obj in self.get_all_urdf_objs() if "visual" in obj.get_name()]
 
     def get_links_with_revolute_joints(self) -> list[Link]:
         return [link for link in self.links if link.joint_type == "revolute"]
@@ -129,6 +84,11 @@ class URDFObject(Entity):
             for obj in link.get_all_objs():
                 if "collision" in obj.get_name() or "inertial" in obj.get_name():
                     obj.hide()
+
+    def hide(self, hide_object: bool = True) -> None:
+        super().hide(hide_object)
+        for link in self.links:
+            link.hide(hide_object)
 
     def set_ascending_category_ids(self, category_ids: list[int] | None = None) -> None:
         """``category_id`` 1, 2, ... (or ``category_ids``) for the links and their objects, in link order."""
@@ -142,54 +102,166 @@ class URDFObject(Entity):
                 obj.set_cp("category_id", category_id)
 
     def remove_link_by_index(self, index: int = 0) -> None:
-        """Drop link ``index`` from ``links``. A link with a joint is deleted with its objects, its child chain
-        moved by the offset between the two joints' positions (BlenderProc moves the bones' heads so); a link
-        without a joint (a 'world' link) only leaves the list, as in BlenderProc."""
+        """Drop link ``index`` from ``links``. When it has a joint and a child, its objects and itself are
+        deleted and the child's chain (bones and objects) moves by the offset between the two joints, so the
+        child takes its place (rotations unchanged); a link without a joint only leaves the list, as in
+        BlenderProc."""
         if not 0 <= index < len(self.links):
             raise InputError(f"Invalid index {index}. Index must be in range 0, {len(self.links)} (no. links: "
                              f"{len(self.links)}).")
         removed = self.links.pop(index)
         child = removed.link_child
-        if child is None or removed.joint_name is None:
+        if child is None or removed.rig is None:
             return
-        offset = child.get_local2world_mat()[:3, 3] - removed.get_local2world_mat()[:3, 3]
+        offset = (child.rig.deform.head if child.rig is not None else child.basis(None)[:3, 3]) \
+            - removed.rig.deform.head
+        self.armature.reset_to_frame(SCENE_FRAME)  # BlenderProc edits the bones in edit mode
         chain: Link | None = child
         while chain is not None:
+            for bone in chain.rig.bones() if chain.rig is not None else []:
+                bone.head, bone.tail = bone.head - offset, bone.tail - offset
             for obj in chain.get_all_objs():
-                obj.set_local2world_mat(_shifted(obj.get_local2world_mat(), -offset))
+                rest = self._poser.rest_basis(obj)
+                rest[:3, 3] -= offset
+                self._poser.set_rest_basis(obj, rest)
             chain = chain.link_child
         if removed is self.ik_link:
             self.ik_link = None
         for obj in removed.get_all_objs():
             obj.delete()
         removed.delete()
+        self.refresh_objects()
 
-    def hide(self, hide_object: bool = True) -> None:
-        super().hide(hide_object)
+    # --- poses --------------------------------------------------------------------------------------------
+    def _poses(self, frame: int | None) -> dict[str, np.ndarray]:
+        if frame is None:
+            self.armature.update()
+            return self.armature.evaluated
+        return self.armature.evaluate(frame)
+
+    def get_all_local2world_mats(self, frame: int | None = None) -> np.ndarray:
+        """(links with a joint, 4, 4): their deform bones' poses in the world (m)."""
+        poses, world = self._poses(frame), self.world_matrix(frame)
+        return np.stack([world @ poses[link.rig.deform.name] for link in self.links if link.rig is not None])
+
+    def _stacked(self, kind: str, frame: int | None) -> np.ndarray:
+        world = self.world_matrix(frame)
+        per_link = [getattr(link, f"get_{kind}_local2world_mat{'' if kind == 'inertial' else 's'}")(world, frame)
+                    for link in self.links]
+        missing = [link.get_name() for link, mats in zip(self.links, per_link) if mats is None]
+        if missing:
+            raise InputError(f"bproc.types.URDFObject.get_all_{kind}_local2world_mats: link(s) {missing} have no "
+                             f"{kind} (BlenderProc cannot stack them either)")
+        return np.stack([np.asarray(mats) for mats in per_link])
+
+    def get_all_visual_local2world_mats(self, frame: int | None = None) -> np.ndarray:
+        """(links, visuals per link, 4, 4): every link's visuals posed by its bone (m, world)."""
+        return self._stacked("visual", frame)
+
+    def get_all_collision_local2world_mats(self, frame: int | None = None) -> np.ndarray:
+        return self._stacked("collision", frame)
+
+    def get_all_inertial_local2world_mats(self, frame: int | None = None) -> np.ndarray:
+        return self._stacked("inertial", frame)
+
+    # --- the objects following the bones ------------------------------------------------------------------
+    def refresh_objects(self) -> None:
+        """Pose every link's objects by its deform bone: now, and at every keyed frame (module documentation)."""
+        if not self._batch:
+            self._poser.refresh(self.armature, self.all_links)
+
+    # --- joint space --------------------------------------------------------------------------------------
+    def _switch_fk_ik_mode(self, mode: str = "fk", keep_pose: bool = True) -> None:
+        if mode == "ik" and self.ik_controller_bone is None:
+            raise InputError("bproc.types.URDFObject: no IK bone controller; set one up first with "
+                             "create_ik_bone_controller()")
+        if self.fk_ik_mode != mode:
+            for link in self.links:
+                link.switch_fk_ik_mode(mode, keep_pose)
+            self.fk_ik_mode = mode
+
+    def _set_keyframe(self, name: str, frame: int) -> None:
+        """Key ``name`` (``rotation_euler`` or ``location``) of the robot and its bones at ``frame``."""
+        self.armature.update()
+        own = self._rotation if name == "rotation_euler" else self._location
+        own.set(own.value, int(frame))
+        bones: list[Bone] = []
         for link in self.links:
-            link.hide(hide_object)
+            if link.rig is not None:
+                bones.extend(link.rig.bones())
+                for constraint in (link.rig.deform.copy_rotation(n) for n in ("copy_rotation.fk", "copy_rotation.ik")):
+                    if constraint is not None and link.joint_type == "revolute":
+                        constraint.influence.set(constraint.influence.value, int(frame))
+        bones += [b for b in (self.ik_constraint_bone, self.ik_controller_bone) if b is not None]
+        for bone in bones:
+            value = bone.rotation if name == "rotation_euler" else bone.location
+            value.set(value.value, int(frame))
+        if int(frame) > SESSION.frame_end:
+            SESSION.frame_end += 1
 
-    def get_all_local2world_mats(self) -> np.ndarray:
-        """(links with a joint, 4, 4): their joint frames in the world."""
-        return np.stack([link.get_local2world_mat() for link in self.links if link.joint_name is not None])
+    def set_rotation_euler_fk(self, link: Link | None, rotation_euler: Any, mode: str = "absolute",
+                              frame: int = 0) -> None:
+        """Rotate ``link``'s joint, or every revolute joint (one angle each, or a list with one per joint), in
+        FK mode; keyed at ``frame``."""
+        with self._batched():
+            self._switch_fk_ik_mode("fk")
+            if link is not None:
+                link.set_rotation_euler_fk(rotation_euler, mode)
+            else:
+                revolute = self.get_links_with_revolute_joints()
+                if isinstance(rotation_euler, list) and len(rotation_euler) == len(revolute):
+                    for joint_link, rotation in zip(revolute, rotation_euler):
+                        joint_link.set_rotation_euler_fk(rotation, mode)
+                else:
+                    for joint_link in revolute:
+                        joint_link.set_rotation_euler_fk(rotation_euler, mode)
+            self._set_keyframe("rotation_euler", frame)
 
-    def get_all_visual_local2world_mats(self) -> np.ndarray:
-        return np.stack([obj.get_local2world_mat() for obj in self.get_all_visual_objs()])
+    def create_ik_bone_controller(self, link: Link | None = None, relative_location: Any = None,
+                                  use_rotation: bool = True, chain_length: int = 0) -> None:
+        """Set up IK for ``link`` (default: the last), its point of control ``relative_location`` (m, armature
+        axes) from its joint; ``chain_length`` parent bones move (0: all); ``use_rotation``: the link turns too."""
+        if self.ik_controller_bone is not None:
+            raise InputError("bproc.types.URDFObject.create_ik_bone_controller: the robot already has an IK "
+                             "controller; more than one is not supported (as in BlenderProc)")
+        link = self.links[-1] if link is None else link
+        with self._batched():
+            constraint, controller, offset = link.create_ik_bone_controller(relative_location, use_rotation,
+                                                                            chain_length)
+            self.ik_constraint_bone, self.ik_controller_bone, self.ik_bone_offset = constraint, controller, offset
+            self.ik_link = link
+            self._switch_fk_ik_mode("ik")
 
-    def get_all_collision_local2world_mats(self) -> np.ndarray:
-        return np.stack([obj.get_local2world_mat() for obj in self.get_all_collision_objs()])
+    def _ik_link(self, call: str) -> Link:
+        self._switch_fk_ik_mode("ik")
+        if self.ik_link is None:
+            raise InputError(f"bproc.types.URDFObject.{call}: the robot has no IK link")
+        return self.ik_link
 
-    def get_all_inertial_local2world_mats(self) -> np.ndarray:
-        return np.stack([obj.get_local2world_mat() for obj in self.get_all_inertial_objs()])
+    def set_rotation_euler_ik(self, rotation_euler: Any, mode: str = "absolute", frame: int = 0) -> None:
+        """Rotate the IK controller (XYZ angles, rad), keyed at ``frame``."""
+        with self._batched():
+            self._ik_link("set_rotation_euler_ik").set_rotation_euler_ik(rotation_euler, mode)
+            self._set_keyframe("rotation_euler", frame)
 
-    set_rotation_euler_fk = _urdf_method("set_rotation_euler_fk")
-    set_rotation_euler_ik = _urdf_method("set_rotation_euler_ik")
-    set_location_ik = _urdf_method("set_location_ik")
-    create_ik_bone_controller = _urdf_method("create_ik_bone_controller")
-    has_reached_ik_pose = _urdf_method("has_reached_ik_pose")
+    def set_location_ik(self, location: Any, frame: int = 0) -> None:
+        """Ask the IK link's joint to reach ``location`` (m, armature frame), keyed at ``frame``."""
+        with self._batched():
+            self._ik_link("set_location_ik").set_location_ik(location)
+            self._set_keyframe("location", frame)
 
+    def has_reached_ik_pose(self, location_error: float = 0.01, rotation_error: float = 0.01) -> bool:
+        """Whether the IK chain reached the controller: translation (m) and rotation (rad) differences from the
+        offset they had when it was made, each below its tolerance."""
+        if self.ik_constraint_bone is None or self.ik_controller_bone is None or self.ik_bone_offset is None:
+            raise InputError("bproc.types.URDFObject.has_reached_ik_pose: no IK bone controller; call "
+                             "create_ik_bone_controller() first")
+        current = np.linalg.inv(self.armature.pose(self.ik_constraint_bone.name)) \
+            @ self.armature.pose(self.ik_controller_bone.name)
+        moved = float(np.linalg.norm(current[:3, 3] - self.ik_bone_offset[:3, 3]))
+        turned = quaternion_angle(current[:3, :3].T @ self.ik_bone_offset[:3, :3])
+        reached = moved < location_error and turned < rotation_error
+        log_line(f"IK pose {'is' if reached else 'is not'} within the given constraints: translation difference "
+                 f"{moved:.4f} (max: {location_error}), rotation difference {turned:.4f} (max: {rotation_error})")
+        return reached
 
-def _shifted(matrix: np.ndarray, delta: np.ndarray) -> np.ndarray:
-    moved = matrix.copy()
-    moved[:3, 3] += delta
-    return moved

@@ -300,8 +300,10 @@ def test_urdf_links_at_the_zero_pose(bproc, tmp_path):
     robot.set_ascending_category_ids()
     assert visual.get_cp("category_id") == 2
     assert robot.get_all_local2world_mats().shape == (1, 4, 4)
-    with pytest.raises(InputError, match="URDFObject.set_rotation_euler_fk is not supported"):
-        robot.set_rotation_euler_fk(link=None, rotation_euler=0.2, mode="relative", frame=0)
+    robot.set_rotation_euler_fk(link=None, rotation_euler=0.5, mode="relative", frame=0)  # about j1's axis (z)
+    turned = np.pi / 2 + 0.5
+    np.testing.assert_allclose(visual.get_local2world_mat()[:3, 3], [0.1 * np.cos(turned), 0.1 * np.sin(turned), 0.5],
+                               atol=1e-9)
     robot.remove_link_by_index(0)  # no joint: only leaves the list
     assert [link.get_name() for link in robot.links] == ["arm.001"] and base.is_valid()
 
