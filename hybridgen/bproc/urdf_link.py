@@ -2,11 +2,12 @@
 
 A link is a mesh object without geometry that stays at its zero pose (BlenderProc's link objects are moved by
 their armature's deformation, not by their own pose); its visual, collision and inertial objects follow its
-joint's deform bone (:mod:`hybridgen.bproc.urdf_rig`), keyed per frame by its robot (:mod:`hybridgen.bproc.urdf_object`). Its
-joint's bones are ``rig`` (None for the root link). Joint-space calls act on those bones as BlenderProc's do: FK
-sets the FK bone's Euler angles (absolute ones clipped to the joint's limits), IK moves the IK controller bone
-(``create_ik_bone_controller``), and ``switch_fk_ik_mode`` hands the link's deform bone from one chain to the
-other, the new chain taking the old one's pose. Matrices are 4x4, metres, world frame unless said otherwise.
+joint's deform bone (:mod:`hybridgen.bproc.urdf_rig`), keyed per frame by its robot
+(:mod:`hybridgen.bproc.urdf_object`). Its joint's bones are ``rig`` (None for the root link). Joint-space calls
+act on those bones as BlenderProc's do: FK sets the FK bone's Euler angles (absolute ones clipped to the joint's
+limits), IK moves the IK controller bone (``create_ik_bone_controller``), and ``switch_fk_ik_mode`` hands the
+link's deform bone from one chain to the other, the new chain taking the old one's pose. Matrices are 4x4,
+metres, world frame unless said otherwise.
 """
 from __future__ import annotations
 
