@@ -15,8 +15,8 @@ All angles in radians, rotations as 3x3 NumPy matrices acting on column vectors,
 - :func:`twist_angle` / :func:`axis_angle`: the angle about one local axis that Blender's IK solver reads from a
   bone's rotation (the twist about Y; the Euler angle about X or Z).
 
-tests/bproc/test_bone_math.py holds these against bone matrices measured with bpy 4.2
-(tools/urdf_poses.py ``--bones``).
+tests/bproc/test_urdf_blender_table.py holds the rest rotations (and the poses they lead to) against bpy 4.2's
+(tools/urdf_table.py).
 """
 from __future__ import annotations
 
