@@ -80,6 +80,7 @@ def _render_square(bproc, strength: float | None) -> np.ndarray:  # noqa: F811
     return np.where(colors <= 0.04045, colors / 12.92, ((colors + 0.055) / 1.055) ** 2.4)  # linear
 
 
+@pytest.mark.filterwarnings("ignore:bproc.material.add_dust")
 @pytest.mark.parametrize("strength", [1.0])
 def test_dusty_square_renders_toward_dust(bproc, strength: float) -> None:  # noqa: F811
     import hybridgen.bproc as module
