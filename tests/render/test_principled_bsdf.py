@@ -1,7 +1,8 @@
 """hybridgen's Principled BSDF (render/pathtrace/principled_bsdf.py) against its analytic limits: white furnace per
 lobe mix (by sampling and by integrating eval over the sphere, both), Fresnel at normal incidence from the IOR,
 the Lambertian limit, metallic F82 tint at 82 degrees, and sample / eval / pdf consistency (exact per sample,
-and the sampled directions' moments against the pdf's)."""
+and the sampled directions' moments against the pdf's); sheen and subsurface likewise, and their limits (no
+sheen below a weight, the sheen lobe's own albedo, the subsurface diffuse fallback's clamped base color)."""
 from __future__ import annotations
 
 import math
@@ -32,7 +33,7 @@ def mi(request: pytest.FixtureRequest):
 def bsdf(mi, base=(1.0, 1.0, 1.0), **inputs):
     from hybridgen.render.pathtrace.principled_bsdf import PLUGIN_NAME
 
-    for name in ("specular_tint", "coat_tint"):
+    for name in ("specular_tint", "coat_tint", "sheen_tint"):
         if name in inputs:
             inputs[name] = mi.ScalarColor3f(inputs[name])
     return mi.load_dict({"type": PLUGIN_NAME, "base_color": {"type": "rgb", "value": list(base)}, **inputs})
@@ -85,11 +86,20 @@ FURNACE = [  # (inputs, conserves energy in Blender's model)
     (dict(roughness=0.5, specular=0.5, transmission=0.5), True),
     (dict(roughness=0.5, specular=0.5, coat_weight=1.0, coat_roughness=0.3, coat_tint=(0.9, 0.6, 0.3)), False),
     (dict(roughness=0.6, metallic=1.0, specular_tint=(0.2, 0.5, 1.0)), False),
+    # sheen on top of the stack at every roughness and weight: its albedo plus what it leaves the layers below
+    *[(dict(roughness=0.5, specular=0.5, sheen_weight=w, sheen_roughness=r), True)
+      for w, r in ((1.0, 0.05), (1.0, 0.3), (1.0, 0.5), (1.0, 1.0), (0.5, 0.7), (0.25, 0.2))],
+    (dict(roughness=0.3, specular=0.5, coat_weight=1.0, coat_roughness=0.2, sheen_weight=1.0, sheen_roughness=0.4),
+     True),
+    (dict(roughness=0.4, metallic=1.0, sheen_weight=0.8, sheen_roughness=0.6), True),
+    (dict(roughness=0.5, specular=0.5, sheen_weight=1.0, sheen_roughness=0.5, sheen_tint=(1.0, 0.5, 0.2)), False),
+    (dict(roughness=0.5, specular=0.5, subsurface_weight=1.0), True),
+    (dict(roughness=0.3, specular=0.5, subsurface_weight=0.5, sheen_weight=0.7, sheen_roughness=0.8), True),
 ]
 
 
 @pytest.mark.parametrize("inputs,conserves", FURNACE)
-@pytest.mark.parametrize("mu", [0.95, 0.4])
+@pytest.mark.parametrize("mu", [0.95, 0.4, 0.12])
 def test_white_furnace(mi, inputs, conserves, mu) -> None:
     b = bsdf(mi, **inputs)
     _, weights, pdfs = sampled(mi, b, mu)
@@ -98,8 +108,8 @@ def test_white_furnace(mi, inputs, conserves, mu) -> None:
     noise = 4.0 * weights.std(axis=0) / math.sqrt(len(weights)) + 0.004
     np.testing.assert_allclose(by_sampling, by_integration, atol=noise.max())
     assert by_integration.max() <= 1.0 + 0.012, (inputs, by_integration)  # never created
-    if conserves:
-        np.testing.assert_allclose(by_integration, 1.0, atol=0.012)
+    if conserves:  # Cycles' layering by estimated albedos loses up to 1.5 % at grazing views (coat, mu 0.12)
+        np.testing.assert_allclose(by_integration, 1.0, atol=0.012 if mu >= 0.4 else 0.02)
     else:
         assert by_integration.min() < 0.985  # a tint absorbs (the F82 tint mostly at grazing angles)
 
@@ -159,7 +169,11 @@ def test_metallic_f82_tint(mi, tint) -> None:
 CONSISTENCY = [dict(base=(0.7, 0.4, 0.2), roughness=0.5, specular=0.5),
                dict(base=(0.8, 0.8, 0.8), roughness=0.35, metallic=1.0, anisotropic=0.7, anisotropic_rotation=0.1),
                dict(base=(0.5, 0.9, 0.6), roughness=0.4, transmission=1.0, ior=1.5),
-               dict(base=(0.6, 0.2, 0.2), roughness=0.6, specular=0.7, coat_weight=0.8, coat_roughness=0.35)]
+               dict(base=(0.6, 0.2, 0.2), roughness=0.6, specular=0.7, coat_weight=0.8, coat_roughness=0.35),
+               dict(base=(0.1, 0.05, 0.2), roughness=0.5, specular=0.5, sheen_weight=1.0, sheen_roughness=0.3,
+                    sheen_tint=(0.9, 0.8, 1.0)),
+               dict(base=(0.0, 0.0, 0.0), specular=0.0, sheen_weight=1.0, sheen_roughness=0.8),
+               dict(base=(0.8, 0.5, 0.4), roughness=0.5, specular=0.5, subsurface_weight=0.6)]
 
 
 @pytest.mark.parametrize("inputs", CONSISTENCY)
@@ -213,3 +227,43 @@ def test_flags_name_the_lobes(mi) -> None:
     types = np.array(bs.sampled_type)
     assert below.any() and np.all(types[below] == int(flags.GlossyTransmission))
     assert np.all(types[~below & (pdfs > 0)] == int(flags.GlossyReflection))
+
+
+@pytest.mark.parametrize("mu", [0.9, 0.5, 0.15])
+def test_sheen_weight_zero_is_no_sheen_and_the_lobe_reflects_its_albedo(mi, mu) -> None:
+    """Sheen Weight 0 is the material without sheen exactly; over a black base without specular the BSDF is the
+    sheen lobe alone, whose albedo (by sampling and by integration) is weight x tint x R(mu, roughness) and whose
+    every sample weighs just that (the lobe is drawn exactly)."""
+    from hybridgen.render.pathtrace import principled_tables as tables
+
+    plain, zero = bsdf(mi, base=(0.6, 0.3, 0.2), roughness=0.4), bsdf(mi, base=(0.6, 0.3, 0.2), roughness=0.4,
+                                                                       sheen_weight=0.0, sheen_roughness=0.2)
+    np.testing.assert_array_equal(integrated(mi, plain, mu)[0], integrated(mi, zero, mu)[0])
+    for rough in (0.2, 0.5, 0.9):
+        _, _, albedo = tables.sheen_ltc(mi.Float(rough), mi.Float(mu))
+        expected = 0.7 * np.array([1.0, 0.6, 0.3]) * float(np.array(albedo)[0])
+        lobe = bsdf(mi, base=(0.0, 0.0, 0.0), specular=0.0, sheen_weight=0.7, sheen_roughness=rough,
+                    sheen_tint=(1.0, 0.6, 0.3))
+        _, weights, _ = sampled(mi, lobe, mu)
+        np.testing.assert_allclose(weights, np.broadcast_to(expected, weights.shape), rtol=2e-4, atol=1e-7)
+        np.testing.assert_allclose(integrated(mi, lobe, mu)[0], expected, rtol=0.01, atol=2e-5)
+
+
+def test_subsurface_is_the_diffuse_fallback(mi) -> None:
+    """Subsurface Weight w mixes Cycles' diffuse lobe (the base color) with its BSSRDF's diffuse fallback (the
+    base color clamped to 1; hybridgen's base colors are in 0..1): the Lambertian albedo stays the base color."""
+    base = np.array([0.9, 0.5, 0.2])
+    for weight in (0.0, 0.5, 1.0):
+        b = bsdf(mi, base=tuple(base), roughness=0.4, specular=0.0, subsurface_weight=weight)
+        np.testing.assert_allclose(sampled(mi, b, 0.7)[1].mean(axis=0), base, rtol=1e-5)
+        np.testing.assert_allclose(integrated(mi, b, 0.7)[0], base, rtol=2e-3)
+    # the random walk's inputs stay on the material and do not reach the BSDF (hybridgen does not walk)
+    from hybridgen.render.pathtrace.principled_material import plugin_dict
+    from hybridgen.scene.material import Material
+
+    material = Material(extra={"subsurface_weight": 1.0, "subsurface_radius": [1.0, 0.5, 0.2], "subsurface_scale": 0.1,
+                               "subsurface_ior": 1.6, "subsurface_anisotropy": 0.3,
+                               "subsurface_method": "RANDOM_WALK_SKIN", "sheen_tint": [0.5, 0.5, 0.5]})
+    inputs = plugin_dict(material, "skin", {"type": "rgb", "value": [0.8, 0.5, 0.4]}, 0.5, 0.0, 0.5)
+    assert inputs["subsurface_weight"] == 1.0 and "sheen_tint" in inputs
+    assert not [key for key in inputs if key.startswith("subsurface_") and key != "subsurface_weight"]

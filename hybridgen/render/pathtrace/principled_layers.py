@@ -137,6 +137,8 @@ def layers(inp: Inputs, wi: Any, backfacing: Any) -> Layers:
         factor, albedo = _reflective_layer(inp.coat_rough, mu, inp.coat_ior, coat_f0)
         coat_w = inp.coat * factor
         share_coat = inp.coat * _average(albedo)
+        if inp.has_sheen:  # under the sheen (a gray weight: the sheen takes its albedo's largest channel)
+            coat_w, share_coat = coat_w * weight, share_coat * _average(weight)
         weight = weight * dr.clip(1.0 - inp.coat * _max(albedo), 0.0, 1.0)
         if inp.has_coat_tint:
             cos_t = dr.safe_sqrt(1.0 - (1.0 - mu * mu) / dr.square(inp.coat_ior))
