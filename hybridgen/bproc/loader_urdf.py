@@ -7,13 +7,14 @@ element or ``<link>_visual`` / ``<link>_collision``, scaled by the element's siz
 ``get_size_from_geometry`` scales it (the largest mesh scale; for boxes and cylinders their largest dimension,
 on top of the dimensions - BlenderProc's behaviour); a visual's ``<material>`` becomes its only material
 (shared by name, white when the URDF gives no color, a ``<texture>`` as base color image). Every link has an
-``<link>_inertial`` 3 cm cube at the link's frame when it has an ``<inertial>`` (its origin kept, not applied, as
-BlenderProc does). Each link is a :class:`Link` entity at its zero-pose world matrix; the robot is a
-:class:`URDFObject` (an entity named after the robot, BlenderProc's armature) parenting the links and their
-objects, with BlenderProc's bones for every joint (:mod:`hybridgen.bproc.urdf_rig`) that move the objects
-(:mod:`hybridgen.bproc.urdf_object`); collision and inertial objects are hidden. ``weight_distribution`` changes
-nothing here (every object follows one bone rigidly, BlenderProc's default ``rigid``); ``fk_offset`` and
-``ik_offset`` place the FK and IK bones (m), which only moves where BlenderProc's IK controller sits.
+``<link>_inertial`` 3 cm cube at the link's frame (its ``<inertial>``'s origin kept, not applied; without one,
+mass 1 kg and unit inertia, urdfpy's default), as BlenderProc makes them. Each link is a :class:`Link` (a mesh
+object without geometry) at its zero-pose world matrix; the robot is a :class:`URDFObject` (an entity named after
+the robot, BlenderProc's armature) parenting the links and their objects, with BlenderProc's bones for every joint
+(:mod:`hybridgen.bproc.urdf_rig`) that move the objects (:mod:`hybridgen.bproc.urdf_object`); collision and
+inertial objects are hidden. ``weight_distribution`` changes nothing here (every object follows one bone rigidly,
+BlenderProc's default ``rigid``); ``fk_offset`` and ``ik_offset`` place the FK and IK bones (m), which only moves
+where BlenderProc's IK controller sits.
 """
 from __future__ import annotations
 
@@ -23,6 +24,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..io.urdf import Element, Robot, mesh_file, read_urdf
+from ..io.urdf import Inertial as UrdfInertial
 from .loader_support import to_mesh_objects
 from .types import Material, MeshObject
 from .urdf_object import Inertial, Link, URDFObject
@@ -116,19 +118,17 @@ def load_urdf(urdf_file: str, weight_distribution: str = "rigid", fk_offset: Any
         pose = robot.link_poses[spec.name]
         visuals = [_element_object(robot, e, f"{spec.name}_visual", pose, materials) for e in spec.visuals]
         collisions = [_element_object(robot, e, f"{spec.name}_collision", pose, materials) for e in spec.collisions]
-        inertial = None
-        if spec.inertial is not None:
-            cube = create_primitive("CUBE")
-            _bake_scale(cube, np.full(3, INERTIAL_SIZE / 2))
-            inertial = Inertial(f"{spec.name}_inertial", cube.parts, spec.inertial.mass, spec.inertial.inertia,
-                                spec.inertial.origin)
-            inertial.set_local2world_mat(pose)
-            cube.delete()
+        element = spec.inertial or UrdfInertial(np.eye(4), 1.0, np.eye(3))  # urdfpy's default, as BlenderProc
+        cube = create_primitive("CUBE")
+        _bake_scale(cube, np.full(3, INERTIAL_SIZE / 2))
+        inertial = Inertial(f"{spec.name}_inertial", cube.parts, element.mass, element.inertia, element.origin)
+        inertial.set_local2world_mat(pose)
+        cube.delete()
         link = Link(spec.name, pose)
         link.visuals, link.collisions, link.inertial = visuals, collisions, inertial
         link.visual_local2link_mats = [e.origin.copy() for e in spec.visuals]
         link.collision_local2link_mats = [e.origin.copy() for e in spec.collisions]
-        link.inertial_local2link_mat = None if inertial is None else np.eye(4)
+        link.inertial_local2link_mat = np.eye(4)
         link.armature, link.owner = armature, urdf_object
         joint = robot.joint_of(spec.name)
         if joint is not None:
