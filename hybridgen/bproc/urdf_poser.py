@@ -17,10 +17,13 @@ from .types import Entity
 
 
 class ObjectPoser:
-    """The motion last applied to each object (by ``id``), to recover its undeformed pose."""
+    """The motion last applied to each object (by ``id``), to recover its undeformed pose, and what each object's
+    key at each frame was made from (a key made from the same bone poses and undeformed pose is not made again)."""
 
     def __init__(self) -> None:
         self._applied: dict[int, np.ndarray] = {}
+        self._made: dict[tuple[int, int], tuple[int, bytes]] = {}
+        self._held: dict[int, dict[str, np.ndarray]] = {}  # keeps the evaluations whose ids ``_made`` holds alive
 
     def rest_basis(self, obj: Entity) -> np.ndarray:
         """The object's basis (in the robot's frame) without the bone's motion last applied to it."""
@@ -34,6 +37,7 @@ class ObjectPoser:
         frames = keyed_frames(armature)
         now = armature.evaluate(None)
         at = {frame: armature.evaluate(frame) for frame in frames}
+        self._held.update(at)
         for link in links:
             if link.rig is None:
                 continue
@@ -41,8 +45,11 @@ class ObjectPoser:
             rest_inverse = np.linalg.inv(bone.rest())
             for obj in (o for o in link.get_all_objs() if o.is_valid()):
                 rest = self.rest_basis(obj)
+                made_from = np.round(rest, 9).tobytes() + np.round(rest_inverse, 9).tobytes()
                 for frame in frames:
-                    set_basis(obj, at[frame][bone.name] @ rest_inverse @ rest, frame)
+                    if self._made.get((id(obj), frame)) != (id(at[frame]), made_from):
+                        set_basis(obj, at[frame][bone.name] @ rest_inverse @ rest, frame)
+                        self._made[(id(obj), frame)] = (id(at[frame]), made_from)
                 motion = now[bone.name] @ rest_inverse
                 set_basis(obj, motion @ rest, None)
                 self._applied[id(obj)] = motion
