@@ -3,7 +3,9 @@
 // or the base-color texture decoded from sRGB by the sRGB8_ALPHA8 texture format and filtered bilinearly,
 // as Mitsuba's bitmap texture does). Alpha-clipped materials (alpha_mode CLIP) drop fragments whose alpha
 // (the alpha map, bilinear, or the constant) is below 0.5: the surface behind shows through. Dust films mix
-// their colors in by their weights (dust.glsl, included below by the albedo pass).
+// their colors in by their weights (dust.glsl, included below by the albedo pass). The diffuse-color variant
+// (PRINCIPLED_DIFFUSE defined, render/raster/principled_diffuse.py) shows Cycles' Diffuse Color pass instead of
+// the base color: what the Principled BSDF's layers leave of it from the view direction.
 uniform vec4 u_base_color;
 uniform bool u_textured;
 uniform bool u_vertex_colored;
@@ -21,6 +23,9 @@ in vec3 v_world;
 in vec3 v_normal;
 
 // dust.glsl
+#ifdef PRINCIPLED_DIFFUSE
+// principled_diffuse.glsl
+#endif
 
 layout(location = 0) out vec4 out_albedo;
 
@@ -30,6 +35,9 @@ void main() {
         if (alpha < 0.5) discard;
     }
     vec3 albedo = u_textured ? texture(u_texture, v_uv).rgb : (u_vertex_colored ? v_color : u_base_color.rgb);
+#ifdef PRINCIPLED_DIFFUSE
+    albedo = principled_diffuse(albedo, v_uv, abs(dot(normalize(v_normal), normalize(u_camera - v_world))));
+#endif
     if (u_dust_count > 0) {
         vec3 n = normalize(v_normal);
         vec3 to_camera = normalize(u_camera - v_world);

@@ -25,14 +25,17 @@ import mathutils
 import numpy as np
 
 
-def _mesh(name: str, data: np.lib.npyio.NpzFile) -> bpy.types.Object:
+def add_mesh(name: str, data: np.lib.npyio.NpzFile) -> bpy.types.Object:
+    """Object ``name`` of ``data`` (``.vertices``, ``.faces``, ``.normals`` and, if there, per-vertex ``.uvs``),
+    smooth with the normals as custom normals, linked to the scene."""
     vertices, faces = data[f"{name}.vertices"], data[f"{name}.faces"]
     mesh = bpy.data.meshes.new(name)
     mesh.from_pydata(vertices.tolist(), [], faces.tolist())
-    uv_layer = mesh.uv_layers.new(name="UVMap")
-    uvs = data[f"{name}.uvs"]
-    for loop in mesh.loops:
-        uv_layer.data[loop.index].uv = uvs[loop.vertex_index].tolist()
+    if f"{name}.uvs" in data:
+        uv_layer = mesh.uv_layers.new(name="UVMap")
+        uvs = data[f"{name}.uvs"]
+        for loop in mesh.loops:
+            uv_layer.data[loop.index].uv = uvs[loop.vertex_index].tolist()
     mesh.shade_smooth()
     mesh.normals_split_custom_set_from_vertices(data[f"{name}.normals"].tolist())
     obj = bpy.data.objects.new(name, mesh)
@@ -70,6 +73,18 @@ def _emissive(tree: bpy.types.NodeTree, bsdf: bpy.types.Node, value: float) -> N
         tree.links.new(emission.outputs["Emission"], socket)  # replaces the link into that input
 
 
+def add_camera(scene: bpy.types.Scene, camera_spec: dict) -> None:
+    """The scene's camera: Blender ``matrix_world``, ``lens`` (mm) on a 36 mm wide sensor, clip start 1 cm."""
+    camera_data = bpy.data.cameras.new("camera")
+    camera_data.sensor_fit, camera_data.sensor_width = "HORIZONTAL", 36.0
+    camera_data.lens = camera_spec["lens"]
+    camera_data.clip_start = 0.01
+    camera = bpy.data.objects.new("camera", camera_data)
+    camera.matrix_world = mathutils.Matrix(camera_spec["matrix_world"])
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+
+
 def main() -> None:
     scene_path, spec_path, out = sys.argv[1:4]
     data = np.load(scene_path)
@@ -78,7 +93,7 @@ def main() -> None:
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     for entry in spec["objects"]:
-        obj = _mesh(entry["name"], data)
+        obj = add_mesh(entry["name"], data)
         obj.data.materials.append(_material(entry, weight_mode))
     world = bpy.data.worlds.new("world")
     world.use_nodes = True
@@ -91,14 +106,7 @@ def main() -> None:
         sun_object = bpy.data.objects.new("sun", sun)
         sun_object.matrix_world = mathutils.Matrix(spec["sun"]["local2world"])
         scene.collection.objects.link(sun_object)
-    camera_data = bpy.data.cameras.new("camera")
-    camera_data.sensor_fit, camera_data.sensor_width = "HORIZONTAL", 36.0
-    camera_data.lens = spec["camera"]["lens"]
-    camera_data.clip_start = 0.01
-    camera = bpy.data.objects.new("camera", camera_data)
-    camera.matrix_world = mathutils.Matrix(spec["camera"]["matrix_world"])
-    scene.collection.objects.link(camera)
-    scene.camera = camera
+    add_camera(scene, spec["camera"])
 
     cycles = scene.cycles
     scene.render.engine, cycles.device = "CYCLES", "CPU"
@@ -111,11 +119,16 @@ def main() -> None:
     cycles.pixel_filter_type = "BOX"
     cycles.filter_width = 0.01 if weight_mode else 1.0
     cycles.seed = spec.get("seed", 0)
-    scene.render.resolution_x, scene.render.resolution_y = spec["resolution"]
-    scene.render.resolution_percentage = 100
     layer = scene.view_layers[0]
     layer.use_pass_uv = layer.use_pass_normal = layer.use_pass_position = weight_mode
     layer.use_pass_diffuse_color = not weight_mode
+    render_exr(scene, spec["resolution"], out)
+
+
+def render_exr(scene: bpy.types.Scene, resolution: list[int], out: str) -> None:
+    """Render ``scene`` at ``resolution`` (width, height) into the multilayer float32 EXR ``out``."""
+    scene.render.resolution_x, scene.render.resolution_y = resolution
+    scene.render.resolution_percentage = 100
     scene.render.image_settings.file_format = "OPEN_EXR_MULTILAYER"
     scene.render.image_settings.color_depth = "32"
     scene.render.filepath = out

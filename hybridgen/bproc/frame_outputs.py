@@ -7,7 +7,8 @@ Per output kind (``SESSION.renderer.outputs``) and the color key:
   range (10000 m) - as distance, or as depth along each pixel's ray.
 - ``normals``: float32 (H, W, 3), Blender camera axes (x right, y up, z backwards), ``0.5 n + 0.5``; 0.5 on the
   background.
-- ``diffuse``: uint8 (H, W, 3) sRGB of the base color.
+- ``diffuse``: uint8 (H, W, 3) sRGB of Cycles' Diffuse Color pass (hybridgen's ``diffuse_color`` pass at pixel
+  centres; Cycles averages a pixel's samples); 0 on the background, as in Cycles.
 - ``segmentation``: :func:`hybridgen.bproc.segmentation.map_frame`'s keys.
 - colors: uint8 (H, W, 3) sRGB (Standard view); ``color_depth`` 16: uint16 of the linear float16 render; file
   format JPEG: the 8-bit image after a JPEG round trip at ``jpg_quality`` (what BlenderProc loads back from its
@@ -80,7 +81,7 @@ def _convert_eye(values: dict[str, Any], table: np.ndarray, cam2world: np.ndarra
             normals[background] = 0.5
             converted[kind] = normals
         elif kind == "diffuse":
-            converted[kind] = to_srgb8(np.asarray(values["albedo"])[..., :3])
+            converted[kind] = to_srgb8(np.asarray(values["diffuse_color"])[..., :3])
         elif kind == "segmentation":
             converted[kind] = map_frame(instances, options["map_by"], options["default_values"], meshes)
     if "colors" in values:

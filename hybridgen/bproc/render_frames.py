@@ -17,7 +17,8 @@ the outputs were enabled and ``colors`` (the ``output_key``) last:
 - ``distance``: float32 (H, W), m from the camera centre; background the mist range, or 1e10 as distance.
 - ``normals``: float32 (H, W, 3), Blender camera axes (x right, y up, z backwards), ``0.5 n + 0.5``; 0.5 on the
   background.
-- ``diffuse``: uint8 (H, W, 3), sRGB diffuse color.
+- ``diffuse``: uint8 (H, W, 3), sRGB of Cycles' Diffuse Color pass (the ``diffuse_color`` pass: what the
+  Principled BSDF's specular, metal, transmission, coat and sheen layers leave of the base color, plus sheen).
 - segmentation (:mod:`hybridgen.bproc.segmentation`): ``instance_segmaps`` int64, ``<entry>_segmaps``,
   ``instance_attribute_maps``.
 
@@ -109,7 +110,8 @@ def _label_request(outputs: dict[str, Any], alpha: bool) -> Any:
     if not outputs and not alpha:
         return None
     return hg.LabelRequest(depth="depth" in outputs or "distance" in outputs, distance="distance" in outputs,
-                           normals="normals" in outputs, map_by=["instance"], albedo="diffuse" in outputs)
+                           normals="normals" in outputs, map_by=["instance"],
+                           passes=("diffuse_color",) if "diffuse" in outputs else ())
 
 
 def _scene(frames: list[int], meshes: list[MeshObject]) -> tuple[Any, np.ndarray]:

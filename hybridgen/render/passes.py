@@ -153,6 +153,14 @@ _SPECS = (
              lambda frame, key: frame.raster.albedo.render(frame.cam2world), ("albedo",), units="linear RGB",
              background="the world color", png="srgb", show="srgb", smooth=True, option="render_albedo",
              option_doc="write 'albedo': linear base color / texture at each pixel"),
+    PassSpec("diffuse_color", "float32", 3, "Cycles' Diffuse Color pass (DiffCol) at each pixel centre: the "
+             "Principled BSDF's diffuse weight (base color less what its specular, metal, transmission, coat and "
+             "sheen layers take from the view direction) plus its sheen albedo", "",
+             lambda frame, key: frame.raster.diffuse_color.render(frame.cam2world, background=(0.0, 0.0, 0.0)),
+             ("diffuse_color",), units="linear RGB", png="srgb", show="srgb", smooth=True,
+             option="render_diffuse_color",
+             option_doc="write 'diffuse_color': Blender's Diffuse Color pass (what the specular layers leave of "
+             "the base color) at each pixel"),
     PassSpec("nocs", "float32", 3, "normalized object coordinates in [0, 1] (NOCS paper)", "",
              lambda frame, key: nocs(frame.raw, frame.intrinsics, frame.cam2world, frame.scene), show="as_stored",
              smooth=True, option="render_nocs", option_doc="write 'nocs': normalized object coordinates in [0, 1]"),

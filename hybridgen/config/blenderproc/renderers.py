@@ -10,7 +10,7 @@ from .setup_keys import GLOBAL_IGNORED
 
 
 _OUTPUT_KEYS = {"output_key": None, "segmap_output_key": None, "distance_output_key": "distance",
-                "depth_output_key": "depth", "normals_output_key": "normals", "diffuse_color_output_key": "albedo",
+                "depth_output_key": "depth", "normals_output_key": "normals", "diffuse_color_output_key": "diffuse_color",
                 "segcolormap_output_key": "instance_attribute_maps",
                 "forward_flow_output_key": "forward_flow", "backward_flow_output_key": "backward_flow"}
 
@@ -63,8 +63,8 @@ def rgb(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]]]:
     cfg = {**BLENDERPROC_LOBE_BOUNCES, **config}
     _output_keys(cfg, note, "colors")
     _renderer_common(cfg, note)
-    if "render_diffuse_color" in cfg:
-        cfg["render_albedo"] = bool(cfg.pop("render_diffuse_color"))
+    if "render_diffuse_color" in cfg:  # Blender's Diffuse Color pass: hybridgen's diffuse_color, not the base color
+        cfg["render_diffuse_color"] = bool(cfg["render_diffuse_color"])
     if "render_normal" in cfg:
         cfg["render_normals"] = bool(cfg.pop("render_normal"))
     denoiser = cfg.pop("denoiser", None)

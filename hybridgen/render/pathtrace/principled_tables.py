@@ -14,19 +14,9 @@ tools/principled_sheen_cycles.py (Blender 4.2), not integrated.
 from __future__ import annotations
 
 from functools import lru_cache
-from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-TABLE_FILE = Path(__file__).with_name("principled_tables.npz")
-
-
-@lru_cache(maxsize=None)
-def host_tables() -> dict[str, np.ndarray]:
-    """The tables as float32 NumPy arrays (C order: the last axis is roughness)."""
-    with np.load(TABLE_FILE) as data:
-        return {key: np.ascontiguousarray(data[key], dtype=np.float32) for key in data.files}
+from ..principled_table_data import TABLE_FILE, host_tables  # noqa: F401 (shared with the raster passes)
 
 
 @lru_cache(maxsize=None)

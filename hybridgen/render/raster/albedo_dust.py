@@ -54,10 +54,7 @@ class ObjectDust:
 
     def apply(self, program: Any, obj: MeshObject, cam2world: np.ndarray) -> None:
         """Set the dust uniforms of ``obj`` for a draw from ``cam2world`` (and bind its textures)."""
-        rotation = obj.local2world[:3, :3]
-        program["u_model"].write(obj.local2world.T.astype(np.float32).tobytes())
-        program["u_normal_matrix"].write(np.linalg.inv(rotation).astype(np.float32).tobytes())  # inverse transpose
-        program["u_camera"].value = tuple(float(c) for c in cam2world[:3, 3])
+        world_uniforms(program, obj, cam2world)
         program["u_dust_uv"].value = self.has_uv
         program["u_dust_count"].value = len(self.layers)
         rows = [(layer.strength, layer.texture_scale, float(layer.texture is not None), 0.0) for layer in self.layers]
@@ -70,6 +67,15 @@ class ObjectDust:
             if texture is not None:
                 texture.use(TEXTURE_UNIT + index)
         program["u_dust_texture"].write(np.arange(TEXTURE_UNIT, TEXTURE_UNIT + LAYERS, dtype=np.int32).tobytes())
+
+
+def world_uniforms(program: Any, obj: MeshObject, cam2world: np.ndarray) -> None:
+    """The world position and normal of ``obj``'s fragments (``u_model``, ``u_normal_matrix``) and the camera
+    position (``u_camera``) for a draw from ``cam2world``: the view direction of dust and diffuse color."""
+    rotation = obj.local2world[:3, :3]
+    program["u_model"].write(obj.local2world.T.astype(np.float32).tobytes())
+    program["u_normal_matrix"].write(np.linalg.inv(rotation).astype(np.float32).tobytes())  # inverse transpose
+    program["u_camera"].value = tuple(float(c) for c in cam2world[:3, 3])
 
 
 def no_dust(program: Any) -> None:

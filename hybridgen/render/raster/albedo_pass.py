@@ -4,7 +4,8 @@ The guide image for denoising, and a label of its own: the material's base color
 texture (decoded from sRGB, bilinear, repeating, as Mitsuba samples it) or the interpolated per-vertex
 colors at the surface point seen through the pixel centre; surfaces of alpha-clipped materials are cut out
 where their alpha is below 0.5; dust films mix in their colors by their weights (:mod:`.albedo_dust`).
-Background pixels get ``background`` (by default the world color).
+Background pixels get ``background`` (by default the world color). The ``diffuse_color`` variant draws Cycles'
+Diffuse Color pass instead of the base color (:mod:`.principled_diffuse`); the plain pass is unchanged by it.
 Textures and UVs are uploaded on first use only.
 """
 from __future__ import annotations
@@ -20,7 +21,8 @@ from ..material_textures import alpha_coverage
 from .projection import projection_from_K
 from .raster_view import RasterView
 from .shader_source import shader_source
-from .albedo_dust import ObjectDust, active_layers, no_dust
+from .albedo_dust import ObjectDust, active_layers, no_dust, world_uniforms
+from . import principled_diffuse
 from .label_framebuffers import release_framebuffer
 
 GL_SRGB8_ALPHA8 = 0x8C43
@@ -52,17 +54,23 @@ def _alpha_image(obj: MeshObject) -> np.ndarray | None:
 
 
 class AlbedoPass:
-    """Draws the albedo of ``view``'s scene; shares its GL context and vertex buffers."""
+    """Draws the albedo of ``view``'s scene (with ``diffuse_color``: Cycles' Diffuse Color pass); shares the
+    view's GL context and vertex buffers."""
 
-    def __init__(self, view: RasterView) -> None:
+    def __init__(self, view: RasterView, diffuse_color: bool = False) -> None:
         self.view = view
         ctx = view.ctx
-        self.program = compile_program(ctx, vertex_shader=shader_source("albedo.vert"),
-                                       fragment_shader=shader_source("albedo.frag").replace(
-                                           "// dust.glsl", shader_source("dust.glsl")))
+        fragment = shader_source("albedo.frag").replace("// dust.glsl", shader_source("dust.glsl"))
+        self._tables = None  # the Principled tables' storage buffer (diffuse color only)
+        if diffuse_color:
+            fragment = fragment.replace("\n", "\n#define PRINCIPLED_DIFFUSE\n" + principled_diffuse.table_defines(), 1)
+            fragment = fragment.replace("// principled_diffuse.glsl", shader_source("principled_diffuse.glsl"))
+            self._tables = ctx.buffer(principled_diffuse.table_values().tobytes())
+        self.program = compile_program(ctx, vertex_shader=shader_source("albedo.vert"), fragment_shader=fragment)
         self._draws: list[tuple[Any, Any, Any, MeshObject]] = []
         self._dust: dict[int, ObjectDust] = {}  # draw index -> its dust layers (render/raster/albedo_dust.py)
-        self._resources: list[Any] = []
+        self._principled: dict[int, principled_diffuse.ObjectPrincipled] = {}  # draw index -> its inputs
+        self._resources: list[Any] = [] if self._tables is None else [self._tables]
         for gpu, obj in zip(view.gpu_objects, view.scene.objects):
             image = _texture_image(obj)
             texture = alpha = None
@@ -76,11 +84,16 @@ class AlbedoPass:
 
             alpha_image = _alpha_image(obj)
             layers = active_layers(obj)
-            if (image is not None or alpha_image is not None or layers) and obj.uvs is not None:
+            inputs = principled_diffuse.ObjectPrincipled(ctx, obj, self._resources) if diffuse_color else None
+            if (image is not None or alpha_image is not None or layers or (inputs and inputs.needs_uv)) and \
+                    obj.uvs is not None:
                 per_vertex(np.asarray(obj.uvs), "2f", "in_uv")
-            if layers:
+            if layers or inputs:
                 content.extend(entry for entry in gpu.content if entry[2] == "in_normal")
+            if layers:
                 self._dust[len(self._draws)] = ObjectDust(ctx, obj, layers, self._resources)
+            if inputs:
+                self._principled[len(self._draws)] = inputs
             if image is not None:
                 texture = ctx.texture((image.shape[1], image.shape[0]), 4, image.tobytes(),
                                       internal_format=GL_SRGB8_ALPHA8)
@@ -116,6 +129,8 @@ class AlbedoPass:
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.disable(moderngl.CULL_FACE)
         world2cam = np.linalg.inv(cam2world)
+        if self._tables is not None:
+            self._tables.bind_to_storage_buffer(principled_diffuse.STORAGE_BINDING)
         self.program["u_projection"].write(projection_from_K(intr.K, intr.width, intr.height, intr.clip_start,
                                                              intr.clip_end).T.astype(np.float32).tobytes())
         for index, (vao, texture, alpha, obj) in enumerate(self._draws):
@@ -124,6 +139,9 @@ class AlbedoPass:
                 self._dust[index].apply(self.program, obj, cam2world)
             elif self._dust:
                 no_dust(self.program)
+            if index in self._principled:
+                world_uniforms(self.program, obj, cam2world)
+                self._principled[index].apply(self.program)
             self.program["u_modelview"].write((world2cam @ obj.local2world).T.astype(np.float32).tobytes())
             self.program["u_base_color"].value = tuple(float(c) for c in material.base_color)
             self.program["u_textured"].value = texture is not None

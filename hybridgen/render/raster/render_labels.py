@@ -25,7 +25,8 @@ def render_labels(scene: Scene, sinks: Iterable[FrameSink], request: LabelReques
     (:class:`~hybridgen.render.keypoint_loop.StereoProducer`)."""
     sinks = list(sinks)
     request = (request or LabelRequest()).with_sinks(sinks)
-    if request.albedo:  # the albedo pass shows base colors: their textures must exist (io/texture_needs.py)
+    if request.albedo or "diffuse_color" in request.keys():  # they show base colors: their textures must exist
+        # (io/texture_needs.py)
         require_base_colors(scene.objects)
     producer: Any
     if render_threads > 1:
