@@ -11,8 +11,9 @@ Blender's steps, each measured with bpy 4.2 where it matters:
    (:func:`hybridgen.scene.displacement.sample_bilinear`; Blender's values at a 4 x 4 image agree). A tile
    without an image reads h = 0: the whole tile moves down by strength / 2 (bpy 4.2: z = -0.5 at strength 1).
 3. Subdivision Surface at ``levels`` (its render level, capped at 3 as BlenderProc's renderer caps it):
-   Catmull-Clark on the grid (:mod:`hybridgen.scene.grid_subdivision`); UVs follow the grid linearly (Blender's
-   "keep boundaries" UV smoothing keeps a grid's UVs linear). The tile stays flat-shaded, as the plane is.
+   Catmull-Clark (:mod:`hybridgen.scene.catmull_clark`: on a grid Blender's corners lie 0.26 % of a cell further
+   out, heights agree within 5e-4 on +-0.25 bumps); UVs follow the grid linearly (Blender's "keep boundaries" UV
+   smoothing keeps a grid's UVs linear). The tile stays flat-shaded, as the plane is.
 """
 from __future__ import annotations
 
@@ -21,8 +22,9 @@ from typing import Any
 
 import numpy as np
 
+from . import catmull_clark
 from .displacement import height_image, sample_bilinear
-from .grid_subdivision import catmull_clark_grid, grid_faces
+from .polygon_mesh import PolygonMesh
 
 SIMPLIFY_SUBDIVISION_RENDER = 3
 """BlenderProc's renderer caps every Subdivision Surface at 3 levels."""
@@ -59,10 +61,19 @@ class GroundTile:
         else:
             h = sample_bilinear(height_image(self.height, owner), uvs.reshape(-1, 2)).reshape(n, n)
         points[..., 2] = (h - self.mid_level) * float(self.strength)
-        levels = min(int(self.levels), SIMPLIFY_SUBDIVISION_RENDER)
-        points = catmull_clark_grid(points, levels)
-        m = points.shape[0]
-        t = np.linspace(0.0, 1.0, m)
-        v, u = np.meshgrid(t, t, indexing="ij")
-        fine_uvs = np.stack([u, v], axis=-1) * float(self.uv_scaling)
-        return points.reshape(-1, 3), grid_faces(m, m), fine_uvs.reshape(-1, 2)
+        quads = grid_quads(n, n)
+        mesh = PolygonMesh(positions=points.reshape(-1, 3), corners=quads.ravel(),
+                           starts=np.arange(0, quads.size + 1, 4), part=np.zeros(len(quads), np.int64),
+                           attributes={"uvs": uvs.reshape(-1, 2)[quads.ravel()]})
+        mesh = catmull_clark.subdivide(mesh, min(int(self.levels), SIMPLIFY_SUBDIVISION_RENDER))
+        triangles, _ = mesh.fan_triangles()
+        vertex_uvs = np.zeros((len(mesh.positions), 2))
+        vertex_uvs[mesh.corners] = mesh.attributes["uvs"]  # a grid has one UV per vertex
+        return mesh.positions, mesh.corners[triangles], vertex_uvs
+
+
+def grid_quads(rows: int, cols: int) -> np.ndarray:
+    """(Q, 4) vertex indices of a row-major grid's cells, counter-clockwise seen from +Z (rows along +Y, columns
+    along +X)."""
+    index = np.arange(rows * cols).reshape(rows, cols)
+    return np.stack([index[:-1, :-1], index[:-1, 1:], index[1:, 1:], index[1:, :-1]], axis=-1).reshape(-1, 4)
