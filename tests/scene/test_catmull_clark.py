@@ -9,7 +9,6 @@ import pytest
 import trimesh
 
 from hybridgen.scene.catmull_clark import subdivide
-from hybridgen.scene.grid_subdivision import catmull_clark_grid
 from hybridgen.scene.mesh_object import MeshObject
 from hybridgen.scene.polygon_mesh import PolygonMesh, from_parts
 
@@ -69,18 +68,6 @@ def test_open_box_and_plane_boundaries_match_blender() -> None:
     # Blender: 0, 0.36458, 0.43056, 0.45833, 0.67188, 0.85417, 0.91667; its lone corners (OpenSubdiv's end cap at a
     # valence-2 boundary vertex) are 43/64 where the B-spline limit is 2/3
     assert np.allclose(xs, [0.0, 0.36458, 0.43056, 0.45833, 0.66667, 0.85417, 0.91667], atol=1e-5)
-
-
-def test_general_subdivision_equals_the_grid_one() -> None:
-    rng = np.random.default_rng(2)
-    grid = np.stack(np.meshgrid(np.linspace(-1, 1, 5), np.linspace(-1, 1, 4), indexing="xy"), axis=-1)
-    points = np.concatenate([grid, rng.uniform(-0.2, 0.2, grid.shape[:2] + (1,))], axis=-1)  # (4 rows, 5 cols, 3)
-    index = np.arange(20).reshape(4, 5)
-    quads = [(index[r, c], index[r, c + 1], index[r + 1, c + 1], index[r + 1, c]) for r in range(3) for c in range(4)]
-    mesh = subdivide(polygons(points.reshape(-1, 3).tolist(), quads), 2)
-    expected = catmull_clark_grid(points, 2).reshape(-1, 3)
-    distance = np.linalg.norm(mesh.positions[:, None] - expected[None], axis=2)
-    assert len(mesh.positions) == len(expected) and distance.min(axis=1).max() < 1e-12
 
 
 def test_polygons_come_back_from_the_loaders_triangles() -> None:
