@@ -5,7 +5,6 @@ from __future__ import annotations
 from typing import Any, Optional
 
 import numpy as np
-from scipy.ndimage import map_coordinates
 
 __all__ = ["apply_lens_distortion"]
 
@@ -15,6 +14,8 @@ def _distort(image: np.ndarray, mapping_coords: np.ndarray, width: int, height: 
     undistorted render, pixel centres at integers, N = width * height in row-major order) with a spline of
     ``order`` (2, or 0 for the nearest pixel), edge pixels repeated outside; the input's dtype back (uint8
     clipped to 0..255 first)."""
+    from scipy.ndimage import map_coordinates  # here: SciPy's ndimage costs ~0.1 s of import in every script's start
+
     data = image.astype(np.float32)
     planes = [data] if image.ndim == 2 else [data[:, :, channel] for channel in range(image.shape[2])]
     distorted = np.stack([map_coordinates(plane, mapping_coords, order=order, mode="nearest").reshape(height, width)

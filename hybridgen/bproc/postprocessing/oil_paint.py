@@ -5,7 +5,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from scipy import stats
 
 from .depth import is_image_list, trim_redundant_channels
 from .opencv import require_cv2
@@ -35,6 +34,8 @@ def _edges(image: np.ndarray, high: float) -> np.ndarray:
 def _filter_rgb(image: np.ndarray, filter_size: int, edges_only: bool) -> np.ndarray:
     """Per pixel, the neighbour (in :func:`_neighbourhood`'s order) whose mean intensity is the window's most
     frequent one; at Canny edges of the uint8 RGB image only when ``edges_only``."""
+    from scipy import stats  # here: SciPy's stats cost ~0.2 s of import in every BlenderProc script's start
+
     neighbours = np.stack(_neighbourhood(image, filter_size))
     intensity = np.stack(_neighbourhood(np.sum(image, axis=2) / 3.0, filter_size), axis=2)
     mode = stats.mode(intensity, axis=2, keepdims=True).mode
@@ -66,6 +67,8 @@ def oil_paint_filter(image: Any, filter_size: int = 5, edges_only: bool = True, 
     image = trim_redundant_channels(image)
     if is_image_list(image):
         return [oil_paint_filter(element, filter_size, edges_only, rgb) for element in image]
+    from scipy import stats
+
     filtered = stats.mode(np.dstack(_neighbourhood(image, filter_size)), axis=2, keepdims=False).mode
     if not edges_only:
         return filtered
