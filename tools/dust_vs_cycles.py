@@ -10,8 +10,8 @@ runs through tools/dust_cycles_scene.py in ``.venv-blenderproc`` with BlenderPro
 
 Printed, per object: (1) the mean linear radiance hybridgen / Cycles per channel (both converged estimates at
 ``--spp``, equal bounces, no clamp, no denoising; pixels well inside each object, from an analytic ray cast),
-and hybridgen's raster albedo over Cycles' DiffCol pass (the base's own share differs already without dust:
-hybridgen's albedo is the base color, Cycles' diffuse color what its specular layer leaves; pixel centres against
+and hybridgen's raster albedo and its diffuse-color pass over Cycles' DiffCol pass (the albedo is the base color,
+Cycles' diffuse color and hybridgen's ``diffuse_color`` what the specular layer leaves of it; pixel centres against
 pixel areas of a sub-pixel pattern add about 1.5 %); (2) the dust weight w: Cycles' exact w at one sample per pixel (its BSDFs replaced by black and white emission)
 against hybridgen's at the same points (rays from the camera to Cycles' Position pass, the dust BSDF's
 ``eval_diffuse_reflectance`` with a black base and a white dust color) - mean w and the share of "dusty" points
@@ -186,14 +186,17 @@ def main() -> None:
     from hybridgen.render.raster.albedo_pass import AlbedoPass
 
     ours_look, _ = render_hybridgen(look_scene, "blender", ns.spp, 3)
-    ours_albedo = AlbedoPass(hg.RasterView(look_scene)).render(look_scene.camera.keypoints[0])
+    raster = hg.RasterView(look_scene)
+    ours_albedo = AlbedoPass(raster).render(look_scene.camera.keypoints[0])
+    ours_diffuse = AlbedoPass(raster, diffuse_color=True).render(look_scene.camera.keypoints[0])
     masks, _ = object_masks(look_scene)
-    print(f"{'object':12s} {'Cycles mean RGB':>26s}   hybridgen / Cycles   albedo / Cycles' DiffCol")
+    print(f"{'object':12s} {'Cycles mean RGB':>26s}   hybridgen / Cycles   albedo, diffuse_color / Cycles' DiffCol")
     for name, mask in masks.items():
         theirs, ours = look["Combined"][..., :3][mask].mean(0), ours_look[mask].mean(0)
         albedo = ours_albedo[mask].mean(0) / look["DiffCol"][mask].mean(0)
+        diffuse = ours_diffuse[mask].mean(0) / look["DiffCol"][mask].mean(0)
         print(f"{name:12s} {' '.join(f'{c:8.4f}' for c in theirs)}   {' '.join(f'{r:6.3f}' for r in ours / theirs)}"
-              f"   {' '.join(f'{r:6.3f}' for r in albedo)}   ({mask.sum()} px)")
+              f"   {' '.join(f'{r:6.3f}' for r in albedo)}, {' '.join(f'{r:6.3f}' for r in diffuse)}   ({mask.sum()} px)")
     report_weights(objects, look_scene, weights, ns.store)
 
 
