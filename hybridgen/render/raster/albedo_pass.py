@@ -61,6 +61,8 @@ class AlbedoPass:
         self.view = view
         ctx = view.ctx
         fragment = shader_source("albedo.frag").replace("// dust.glsl", shader_source("dust.glsl"))
+        if any(active_layers(obj) for obj in view.scene.objects):  # the dust code only where it can show
+            fragment = fragment.replace("\n", "\n#define DUST_FILMS\n", 1)
         self._tables = None  # the Principled tables' storage buffer (diffuse color only)
         if diffuse_color:
             fragment = fragment.replace("\n", "\n#define PRINCIPLED_DIFFUSE\n" + principled_diffuse.table_defines(), 1)
