@@ -3,7 +3,7 @@ pass (DiffCol) in Blender 4.2, pixel by pixel.
 
     .venv/bin/python tools/diffuse_color_vs_cycles.py [--res 400x320] [--store tests/render/data/diffuse_color_cycles.json]
 
-The scene (both engines, the same triangles and smooth normals): 20 UV spheres (64 x 32, r 0.45 m) in a 5 x 4
+The scene (both engines, the same triangles and smooth normals): 20 of Blender's UV spheres (64 x 32, r 0.45 m) in a 5 x 4
 grid seen from 9 m, each with a Principled BSDF of one sweep entry (:data:`MATERIALS`: Blender's input names,
 over an orange base): roughness, IOR, Specular IOR Level, metallic, transmission, coat (plain and tinted), sheen,
 specular tint, subsurface, a white base. Cycles renders through tools/diffuse_color_cycles.py in
@@ -54,14 +54,13 @@ FIELDS = {"Base Color": "base_color", "Roughness": "roughness", "Metallic": "met
 
 
 def sphere(centre: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(vertices, faces, unit normals) of a UV sphere of :data:`RADIUS` at ``centre`` (seam and poles repeated)."""
-    u, v = np.meshgrid(np.linspace(0, 1, SEGMENTS + 1), np.linspace(0, 1, RINGS + 1))
-    phi, theta = 2 * np.pi * u, np.pi * (1 - v)
-    normals = np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], -1).reshape(-1, 3)
-    index = np.arange((RINGS + 1) * (SEGMENTS + 1)).reshape(RINGS + 1, SEGMENTS + 1)
-    a, b, c, d = index[:-1, :-1], index[:-1, 1:], index[1:, 1:], index[1:, :-1]
-    faces = np.concatenate([np.stack([a, b, c], -1)[1:].reshape(-1, 3), np.stack([a, c, d], -1)[:-1].reshape(-1, 3)])
-    return normals * RADIUS + centre, faces, normals
+    """(vertices, triangles, unit normals) of Blender's UV sphere (:data:`SEGMENTS` x :data:`RINGS`, radius
+    :data:`RADIUS`) at ``centre``, smooth."""
+    from hybridgen.scene.blender_primitives import uv_sphere
+
+    mesh = uv_sphere(SEGMENTS, RINGS, RADIUS)
+    triangles, _ = mesh.fan_triangles()
+    return mesh.positions + centre, mesh.corners[triangles], mesh.positions / RADIUS
 
 
 def centres() -> list[np.ndarray]:

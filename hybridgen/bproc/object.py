@@ -1,10 +1,16 @@
 """``bproc.object``: the scene's mesh objects, primitives, empties and points of interest (BlenderProc's
 MeshObjectUtility / EntityUtility).
 
-``create_primitive`` makes Blender's primitives with Blender's default sizes (``CUBE``/``PLANE`` ``size`` 2 m,
-``SPHERE`` ``radius`` 1 m, ``CYLINDER``/``CONE`` ``radius`` 1 m and ``depth`` 2 m), flat-shaded and without a
-material slot, as ``bpy.ops.mesh.primitive_*_add`` does; the plane has Blender's UV map (0..1 along x and y), the
-others none. The sphere is hybridgen's icosphere where Blender's is a UV sphere (same radius, different facets)."""
+``create_primitive`` makes Blender 4.2's primitives as ``bpy.ops.mesh.primitive_*_add`` does (BlenderProc passes
+its keyword arguments on): the same vertices, polygons (corner order included) and UV map
+(:mod:`hybridgen.scene.blender_primitives`, measured with bpy 4.2), flat-shaded, without a material slot, with
+Blender's arguments and defaults - ``CUBE``/``PLANE`` ``size`` 2 m, ``SPHERE`` (a UV sphere) ``radius`` 1 m,
+``segments`` 32, ``ring_count`` 16, ``CYLINDER`` ``radius`` 1 m, ``CONE`` ``radius1`` 1 m and ``radius2`` 0,
+both ``depth`` 2 m, ``vertices`` 32, ``end_fill_type`` NGON; ``calc_uvs`` False leaves the mesh without UVs. As
+in Blender, ``scale`` is baked into the mesh (the object's scale stays 1) but for ``PLANE``, whose object
+BlenderProc scales; ``location`` and ``rotation`` (XYZ Euler, rad) pose the object. The polygons are kept for
+modifiers (subdivision reads Blender's quads). ``MONKEY`` (Suzanne) stops with one line: its mesh is Blender's
+own data table, not reproduced here."""
 from __future__ import annotations
 
 from typing import Any, Sequence
@@ -28,40 +34,48 @@ __all__ = ["compute_poi", "convert_to_entities", "convert_to_meshes", "create_bv
            "sample_poses_on_surface", "scene_ray_cast", "simulate_physics", "simulate_physics_and_fix_final_poses",
            "slice_faces_with_normals"]
 
-SHAPES = {"CUBE": ("cube", "Cube"), "PLANE": ("plane", "Plane"), "SPHERE": ("sphere", "Sphere"),
-          "CYLINDER": ("cylinder", "Cylinder"), "CONE": ("cone", "Cone")}
-"""BlenderProc shape -> (hybridgen primitive, Blender's object name)."""
+SHAPES = {"CUBE": ("cube", "Cube", ("size",)), "PLANE": ("plane", "Plane", ("size",)),
+          "SPHERE": ("uv_sphere", "Sphere", ("radius", "segments", "ring_count")),
+          "CYLINDER": ("cylinder", "Cylinder", ("radius", "depth", "vertices", "end_fill_type")),
+          "CONE": ("cone", "Cone", ("radius1", "radius2", "depth", "vertices", "end_fill_type"))}
+"""BlenderProc shape -> (:mod:`hybridgen.scene.blender_primitives` builder, Blender's object name, the builder's
+arguments)."""
 POSE_KEYS = ("location", "rotation", "scale")
+IGNORED_KEYS = ("calc_uvs", "enter_editmode", "align")
 
 
 def create_primitive(shape: str, **kwargs: Any) -> MeshObject:
-    """A new primitive mesh object (see the module documentation); ``location``, ``rotation`` (XYZ Euler, rad)
-    and ``scale`` set its pose."""
+    """A new primitive mesh object (see the module documentation)."""
+    from ..scene import blender_primitives
+    from ..scene.material import Material as SceneMaterial
+    from ..scene.mesh_object import MeshObject as ScenePart
+
     upper = str(shape).upper()
+    if upper == "MONKEY":
+        fail("bproc.object.create_primitive('MONKEY')", "Suzanne's mesh is Blender's own data table")
     if upper not in SHAPES:
         fail(f"bproc.object.create_primitive({shape!r})", f"shapes: {', '.join(SHAPES)}")
-    unknown = set(kwargs) - {"size", "radius", "depth", *POSE_KEYS}
+    kind, name, arguments = SHAPES[upper]
+    unknown = set(kwargs) - {*arguments, *POSE_KEYS, *IGNORED_KEYS}
     if unknown:
-        fail(f"bproc.object.create_primitive({upper}, {', '.join(sorted(unknown))}=...)")
-    kind, name = SHAPES[upper]
-    if kind in ("cube", "plane"):
-        size = float(kwargs.get("size", 2.0))
-        part = make_primitive(kind, size)
-        if kind == "plane":  # Blender's UV map of its plane: (x / size + 0.5, y / size + 0.5)
-            part.uvs = part.vertices[:, :2] / size + 0.5
-    else:
-        radius = float(kwargs.get("radius", 1.0))
-        part = make_primitive(kind, 2 * radius)
-        if kind != "sphere" and "depth" in kwargs:
-            part.vertices = part.vertices * np.array([1.0, 1.0, float(kwargs["depth"]) / (2 * radius)])
-    part.vertex_normals = None  # Blender's primitives are flat-shaded
-    part.__dict__.pop("face_normals", None)
-    obj = MeshObject(name, [part])
+        fail(f"bproc.object.create_primitive({upper}, {', '.join(sorted(unknown))}=...)",
+             f"Blender's primitive_{kind}_add takes {', '.join(arguments)}")
+    if kwargs.get("align", "WORLD") != "WORLD":
+        fail(f"bproc.object.create_primitive({upper}, align={kwargs['align']!r})", "align='WORLD' only")
+    mesh = getattr(blender_primitives, kind)(**{key: kwargs[key] for key in arguments if key in kwargs})
+    if "scale" in kwargs and upper != "PLANE":  # Blender bakes the operator's scale into the mesh
+        mesh.positions = mesh.positions * np.asarray(kwargs["scale"], dtype=np.float64).reshape(3)
+    if not kwargs.get("calc_uvs", True):
+        mesh.attributes.pop("uvs")
+    template = ScenePart(name=name, vertices=mesh.positions, faces=[[0, 1, 2]], material=SceneMaterial(
+        name=f"{kind}_material"), uvs=np.zeros((len(mesh.positions), 2)) if "uvs" in mesh.attributes else None)
+    obj = MeshObject(name, [template])
+    obj._set_stack_mesh(mesh)  # Blender's polygons and UVs, kept for modifiers
     if "location" in kwargs:
         obj.set_location(kwargs["location"])
     if "rotation" in kwargs:
         obj.set_rotation_euler(kwargs["rotation"])
-    if "scale" in kwargs:
+    if "scale" in kwargs and upper == "PLANE":  # Blender ignores it for planes; BlenderProc sets the object's
         obj.set_scale(kwargs["scale"])
     return obj
 

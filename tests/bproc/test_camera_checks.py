@@ -170,7 +170,8 @@ def test_camera_frustum_corners_and_object(bproc) -> None:  # noqa: F811
     frustum = bproc.camera.get_camera_frustum_as_object(clip_start=near, clip_end=far)
     assert frustum.get_name() == "Camera Frustum"
     vertices, faces = frustum.world_triangles()
-    assert sorted(map(tuple, np.round(vertices, 9))) == sorted(map(tuple, np.round(corners, 9)))
+    # the cube's 8 corners (hybridgen splits them where the UV map has seams)
+    assert sorted(set(map(tuple, np.round(vertices, 9)))) == sorted(map(tuple, np.round(corners, 9)))
     # a closed truncated pyramid of volume (h / 3) (A1 + A2 + sqrt(A1 A2)); the cube's +z corners go to the far
     # plane, along the camera's -z, a mirroring: its faces wind inwards, as in Blender (negative signed volume)
     tri = vertices[faces]

@@ -28,7 +28,7 @@ def _corner_uvs(obj) -> dict[tuple[float, ...], set[tuple[float, float]]]:
 def test_cylinder_and_sphere_match_blender(bproc, projection: str, expected: list) -> None:  # noqa: F811
     cube = bproc.object.create_primitive("CUBE", size=1.0, location=[0.4, -0.2, 0.7], rotation=[0.3, -0.2, 0.5],
                                          scale=[1.5, 0.8, 2.0])
-    cube.add_uv_mapping(projection)
+    cube.add_uv_mapping(projection, overwrite=True)  # the cube primitive has Blender's UV map already
     found = _corner_uvs(cube)
     signs = [(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
     for sign, (u, v) in zip(signs, expected):
@@ -40,7 +40,7 @@ def test_cylinder_and_sphere_match_blender(bproc, projection: str, expected: lis
 def test_cube_projection_and_overwrite(bproc) -> None:  # noqa: F811
     box = bproc.object.create_primitive("CUBE", size=1.0, location=[3.0, 0.0, 0.0], scale=[1.0, 1.0, 1.0])
     box.parts[0].vertices = box.parts[0].vertices * np.array([2.0, 1.0, 0.5]) + np.array([1.0, 0.0, 0.0])
-    box.add_uv_mapping("cube")
+    box.add_uv_mapping("cube", overwrite=True)  # over the primitive's own UV map
     part = box.parts[0]
     tri = part.vertices[part.faces]
     normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
