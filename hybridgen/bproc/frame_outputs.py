@@ -3,8 +3,9 @@
 
 Per output kind (``SESSION.renderer.outputs``) and the color key:
 
-- ``depth`` / ``distance``: float32 (H, W) m; background 1e10 (Cycles' Z pass) or, with antialiasing, the mist
-  range (10000 m) - as distance, or as depth along each pixel's ray.
+- ``depth`` / ``distance``: float32 (H, W) m - antialiased depth float64, as BlenderProc's dist2depth makes it;
+  background 1e10 (Cycles' Z pass) or, with antialiasing, the mist range (10000 m) - as distance, or as depth
+  along each pixel's ray.
 - ``normals``: float32 (H, W, 3), Blender camera axes (x right, y up, z backwards), ``0.5 n + 0.5``; 0.5 on the
   background.
 - ``diffuse``: uint8 (H, W, 3) sRGB of Cycles' Diffuse Color pass (hybridgen's ``diffuse_color`` pass at pixel
@@ -75,7 +76,8 @@ def _convert_eye(values: dict[str, Any], table: np.ndarray, cam2world: np.ndarra
             far = options["distance_max"] if options["antialiasing"] else BACKGROUND_DEPTH
             far_depth = far / ray_lengths if options["antialiasing"] else np.full_like(ray_lengths, far)
             image[background] = (far_depth if kind == "depth" else far_depth * ray_lengths)[background]
-            converted[kind] = image
+            # BlenderProc makes antialiased depth with dist2depth: float32 distances x float64 factors -> float64
+            converted[kind] = image.astype(np.float64) if kind == "depth" and options["antialiasing"] else image
         elif kind == "normals":
             normals = encode_normals(values["normals"], blender_to_opencv(cam2world), "camera")
             normals[background] = 0.5
