@@ -35,6 +35,7 @@ from ..scene.mesh_object import MeshObject
 from .image_check import check_image_file
 from .blender_names import _SENTINEL, _SENTINEL_RE, blender_name, tag_obj_objects, unique_blender_name
 from .mesh_references import is_lenient, referenced_files
+from .obj_smoothing import blender_smooth_normals, smooth_objects
 from .mtl_principled import apply_mtl_values
 from .texture_needs import check_libraries, diffuse_maps_by_material, mark_missing_textures
 
@@ -209,6 +210,7 @@ def load_objects(path: str | Path, *, name: str | None = None, category_id: int 
     if obj_names is not None:  # keep the file's object order (trimesh lists them last-first)
         order = {n: i for i, n in enumerate(obj_names)}
         parts.sort(key=lambda part: order[part[0]])
+    smoothing = smooth_objects(file) if file_type == "obj" else {}
     distinct = list(dict.fromkeys(p[0] for p in parts))
     counts = {n: sum(1 for p in parts if p[0] == n) for n in distinct}
     split = [n for n in distinct if counts[n] > 1]
@@ -229,6 +231,12 @@ def load_objects(path: str | Path, *, name: str | None = None, category_id: int 
             vertices = np.asarray(geometry.vertices, dtype=np.float64) @ rotation.T
             normals = (np.asarray(geometry.vertex_normals, dtype=np.float64) @ rotation.T
                        if _has_loaded_normals(geometry) else None)
+            shading = smoothing.get(part_name if obj_names is not None else None, False)
+            if normals is None and shading:  # s 1 without vn: Blender shades smooth (io/obj_smoothing)
+                normals = blender_smooth_normals(vertices, np.asarray(geometry.faces), weld=uv is not None)
+            elif normals is None and shading is None and notify is not None:
+                notify(f"mesh '{file}': object '{part_name}' has faces in and out of smoothing groups and no "
+                       "normals; hybridgen shades all of them flat (Blender shades the grouped ones smooth)")
         extra = {"material_part": _material_name(geometry)} if counts[part_name] > 1 else {}
         colors = vertex_colors_linear(geometry.visual)
         try:
