@@ -32,8 +32,8 @@ SWEEP: list[tuple[str, tuple[float, float, float], dict[str, Any]]] = [
     ("copper_m1_r1", (0.95, 0.64, 0.54), dict(roughness=1.0, metallic=1.0)),
     ("green_m05_r04", (0.2, 0.7, 0.3), dict(roughness=0.4, metallic=0.5)),
     ("red_coat", (0.8, 0.1, 0.1), dict(roughness=0.5, specular=0.5, extra=dict(coat_weight=1.0, coat_roughness=0.1))),
-    ("blue_coat_tint", (0.1, 0.2, 0.6), dict(roughness=0.6, specular=0.5,
-                                             extra=dict(coat_weight=0.7, coat_roughness=0.3, coat_tint=(1.0, 0.8, 0.5)))),
+    ("blue_coat_tint", (0.1, 0.2, 0.6), dict(roughness=0.6, specular=0.5, extra=dict(
+        coat_weight=0.7, coat_roughness=0.3, coat_tint=(1.0, 0.8, 0.5)))),
     ("glass_r02", (1.0, 1.0, 1.0), dict(roughness=0.2, transmission=1.0, ior=1.5)),
     ("green_glass_r05", (0.3, 0.9, 0.4), dict(roughness=0.5, transmission=1.0, ior=1.45)),
     ("aniso_metal", (0.9, 0.9, 0.9), dict(roughness=0.4, metallic=1.0, extra=dict(anisotropic=0.8))),
@@ -58,9 +58,25 @@ SWEEP_LAYERS: list[tuple[str, tuple[float, float, float], dict[str, Any]]] = [
     ("skin_ss1_amass", (0.8, 0.5, 0.4), dict(roughness=0.5, specular=0.003, extra=dict(
         subsurface_weight=1.0, subsurface_scale=0.2, subsurface_ior=2.5, subsurface_method="RANDOM_WALK_SKIN"))),
 ]
-GROUPS = {"principled": SWEEP, "layers": SWEEP_LAYERS}
-"""The sweeps, each rendered as a scene of its own (``--group``): the first sweep of issue 32 and the sheen /
-subsurface one."""
+SKIN = (0.8, 0.5, 0.4)
+SWEEP_SUBSURFACE: list[tuple[str, tuple[float, float, float], dict[str, Any]]] = [
+    # Cycles' random walk against hybridgen's diffuse fallback: weight x radius scale (the radius (1, 0.2, 0.1) m,
+    # Blender's default, times the scale; the spheres are 0.36 m across), and what else changes Cycles' walk
+    (f"ss{name}", SKIN, dict(roughness=0.5, specular=0.5, extra=dict(subsurface_weight=w, subsurface_scale=scale)))
+    for name, w, scale in (("0", 0.0, 0.05), ("05_s001", 0.5, 0.01), ("05_s005", 0.5, 0.05), ("05_s02", 0.5, 0.2),
+                           ("1_s001", 1.0, 0.01), ("1_s005", 1.0, 0.05), ("1_s02", 1.0, 0.2))
+] + [
+    ("ss1_s005_aniso08", SKIN, dict(roughness=0.5, specular=0.5, extra=dict(subsurface_weight=1.0,
+                                                                            subsurface_anisotropy=0.8))),
+    ("ss1_s005_ior2", SKIN, dict(roughness=0.5, specular=0.5, extra=dict(subsurface_weight=1.0, subsurface_ior=2.0))),
+    ("ss1_s005_spec0", SKIN, dict(roughness=0.5, specular=0.0, extra=dict(subsurface_weight=1.0))),
+    ("ss1_s005_r01", SKIN, dict(roughness=0.1, specular=0.5, extra=dict(subsurface_weight=1.0))),
+    ("ss1_s005_skin", SKIN, dict(roughness=0.5, specular=0.5, extra=dict(subsurface_weight=1.0,
+                                                                         subsurface_method="RANDOM_WALK_SKIN"))),
+]
+GROUPS = {"principled": SWEEP, "layers": SWEEP_LAYERS, "subsurface": SWEEP_SUBSURFACE}
+"""The sweeps, each rendered as a scene of its own (``--group``): the first sweep of issue 32, the sheen /
+subsurface one (both stored for the tests), and subsurface weights x radius scales (measured for the docs)."""
 COLUMNS, SPACING, DIAMETER = 6, 0.46, 0.36
 LIGHTINGS = ("sun", "hdri")
 
@@ -70,9 +86,10 @@ TEST_OBJECTS = ("red_s1_r03", "white_s05_r05", "grey_m1_r06", "copper_m1_r1")
 color Mitsuba's principled got 7-55 % wrong."""
 
 
-TEST_LAYER_OBJECTS = ("red_sheen1_r05", "velvet_sheen1_r03", "gold_coat_sheen", "skin_ss1_r0")
-"""The spheres of the second test view (sheen over a dielectric, over a near-black base, over a coat; subsurface
-without a radius, which Cycles renders with its diffuse fallback as hybridgen does)."""
+TEST_LAYER_OBJECTS = ("red_sheen1_r05", "velvet_sheen1_r03", "skin_ss1_r0", "aniso_metal")
+"""The spheres of the second test view: sheen over a dielectric and over a near-black base; subsurface without a
+radius (which Cycles renders with its diffuse fallback, as hybridgen does); anisotropic metal (Blender's default
+radial tangent)."""
 
 
 def sweep(names: tuple[str, ...] | None = None,

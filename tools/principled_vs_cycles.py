@@ -1,16 +1,16 @@
 """hybridgen's color against Blender 4.2's Cycles, object by object, on sweeps of Principled materials.
 
-Run: .venv/bin/python tools/principled_vs_cycles.py [--group principled|layers] [--res 360x240] [--spp 256]
-         [--cycles-spp 256] [--bounces 4] [--lighting sun,hdri] [--reuse-cycles]
+Run: .venv/bin/python tools/principled_vs_cycles.py [--group principled|layers|subsurface] [--res 360x240]
+         [--spp 256] [--cycles-spp 256] [--bounces 4] [--lighting sun,hdri] [--reuse-cycles]
          [--store tests/render/data/principled_cycles.json]
      .venv/bin/python tools/principled_vs_cycles.py --time-scene tabletop --res 160x120 --spp 64
          (time per sample of a color benchmark scene with each principled model, no Cycles)
 
 The scenes (tools/principled_sweep.py): rows of spheres over a grey Lambertian floor, each sphere one material
 of a sweep - ``principled``: base colors x roughness x metallic x Specular IOR Level x coat x transmission x
-anisotropy; ``layers``: sheen and subsurface - under a sun and sky (``sun``) or a sky HDRI (``hdri``). Both
-engines render the same meshes and
-vertex normals at fixed sample counts with equal bounces in every lobe (``--bounces`` Cycles bounces = Mitsuba
+anisotropy; ``layers``: sheen and subsurface; ``subsurface``: subsurface weights x radius scales (no test view)
+- under a sun and sky (``sun``) or a sky HDRI (``hdri``). Both engines render the same meshes and vertex
+normals at fixed sample counts with equal bounces in every lobe (``--bounces`` Cycles bounces = Mitsuba
 depth + 2), no clamping, no glossy filter, a one-pixel box filter, no denoising, no light tree: converged
 estimates of the same integral. Cycles runs through ``bpy`` 4.2 in ``.venv-bpy`` (tools/cycles_render.py,
 the color benchmark's worker; BlenderProc 2.8's Blender).
@@ -39,8 +39,8 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tools"))
-from principled_sweep import (LIGHTINGS, TEST_LAYER_OBJECTS, TEST_OBJECTS, build_scene,  # noqa: E402,F401
-                              object_masks, object_means)
+from principled_sweep import (GROUPS, LIGHTINGS, TEST_LAYER_OBJECTS, TEST_OBJECTS,  # noqa: E402,F401
+                              build_scene, object_masks, object_means)
 
 LAYER_INPUTS = ("sheen_", "subsurface_")
 """Prefixes of the ``extra`` inputs the ``layers`` sweep's "before" drops."""
@@ -132,7 +132,7 @@ def ratio_row(name: str, cycles: list[float], ours: dict[str, list[float]]) -> s
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--group", default="principled", choices=sorted(TEST_VIEWS))
+    parser.add_argument("--group", default="principled", choices=sorted(GROUPS))
     parser.add_argument("--res", default="360x240")
     parser.add_argument("--spp", type=int, default=256, help="hybridgen's samples per pixel")
     parser.add_argument("--cycles-spp", type=int, default=256)
@@ -177,8 +177,9 @@ def main() -> None:
             part["lightings"][lighting] = {"pixels": {n: int(m.sum()) for n, m in masks.items()},
                                            "cycles": cycles, "hybridgen": ours["blender"]}
     if args.store and not args.reuse_cycles:
-        key, objects = TEST_VIEWS[args.group]
-        stored[key] = test_view(args.bounces, objects)
+        if args.group in TEST_VIEWS:
+            key, objects = TEST_VIEWS[args.group]
+            stored[key] = test_view(args.bounces, objects)
         args.store.parent.mkdir(parents=True, exist_ok=True)
         args.store.write_text(json.dumps(stored, indent=1) + "\n")
         print(f"stored {args.store}")
