@@ -48,6 +48,10 @@ class Material:
     - ``alpha_mode``: "BLEND" - alpha is a fractional opacity in color, labels see the surface (BlenderProc's
       default, segmentation without ``use_alpha``); "CLIP" - alpha >= 0.5 is opaque, below it the surface is
       cut out of color, albedo and every label (Blender's alpha clip, BlenderProc's ``use_alpha``).
+    - ``extra``: Blender 4.2's Principled inputs that have no field of their own (specular tint, anisotropy, coat,
+      sheen, subsurface), under Blender's names in snake case with Blender's defaults and ranges
+      (:mod:`hybridgen.scene.principled_inputs`, docs/principled_bsdf.md); hybridgen's own Principled BSDF renders
+      them (JIT variants).
     - ``missing_files``: the diffuse textures (MTL ``map_Kd``) the mesh file names for this material that do not
       exist. Only outputs that show base color need them (:mod:`hybridgen.io.texture_needs`); setting
       ``base_color`` or ``base_color_texture`` through a config clears them.
