@@ -40,3 +40,25 @@ def test_overrides_keep_what_they_do_not_name():
     texture = str(REPO / "configs/assets/crate.png")
     both = apply_material_config(material, {"base_color": [1, 0, 0], "base_color_texture": texture})
     assert both.base_color_texture is not None and str(both.base_color_texture).endswith("crate.png")
+
+
+def test_principled_inputs_by_blender_names_join_extra():
+    """Blender's other Principled inputs (snake-case names) go into ``extra``, checked, next to what the material
+    already carries there; a bad value names its key."""
+    import pytest
+
+    from hybridgen.errors import ConfigError
+    from hybridgen.scene.material import Material
+
+    material = Material(extra={"coat_weight": 0.5})
+    changed = apply_material_config(material, {"sheen_weight": 1, "sheen_tint": [0.9, 0.8, 0.7],
+                                               "subsurface_weight": 0.5, "subsurface_radius": [1.0, 0.2, 0.1],
+                                               "subsurface_method": "RANDOM_WALK_SKIN", "roughness": 0.4})
+    assert changed.extra == {"coat_weight": 0.5, "sheen_weight": 1.0, "sheen_tint": (0.9, 0.8, 0.7),
+                             "subsurface_weight": 0.5, "subsurface_radius": (1.0, 0.2, 0.1),
+                             "subsurface_method": "RANDOM_WALK_SKIN"}
+    assert changed.roughness == 0.4 and material.extra == {"coat_weight": 0.5}  # the original is left alone
+    for key, value, reason in (("sheen_tint", 0.5, "RGB color"), ("subsurface_radius", [1, -1, 0], ">= 0"),
+                               ("subsurface_method", "WALK", "one of BURLEY"), ("sheen_weight", "a", "finite")):
+        with pytest.raises(ConfigError, match=f"material.{key}.*{reason}|{reason}.*material.{key}"):
+            apply_material_config(material, {key: value})
