@@ -1,6 +1,7 @@
 """Python API: path-traced color of every keypoint (plus, optionally, the labels) into frame sinks."""
 from __future__ import annotations
 
+from functools import partial
 from typing import Any, Iterable, Sequence
 
 import numpy as np
@@ -10,6 +11,7 @@ from ..io.texture_needs import require_base_colors
 from ..scene.scene import Scene
 from . import denoise_guides
 from .denoise_guides import DenoiseGuides
+from .guide_edges import guide_edges
 from .guide_worker import GuideWorker
 from .keypoint_loop import Producer, ProgressFactory, StereoProducer, run_keypoints
 from .passes import color_keys, layout
@@ -77,6 +79,8 @@ class ColorProducer:
                 "noise_threshold": plan.noise_threshold, "adaptive_sampling": plan.adaptive,
                 "clamp_indirect": s.clamp_indirect if self.view.clamped else 0.0,
                 "filter_glossy": s.filter_glossy if self.view.own_integrator else 0.0,
+                **({"edge_min_samples": plan.edge_min_samples}
+                   if plan.adaptive and plan.edge_min_samples and self.denoise else {}),
                 "pixel_filter": (f"Blackman-Harris, filter_width {self.view.filter_width} px" if self.view.filter_width
                                  else "box, 1 px"),
                 "min_bounces": s.min_bounces, "max_bounces": s.max_bounces, "mitsuba_max_depth": s.max_bounces + 2,
@@ -90,7 +94,14 @@ class ColorProducer:
     def produce(self, index: int, cam2world: np.ndarray, eye: int = 0) -> dict[str, Any]:
         worker = self._worker  # guides drawn on their own thread while the samples are traced
         drawing = worker.submit(cam2world, self.view.filter_width) if worker is not None else None
-        linear, counts = self.view.render_with_counts(cam2world, keypoint_seed(self.seed, index, eye))
+        plan = self.settings.plan()
+        guides = None
+        edges = None
+        if self.denoise and plan.adaptive and plan.edge_min_samples:  # the guides' edges get more samples
+            if drawing is None and self._guides is not None:  # the shared raster: guides drawn first
+                guides = self._guides.render(cam2world, self.view)
+            edges = partial(_edges_of, worker, drawing, guides)
+        linear, counts = self.view.render_with_counts(cam2world, keypoint_seed(self.seed, index, eye), edges=edges)
         values: dict[str, Any] = {}
         if self.keep_raw:
             values["colors_raw"] = to_srgb8(linear)
@@ -99,7 +110,7 @@ class ColorProducer:
         if worker is not None and drawing is not None:
             linear = oidn_denoise(linear, *worker.result(drawing))
         elif self._guides is not None:
-            linear = oidn_denoise(linear, *self._guides.render(cam2world, self.view))
+            linear = oidn_denoise(linear, *(guides or self._guides.render(cam2world, self.view)))
         values["colors"] = to_srgb8(linear)
         if self.hdr:
             values["colors_hdr"] = linear.astype(np.float16)
@@ -118,6 +129,13 @@ class ColorProducer:
         if self._worker is not None:
             worker, self._worker = self._worker, None
             worker.release()
+
+
+def _edges_of(worker: GuideWorker | None, drawing: Any, guides: tuple[np.ndarray, np.ndarray] | None) -> np.ndarray:
+    """The edge pixels (:func:`hybridgen.render.guide_edges.guide_edges`) of a keypoint's denoising guides: drawn
+    already (``guides``) or by ``worker`` (waits for its ``drawing``)."""
+    albedo, normals = guides if guides is not None else worker.result(drawing)  # type: ignore[union-attr]
+    return guide_edges(albedo, normals)
 
 
 def render_color(scene: Scene, sinks: Iterable[FrameSink], settings: PathTraceSettings | None = None, *,

@@ -10,6 +10,9 @@ Knobs (Cycles' and BlenderProc's names and meaning):
 - ``max_samples``: samples per pixel a pixel never exceeds (Cycles' ``samples`` when adaptive).
 - ``min_samples``: samples every pixel gets before the first error estimate (Cycles' "Min Samples"); 0, the
   default, means Cycles' automatic value (:func:`automatic_min_samples`: 64 at threshold 0.01).
+- ``edge_min_samples`` (hybridgen's, 0 = off): samples a pixel the denoiser cannot smooth (an edge of the denoising
+  guides, :mod:`hybridgen.render.guide_edges`) gets at least, whatever its error estimate; the render's caller
+  hands the edge pixels to :func:`render_adaptive`, which asks for them after the first round.
 
 The error estimate is Cycles' (after Dammertz et al. 2010, "A hierarchical automatic stopping condition
 for Monte Carlo global illumination"; ``film_adaptive_sampling_convergence_check`` in Cycles'
@@ -67,6 +70,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -93,6 +97,7 @@ class SamplingPlan:
     max_samples: int = 1024
     min_samples: int = 16
     noise_threshold: float = 0.01
+    edge_min_samples: int = 0
 
     def __post_init__(self) -> None:
         if self.max_samples < 1:
@@ -104,6 +109,8 @@ class SamplingPlan:
                              f"pixel's samples: samples must be >= 2, got {self.max_samples}")
         if self.adaptive and not 2 <= self.min_samples <= self.max_samples:
             raise InputError(f"min_samples must be in 2..samples ({self.max_samples}), got {self.min_samples}")
+        if not 0 <= self.edge_min_samples <= self.max_samples:
+            raise InputError(f"edge_min_samples must be in 0..samples ({self.max_samples}), got {self.edge_min_samples}")
 
     @property
     def adaptive(self) -> bool:
@@ -154,20 +161,29 @@ def dilate(mask: np.ndarray) -> np.ndarray:
     return out
 
 
-def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int) -> tuple[np.ndarray, np.ndarray]:
-    """Linear RGB (float32 H x W x 3) and samples per pixel (uint32 H x W) of one keypoint."""
+def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
+                    edges: Callable[[], np.ndarray | None] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Linear RGB (float32 H x W x 3) and samples per pixel (uint32 H x W) of one keypoint. With the plan's
+    ``edge_min_samples``, ``edges`` is called once, after the first round (so that the caller can find them
+    meanwhile), for the pixels (bool H x W, or None: none) that get at least that many samples."""
     h, w = tracer.height, tracer.width
     if isinstance(tracer, PixelTracer):
         tracer.guide_world()
     sum_a, sum_b = np.zeros((h * w, 3)), np.zeros((h * w, 3))
     count = np.zeros(h * w, dtype=np.uint32)
     active = np.arange(h * w)
+    floor: np.ndarray | None = None  # the edge pixels (flat bool), once asked for
     for round_index, spp in enumerate(plan.rounds()):
         if round_index > 0:
             error = pixel_error(sum_a[active], sum_b[active], count[active])
             unconverged = np.zeros(h * w, dtype=bool)
             unconverged[active] = error >= plan.noise_threshold * CYCLES_THRESHOLD_SCALE
             keep = dilate(unconverged.reshape(h, w)).ravel()
+            if plan.edge_min_samples and edges is not None:
+                if floor is None:
+                    found = edges()
+                    floor = np.zeros(h * w, dtype=bool) if found is None else np.asarray(found, dtype=bool).ravel()
+                keep |= floor & (count < plan.edge_min_samples)
             active = active[keep[active]]
             if len(active) == 0:
                 break

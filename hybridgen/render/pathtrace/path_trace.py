@@ -9,7 +9,7 @@ centre where the label sample (u, v) is taken (Cycles' Blackman-Harris, :mod:`hy
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -159,10 +159,11 @@ class PathTraceView:
         forces a plain fixed-count estimate."""
         return self.render_with_counts(cam2world, seed, spp)[0]
 
-    def render_with_counts(self, cam2world: np.ndarray, seed: int,
-                           spp: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    def render_with_counts(self, cam2world: np.ndarray, seed: int, spp: int | None = None,
+                           edges: Callable[[], np.ndarray | None] | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Linear RGB (float32 H x W x 3) and samples per pixel (uint32 H x W) of one keypoint, sampled by
-        the settings' plan (adaptive or fixed; ``spp`` forces a fixed count)."""
+        the settings' plan (adaptive or fixed; ``spp`` forces a fixed count); ``edges``: the pixels the plan's
+        ``edge_min_samples`` applies to (:func:`~hybridgen.render.pathtrace.adaptive_sampling.render_adaptive`)."""
         import mitsuba as mi
 
         self.set_pose(cam2world)
@@ -171,7 +172,7 @@ class PathTraceView:
             image = mi.render(self.mi_scene, sensor=self.sensor, spp=plan.max_samples, seed=int(seed))
             counts = np.full((self.intrinsics.height, self.intrinsics.width), plan.max_samples, np.uint32)
             return np.array(image, dtype=np.float32)[..., :3], counts
-        return render_adaptive(self._tracer, plan, int(seed))
+        return render_adaptive(self._tracer, plan, int(seed), edges)
 
 
 class FullFrameTracer:

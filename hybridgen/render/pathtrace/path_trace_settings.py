@@ -84,6 +84,10 @@ class PathTraceSettings:
 
     ``caustics_refractive``: Cycles' option (default True, Cycles'); False drops refraction at surfaces a diffuse
     bounce led to (:mod:`hybridgen.render.pathtrace.clamped_path`); JIT variants only.
+
+    ``edge_min_samples`` (hybridgen's; default 0 = off): with adaptive sampling and denoising, the samples per pixel
+    the pixels on edges of the denoising guides get at least (:mod:`hybridgen.render.guide_edges`; at most the
+    maximum). BlenderProc scripts render with four times the minimum (:mod:`hybridgen.bproc.render_frames`).
     """
 
     samples: int | None = None
@@ -98,6 +102,7 @@ class PathTraceSettings:
     filter_width: float = pixel_filter.DEFAULT_WIDTH
     filter_glossy: float = glossy_filter.DEFAULT_FILTER_GLOSSY
     caustics_refractive: bool = True
+    edge_min_samples: int = 0
 
     def __post_init__(self) -> None:
         if self.samples is not None and self.samples < 1:
@@ -113,6 +118,8 @@ class PathTraceSettings:
             raise InputError(f"clamp_indirect must be >= 0 (0 = off), got {self.clamp_indirect}")
         if not (math.isfinite(self.filter_glossy) and self.filter_glossy >= 0):
             raise InputError(f"filter_glossy must be >= 0 (0 = off), got {self.filter_glossy}")
+        if self.edge_min_samples < 0:
+            raise InputError(f"edge_min_samples must be >= 0 (0 = off), got {self.edge_min_samples}")
         if not (math.isfinite(self.filter_width) and 0 <= self.filter_width <= 10):
             raise InputError(f"filter_width must be in 0..10 px (0 = one-pixel box), got {self.filter_width}")
         self.plan()  # validates the sampling knobs
@@ -128,7 +135,7 @@ class PathTraceSettings:
             if threshold == 0:  # adaptivity off: the maximum in every pixel
                 return SamplingPlan(most, most, 0.0)
             least = self._min_samples(threshold)
-        return SamplingPlan(most, min(least, most), threshold)
+        return SamplingPlan(most, min(least, most), threshold, min(self.edge_min_samples, most))
 
     def _min_samples(self, threshold: float) -> int:
         """``min_samples``, or Cycles' automatic minimum for ``threshold`` (> 0) when it is 0."""

@@ -1,0 +1,170 @@
+"""Edge pixels of the denoising guides get more samples: hybridgen.render.guide_edges finds them (analytic guide
+images), adaptive sampling gives them ``edge_min_samples`` (a noise-free stand-in tracer: exact counts), the color
+producer does so from its own guides (a silhouette against a black sky, whose pixels otherwise stop at the
+minimum), and BlenderProc scripts render with it when they denoise."""
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+import hybridgen as hg
+from hybridgen.render.guide_edges import ALBEDO_STEP, NORMAL_STEP, guide_edges
+from hybridgen.render.pathtrace.adaptive_sampling import SamplingPlan, render_adaptive
+from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
+
+
+def _flat(height: int = 6, width: int = 10) -> tuple[np.ndarray, np.ndarray]:
+    albedo = np.full((height, width, 3), 0.5, np.float32)
+    normals = np.zeros((height, width, 3), np.float32)
+    normals[..., 2] = 1.0
+    return albedo, normals
+
+
+def test_an_albedo_step_marks_the_two_columns_beside_it() -> None:
+    albedo, normals = _flat()
+    albedo[:, 5:] = 0.5 + ALBEDO_STEP  # a step of 3 x ALBEDO_STEP summed over RGB
+    expected = np.zeros((6, 10), bool)
+    expected[:, 4:6] = True
+    assert np.array_equal(guide_edges(albedo, normals), expected)
+    albedo[:, 5:] = 0.5 + ALBEDO_STEP / 4  # 0.75 x ALBEDO_STEP summed: no edge
+    assert not guide_edges(albedo, normals).any()
+
+
+def test_a_crease_marks_pixels_when_the_normals_turn_more_than_the_step() -> None:
+    albedo, normals = _flat()
+
+    def turned(angle: float) -> np.ndarray:
+        tilted = normals.copy()
+        tilted[:, 5:] = [math.sin(angle), 0.0, math.cos(angle)]  # |dx| + |dz| = sin + 1 - cos
+        return tilted
+
+    steep = math.radians(10.0)
+    assert math.sin(steep) + 1 - math.cos(steep) > NORMAL_STEP
+    assert guide_edges(albedo, turned(steep))[:, 4:6].all()
+    assert guide_edges(albedo, turned(steep)).sum() == 12
+    assert not guide_edges(albedo, turned(math.radians(3.0))).any()  # 0.054 < NORMAL_STEP
+
+
+def test_a_diagonal_neighbour_counts_and_smooth_ramps_do_not() -> None:
+    albedo, normals = _flat()
+    normals[3, 3] = 0.0  # one background pixel (normal 0) in a surface
+    edges = guide_edges(albedo, normals)
+    assert edges[2:5, 2:5].all() and edges.sum() == 9
+    albedo, normals = _flat()
+    albedo[:] = (np.arange(10, dtype=np.float32) * ALBEDO_STEP / 4)[None, :, None]  # 0.75 x the step per pixel
+    assert not guide_edges(albedo, normals).any()
+    albedo, normals = _flat()
+    albedo[2, 2] = np.nan  # a non-finite guide value counts as 0
+    edges = guide_edges(albedo, normals)
+    assert edges[1:4, 1:4].all() and edges.sum() == 9
+
+
+class _ExactTracer:
+    """Every sample of pixel i is i / 100 in each channel: no noise, so every pixel converges at the minimum."""
+
+    whole_frames = False
+    owen_sobol = True
+
+    def __init__(self, width: int, height: int) -> None:
+        self.width, self.height = width, height
+        self.rounds: list[np.ndarray] = []
+
+    def trace(self, pixels: np.ndarray, spp: int, seed: int, first: np.ndarray | None = None):
+        self.rounds.append(np.array(pixels))
+        half = np.repeat((pixels / 100.0)[:, None], 3, axis=1) * (spp / 2)
+        return half, half.copy()
+
+
+def test_edge_pixels_get_edge_min_samples_and_the_others_stop_at_the_minimum() -> None:
+    tracer = _ExactTracer(8, 5)
+    edges = np.zeros((5, 8), bool)
+    edges[1, 2] = edges[4, 7] = True
+    asked: list[int] = []
+
+    def edge_pixels() -> np.ndarray:
+        asked.append(len(tracer.rounds))
+        return edges
+
+    image, counts = render_adaptive(tracer, SamplingPlan(64, 4, 0.01, edge_min_samples=16), 1, edge_pixels)
+    assert asked == [1]  # asked once, after the first round
+    expected = np.where(edges, 16, 4)
+    assert np.array_equal(counts, expected)
+    assert np.allclose(image[..., 0], np.arange(40).reshape(5, 8) / 100.0)
+    assert [sorted(r.tolist()) for r in tracer.rounds[1:]] == [[10, 39], [10, 39]]  # 4 -> 8 -> 16
+    # without the plan's floor the edges are never asked for; None means no edge pixels
+    _, counts = render_adaptive(_ExactTracer(8, 5), SamplingPlan(64, 4, 0.01), 1, lambda: pytest.fail("asked"))
+    assert (counts == 4).all()
+    _, counts = render_adaptive(_ExactTracer(8, 5), SamplingPlan(64, 4, 0.01, edge_min_samples=16), 1, lambda: None)
+    assert (counts == 4).all()
+    with pytest.raises(hg.InputError, match="edge_min_samples"):
+        SamplingPlan(64, 4, 0.01, edge_min_samples=128)
+
+
+def _silhouette_scene() -> hg.Scene:
+    """A white cube lit by a sun against a black sky (sky pixels: every sample 0)."""
+    scene = hg.Scene()
+    scene.add(hg.make_primitive("cube", 1.0, name="cube", category_id=1, color=(0.8, 0.8, 0.8)))
+    scene.world.strength = 0.0
+    scene.lights.append(hg.Light("sun", "SUN", energy=3.0, local2world=hg.object_pose([0, 0, 3], [0.4, 0.3, 0])))
+    scene.camera.intrinsics = hg.Intrinsics.from_fov(0.9, 32, 24)
+    scene.camera.add_keypoint(hg.look_at([2.2, -2.6, 1.8], [0, 0, 0]))
+    return scene
+
+
+def test_the_color_producer_gives_its_guides_edges_the_floor(gl_context) -> None:
+    from hybridgen.render.render_color import ColorProducer
+
+    scene = _silhouette_scene()
+    pose = scene.camera.keypoints[0]
+    ids = hg.RasterView(scene).render(pose, ["instance_segmaps"])["instance_segmaps"]
+    padded = np.pad(ids, 1, mode="edge")
+    silhouette = np.zeros(ids.shape, bool)  # pixel centres with another id among their 4 neighbours
+    for dy, dx in ((0, 1), (2, 1), (1, 0), (1, 2)):
+        silhouette |= padded[dy:dy + ids.shape[0], dx:dx + ids.shape[1]] != ids
+    # sky pixels with no cube pixel within 4 px (the pixel filter's 1.5 px, the guides' filter, one neighbour)
+    cube = np.pad(ids != 0, 4)
+    far_sky = ~np.any([cube[dy:dy + ids.shape[0], dx:dx + ids.shape[1]] for dy in range(9) for dx in range(9)],
+                      axis=0)
+    assert silhouette.sum() > 20 and far_sky.sum() > 300
+    settings = hg.PathTraceSettings(samples=64, noise_threshold=0.01, min_samples=4, edge_min_samples=32,
+                                    max_bounces=1)
+    for raster in (None, hg.render.raster.scene_raster.SceneRaster(scene)):  # guides on a worker, or shared
+        producer = ColorProducer(scene, settings, variant=choose_variant(), denoise=True, sample_counts=True,
+                                 raster=raster)
+        try:
+            counts = producer.produce(0, pose)["sample_counts"]
+            assert producer.attributes()["edge_min_samples"] == 32
+        finally:
+            producer.close()
+            if raster is not None:
+                raster.release()
+        assert (counts[silhouette] >= 32).all()
+        assert (counts[far_sky] == 4).all()
+
+
+def test_blenderproc_scripts_denoise_with_four_times_the_minimum_on_edges(monkeypatch) -> None:
+    from hybridgen.bproc import render_frames
+
+    seen: list[hg.PathTraceSettings] = []
+    monkeypatch.setattr(hg, "render_color", lambda scene, sinks, trace, **kw: seen.append(trace))
+    scene = SimpleNamespace(camera=SimpleNamespace())
+    monkeypatch.setattr(render_frames, "_scene", lambda frames, meshes: (scene, None))
+    monkeypatch.setattr(render_frames, "_depth_of_field", lambda frame: None)
+    monkeypatch.setattr(render_frames, "_stereo_baseline", lambda: None)
+    monkeypatch.delenv(render_frames.MAX_SAMPLES_ENV, raising=False)
+    from hybridgen.bproc.session import SESSION
+
+    def render(denoiser: str | None, samples: int = 1024, threshold: float = 0.01) -> hg.PathTraceSettings:
+        monkeypatch.setattr(SESSION.renderer, "denoiser", denoiser)
+        monkeypatch.setattr(SESSION.renderer, "samples", samples)
+        monkeypatch.setattr(SESSION.renderer, "noise_threshold", threshold)
+        render_frames._render_group([0], [], True, False)
+        return seen[-1]
+
+    assert render("INTEL").edge_min_samples == 256  # 4 x Cycles' automatic minimum 64 at threshold 0.01
+    assert render("INTEL", samples=100).edge_min_samples == 100
+    assert render(None).edge_min_samples == 0
+    assert render("INTEL", threshold=0.0).edge_min_samples == 0
