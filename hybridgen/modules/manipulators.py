@@ -15,7 +15,8 @@ from ..errors import InputError
 from ..scene.frames import object_pose
 from ..run.context import RunContext
 from ..scene.material import TEXTURE_SLOTS, Material
-from ..scene.displacement import displace_objects
+from ..scene.mesh_object import MeshObject
+from ..scene.displacement import displace_object
 from ..scene.frames import matrix_to_euler_xyz
 from .base import Role
 from .selecting import SelectingModule
@@ -89,18 +90,24 @@ class EntityManipulator(SelectingModule):
         Param("attributes", "dict", {}, sampleable=True, doc="custom attributes to set (e.g. for map_by)"),
         Param("category_id", "int|null", None, doc="new category_id"),
         Param("displace", "dict|null", None, sampleable=True,
-              doc="true geometric displacement (Blender's Subdivision + Displace modifiers, BlenderProc's "
-                  "cf_add_displace_modifier_with_texture): {texture: height image, strength: 0.1, mid_level: 0.5, "
-                  "subdiv_level: 2, min_vertices_for_subdiv: 10000, texture_coords: LOCAL|UV}; labels and color "
-                  "see the displaced mesh (hybridgen/scene/displacement.py)"),
+              doc="true geometric displacement (Blender's Subdivision Surface + Displace modifiers, BlenderProc's "
+                  "cf_add_displace_modifier_with_texture): {texture: sampler.Texture / a procedural texture name "
+                  "(CLOUDS, VORONOI, ...) / a height image path (getter.Texture), strength: 0.1, mid_level: 0.5, "
+                  "subdiv_level: 2 (Catmull-Clark, capped at 3), min_vertices_for_subdiv: 10000, texture_coords: "
+                  "LOCAL|UV}, drawn once per Blender object; labels and color see the displaced mesh "
+                  "(hybridgen/scene/displacement.py)"),
     )
 
     def run(self, context: RunContext) -> None:
-        displaced: dict = {}  # objects sharing a mesh and modifier share one displaced mesh
-        for obj in self.selected(context):
-            displace = self.value(context, "displace")
-            if displace is not None:
-                displace_objects([obj], displacement_from_config(displace), displaced)
+        selected = self.selected(context)
+        if self.config["displace"] is not None:
+            displaced: dict = {}  # objects sharing a mesh and modifier share one displaced mesh
+            for parts in blender_objects(selected):
+                displace = self.value(context, "displace")
+                if displace is not None:
+                    modifier = displacement_from_config(displace, textures=context.scene.textures)
+                    displace_object(parts, modifier, displaced)
+        for obj in selected:
             location, rotation, scale = (self.value(context, k) for k in ("location", "rotation", "scale"))
             if location is not None or rotation is not None or scale is not None:
                 current = obj.local2world
@@ -113,3 +120,13 @@ class EntityManipulator(SelectingModule):
             obj.attributes.update(self.value(context, "attributes"))
             if self.config["category_id"] is not None:
                 obj.category_id = self.config["category_id"]
+
+
+def blender_objects(objects: list[MeshObject]) -> list[list[MeshObject]]:
+    """``objects`` grouped into Blender objects: the parts a loader made of one object with several materials
+    (same name and file, ``material_part`` set) together, in their order; every other object alone."""
+    groups: dict[object, list[MeshObject]] = {}
+    for obj in objects:
+        key = (obj.name, obj.attributes.get("source_path")) if "material_part" in obj.attributes else id(obj)
+        groups.setdefault(key, []).append(obj)
+    return list(groups.values())

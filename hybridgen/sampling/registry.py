@@ -15,7 +15,8 @@ import numpy as np
 
 from ..nested import map_nested
 from ..errors import ConfigError, InputError, closest
-from . import attribute_getter, attribute_merger, getters, samplers, texture_getter  # noqa: F401  (they register)
+from . import attribute_getter, attribute_merger, getters, samplers  # noqa: F401  (they register)
+from . import texture_getter, texture_sampler  # noqa: F401  (they register)
 from .sampler_table import ALIASES, SAMPLERS, DrawContext, SamplerSpec
 
 

@@ -7,7 +7,11 @@ the mean of the polygon's corners. Edge point: the mean of the edge's ends and i
 vertex of valence n: (Q + 2 R + (n - 3) V) / n, Q the mean of the face points around it, R the mean of its edges'
 midpoints; of a vertex on exactly two boundary edges (corners too: "All" smooths them) (A + 6 V + B) / 8 from the
 two boundary neighbours; any other vertex stays. After the last level every vertex moves to its limit position:
-interior (n^2 V + 4 sum(edge neighbours) + sum(diagonal neighbours)) / (n (n + 5)), boundary (A + 4 V + B) / 6.
+interior (n^2 V + 4 sum(edge neighbours) + sum(diagonal neighbours)) / (n (n + 5)), boundary (A + 4 V + B) / 6 -
+except a boundary vertex of valence 2 (a lone quad's corner), where Blender (OpenSubdiv, which refines such an
+irregular vertex ``quality`` = 3 times and takes that point) keeps the point of the third level: with the B-spline
+boundary's contraction of 1/4 per level, L + 4^(levels - 3) (V - L), L its limit (measured with bpy 4.2 on a lone
+quad at levels 1-4: 43/64 of the way out where the limit is 2/3, the other vertices at their limits up to level 3).
 
 Per-corner attributes (UVs, normals, colors) are subdivided linearly inside each polygon (Blender's ``uv_smooth``
 NONE; its default PRESERVE_BOUNDARIES also smooths UVs inside UV islands). Measured against bpy 4.2 (a 2 m cube:
@@ -94,8 +98,12 @@ def _step(mesh: PolygonMesh, smooth: bool = True) -> PolygonMesh:
                        np.arange(0, 4 * len(corners) + 1, 4), mesh.part[polygon], attributes)
 
 
-def limit_positions(mesh: PolygonMesh) -> np.ndarray:
-    """The limit positions (V, 3) of a quad mesh's vertices (module doc)."""
+QUALITY = 3
+"""Blender's Subdivision Surface ``quality`` (its default): how often OpenSubdiv refines an irregular vertex."""
+
+
+def limit_positions(mesh: PolygonMesh, levels: int = QUALITY) -> np.ndarray:
+    """The limit positions (V, 3) of a quad mesh's vertices after ``levels`` levels (module doc)."""
     p = mesh.positions
     edges, _, counts = _edges(mesh)
     boundary = counts != 2
@@ -106,6 +114,8 @@ def limit_positions(mesh: PolygonMesh) -> np.ndarray:
     n = valence[interior][:, None]
     out[interior] = (n * n * p[interior] + 4.0 * _partner_sum(p, edges)[interior] + diagonal[interior]) / (n * (n + 5))
     out[crease] = (_partner_sum(p, edges[boundary])[crease] + 4.0 * p[crease]) / 6.0
+    lone = crease & (valence == 2)  # Blender keeps the point of its QUALITY-th level there (module doc)
+    out[lone] += 4.0 ** (levels - QUALITY) * (p[lone] - out[lone])
     return out
 
 
@@ -117,5 +127,5 @@ def subdivide(mesh: PolygonMesh, levels: int, limit: bool = True, smooth: bool =
     for _ in range(int(levels)):
         mesh = _step(mesh, smooth)
     if limit:
-        mesh.positions = limit_positions(mesh)
+        mesh.positions = limit_positions(mesh, int(levels))
     return mesh

@@ -8,11 +8,11 @@ Blender's steps, each measured with bpy 4.2 where it matters:
    then applied to the vertices (metres, object frame).
 2. Displace along the vertex normal (+Z): (h - 0.5) x ``strength`` metres, h the displacement image at the
    vertex's UV (``texture_coords`` UV; the UVs multiplied by ``uv_scaling``), bilinear and repeating
-   (:func:`hybridgen.scene.displacement.sample_bilinear`; Blender's values at a 4 x 4 image agree). A tile
+   (:func:`hybridgen.scene.displacement_texture.sample_bilinear`; Blender's values at a 4 x 4 image agree). A tile
    without an image reads h = 0: the whole tile moves down by strength / 2 (bpy 4.2: z = -0.5 at strength 1).
 3. Subdivision Surface at ``levels`` (its render level, capped at 3 as BlenderProc's renderer caps it):
-   Catmull-Clark (:mod:`hybridgen.scene.catmull_clark`: on a grid Blender's corners lie 0.26 % of a cell further
-   out, heights agree within 5e-4 on +-0.25 bumps); UVs follow the grid linearly (Blender's "keep boundaries" UV
+   Catmull-Clark (:mod:`hybridgen.scene.catmull_clark`: Blender's positions within 1e-5 on +-0.25 bumps, the
+   tile's corners included); UVs follow the grid linearly (Blender's "keep boundaries" UV
    smoothing keeps a grid's UVs linear). The tile stays flat-shaded, as the plane is.
 """
 from __future__ import annotations
@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from . import catmull_clark
-from .displacement import height_image, sample_bilinear
+from .displacement_texture import height_image, sample_bilinear
 from .polygon_mesh import PolygonMesh
 
 SIMPLIFY_SUBDIVISION_RENDER = 3

@@ -11,7 +11,10 @@ triangles a loader made of one polygon back into it (:mod:`hybridgen.scene.polyg
 from __future__ import annotations
 
 import copy
+import os
+import re
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -156,3 +159,18 @@ def from_parts(parts: list[MeshObject], polygons: bool = True) -> PolygonMesh:
     polygon_part = part[loops[starts[:-1]] // 3]
     return PolygonMesh(positions, triangles.ravel()[loops], starts, polygon_part,
                        {name: values[loops] for name, values in attributes.items()})
+
+
+_POLYGON_FACE = re.compile(rb"^f(?:[ \t]+\S+){4,}", re.MULTILINE)
+
+
+def source_has_polygons(path: Any) -> bool:
+    """Whether an object read from ``path`` may hold polygons of more than three corners, i.e. whether
+    :func:`from_parts` should recover them: an OBJ with a face line of four or more vertices; not a PLY, STL or
+    glTF (their loaders give triangles); an object of no file (a primitive) may."""
+    if not isinstance(path, str) or not os.path.isfile(path):
+        return True
+    if not path.lower().endswith(".obj"):
+        return False
+    with open(path, "rb") as handle:
+        return _POLYGON_FACE.search(handle.read()) is not None

@@ -151,3 +151,25 @@ def test_simplify_limits_subdivision_levels(bproc) -> None:  # noqa: F811
     four = bproc.object.create_primitive("CUBE")
     four.add_modifier("SUBSURF", render_levels=4)
     assert vertex_count(four) == 6 * 16 * 16 + 2
+
+
+def test_add_displace_modifier_with_an_image_texture_equals_blender(bproc, tmp_path) -> None:  # noqa: F811
+    """A 4 x 4 RGB image of bproc.loader.load_texture on Blender's 2 m plane: Blender 4.2's displaced vertices
+    (tests/scene/data/blender_displace_image.json, tools/blender_displace_image.py)."""
+    import json
+    from pathlib import Path
+
+    from PIL import Image
+
+    table = json.loads((Path(__file__).parents[1] / "scene" / "data" / "blender_displace_image.json").read_text())
+    case = table["cases"]["rgb catmull-clark 3"]
+    Image.fromarray(np.asarray(table["images"]["rgb.png"], dtype=np.uint8)).save(tmp_path / "rgb.png")
+    texture = bproc.loader.load_texture(str(tmp_path / "rgb.png"))[0]
+    plane = bproc.object.create_primitive("PLANE")
+    plane.add_displace_modifier(texture, mid_level=case["mid_level"], strength=case["strength"],
+                                subdiv_level=case["levels"])
+    ours = np.unique(np.concatenate([part.vertices for part in plane.parts]), axis=0)
+    blender = np.array(case["vertices"])
+    assert len(ours) == len(blender)
+    distance = np.linalg.norm(ours[:, None] - blender[None], axis=2).min(axis=1)
+    assert distance.max() < 2e-6 and np.ptp(blender[:, 2]) > 0.1

@@ -65,9 +65,13 @@ def test_open_box_and_plane_boundaries_match_blender() -> None:
     assert np.allclose(box.positions.max(axis=0), [0.9166667, 0.9166667, 1.0], atol=1e-6)  # the open rim stays
     plane = subdivide(polygons([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [(0, 1, 2, 3)]), 2)
     xs = np.unique(np.round(np.abs(plane.positions[:, 0]), 5))
-    # Blender: 0, 0.36458, 0.43056, 0.45833, 0.67188, 0.85417, 0.91667; its lone corners (OpenSubdiv's end cap at a
-    # valence-2 boundary vertex) are 43/64 where the B-spline limit is 2/3
-    assert np.allclose(xs, [0.0, 0.36458, 0.43056, 0.45833, 0.66667, 0.85417, 0.91667], atol=1e-5)
+    # Blender: 0, 0.36458, 0.43056, 0.45833, 0.67188, 0.85417, 0.91667; its lone corners (valence-2 boundary
+    # vertices, which OpenSubdiv refines 3 times) are 43/64 where the B-spline limit is 2/3 - at every level
+    assert np.allclose(xs, [0.0, 0.36458, 0.43056, 0.45833, 43 / 64, 0.85417, 0.91667], atol=1e-5)
+    for levels in (1, 3):
+        corners = subdivide(polygons([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [(0, 1, 2, 3)]), levels)
+        assert np.abs(corners.positions[:, 0]).max() == pytest.approx(0.9166667, abs=1e-6)  # edge midpoints
+        assert np.sort(np.abs(corners.positions[:4, 0])) == pytest.approx([43 / 64] * 4, abs=1e-7)
 
 
 def test_polygons_come_back_from_the_loaders_triangles() -> None:

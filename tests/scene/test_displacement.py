@@ -1,16 +1,18 @@
 """True geometric displacement (hybridgen/scene/displacement.py) against the analytic height field.
 
-A 2 m plane (z = 0, smooth, UVs u = (x + 1) / 2, v = (y + 1) / 2) displaced with the periodic height
-H(u, v) = 0.5 + 0.4 sin(2 pi u) cos(2 pi v), strength s, is the surface z = f(x, y) = s (H - 0.5). Seen from
+A 4 m plane (z = 0, smooth, UVs u = (x + 1) / 2, v = (y + 1) / 2 in [-0.5, 1.5]) displaced with the periodic
+height H(u, v) = 0.5 + 0.4 sin(2 pi u) cos(2 pi v) read at LOCAL coordinates (u = (x + 1) / 2 of the vertex's own
+position; the image repeats), strength s: every vertex of the subdivided plane - wherever Catmull-Clark puts it;
+a lone quad's grid is not uniform and its rim rounds - lies on the surface z = f(x, y) = s (H - 0.5). Seen from
 straight above, the label depth at each pixel centre is where that pixel's ray meets z = f (solved by Newton
-iterations), and the normal is (-f_x, -f_y, 1) normalised. The mesh approximates f by triangles of edge
-2 m / 2^L (L = subdiv_level) with vertices exactly on f (up to the 256^2 image's bilinear error, < 1e-5 m
-here): linear interpolation over a right triangle of legs e is off by at most M R^2 / 2, R = e / sqrt(2) its
-circumradius and M = s 0.4 pi^2 = 0.79 / m the largest curvature of f, i.e. 1.9e-4 m for L = 6 (e = 3.1 cm),
-up to ~2.1e-4 m along rays tilted up to 0.4 rad over slopes up to 0.25 (measured: 2.08e-4 m); interpolated
-vertex normals are off by about e M / 2 = 0.012 rad (measured: max 0.0092, median 0.001 rad). A trimesh ray
-cast on the displaced mesh and Mitsuba's own ray tracer (the color view's scene) meet the same surface as
-the raster depth.
+iterations), and the normal is (-f_x, -f_y, 1) normalised. The mesh approximates f by triangles of edge about
+4 m / 2^L (L = subdiv_level, 7: 3.1 cm) with vertices on f (up to the 256^2 image's bilinear error: 1.2e-5 m):
+linear interpolation over a right triangle of legs e is off by at most M R^2 / 2, R = e / sqrt(2) its circumradius
+and M = s 0.4 pi^2 = 0.79 / m the largest curvature of f, i.e. 1.9e-4 m for e = 3.1 cm, a little more along tilted
+rays (measured: 1.7e-4 m); interpolated vertex normals are off by at most about e M / 2 = 0.012 rad (measured: max
+0.0014, median 0.0008 rad: the corner-angle weighted normals of a near-regular grid are better). A
+trimesh ray cast on the displaced mesh and Mitsuba's own ray tracer (the color view's scene) meet the same surface
+as the raster depth.
 """
 from __future__ import annotations
 
@@ -20,9 +22,10 @@ import pytest
 import hybridgen as hg
 from hybridgen.config.displacement_config import displacement_from_config
 from hybridgen.errors import ConfigError
-from hybridgen.scene.displacement import Displacement, displace_objects
+from hybridgen.scene.displacement import Displacement, displace_object
+from hybridgen.scene.displacement_texture import ImageHeight
 
-STRENGTH, LEVEL, SIZE = 0.2, 6, 64
+STRENGTH, LEVEL, SIZE = 0.2, 7, 64
 FOCAL, HEIGHT = 78.0, 2.5
 CAM2WORLD = np.array([[1.0, 0, 0, 0], [0, -1, 0, 0], [0, 0, -1, HEIGHT], [0, 0, 0, 1]])
 
@@ -46,8 +49,8 @@ def _f(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray
     return z, fx, fy
 
 
-def _plane(name: str = "plane") -> hg.MeshObject:
-    vertices = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], float)
+def _plane(name: str = "plane", half: float = 1.0) -> hg.MeshObject:
+    vertices = half * np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], float)
     return hg.MeshObject(name, vertices, [[0, 1, 2], [0, 2, 3]], vertex_normals=np.tile([0.0, 0, 1], (4, 1)),
                          uvs=(vertices[:, :2] + 1) / 2, category_id=1)
 
@@ -85,13 +88,13 @@ def _analytic_depth() -> tuple[np.ndarray, np.ndarray]:
 
 @pytest.fixture(scope="module")
 def displaced() -> hg.MeshObject:
-    obj = _plane()
-    displace_objects([obj], Displacement(_image(), strength=STRENGTH, subdiv_level=LEVEL, texture_coords="UV"))
+    obj = _plane(half=2.0)
+    displace_object([obj], Displacement(ImageHeight(_image()), strength=STRENGTH, subdiv_level=LEVEL, simplify=0))
     return obj
 
 
 def test_displaced_plane_depth_and_normals_match_the_height_field(gl_context, displaced):
-    assert len(displaced.faces) == 2 * 4 ** LEVEL
+    assert len(displaced.faces) == 2 * 4 ** LEVEL  # the two triangles were one quad (recovered), now 4^L quads
     labels = hg.RasterView(_scene(displaced)).render(CAM2WORLD, ["depth", "normals"], normals_space="world")
     depth, normals = labels["depth"].astype(np.float64), labels["normals"].astype(np.float64)
     expected_depth, expected_normals = _analytic_depth()
@@ -100,7 +103,7 @@ def test_displaced_plane_depth_and_normals_match_the_height_field(gl_context, di
     assert np.abs(depth - expected_depth)[inside].max() < 3e-4  # bound ~2.1e-4 m (module docstring)
     assert np.abs(depth - HEIGHT)[inside].max() > 0.05  # the surface really moved (amplitude 0.08 m)
     angle = np.arccos(np.clip(np.sum(normals * expected_normals, -1), -1, 1))[inside]
-    assert angle.max() < 0.015 and np.median(angle) < 0.003  # about 0.012 rad (module docstring)
+    assert angle.max() < 0.005 and np.median(angle) < 0.002  # at most about 0.012 rad (module docstring)
     flat_angle = np.arccos(np.clip(expected_normals[..., 2], -1, 1))[inside]
     assert flat_angle.max() > 0.2  # the analytic normals tilt by up to ~0.25 rad in view: not trivial
 
@@ -131,14 +134,21 @@ def test_instances_share_one_displaced_mesh_and_local_coordinates_match_uvs():
     first, second = _plane("a"), _plane("b")
     second.vertices, second.faces, second.uvs, second.vertex_normals = \
         first.vertices, first.faces, first.uvs, first.vertex_normals  # two placements of one model
-    image = _image(32)
-    displace_objects([first, second], Displacement(image, strength=STRENGTH, subdiv_level=2, texture_coords="UV"))
+    image = ImageHeight(_image(32))
+    done: dict = {}
+    for obj in (first, second):
+        displace_object([obj], Displacement(image, strength=STRENGTH, subdiv_level=2, texture_coords="UV"), done)
     assert first.vertices is second.vertices and first.faces is second.faces
-    local = _plane("c")  # local x, y in [-1, 1] map to the image as u = (x + 1) / 2: the same as these UVs
-    displace_objects([local], Displacement(image, strength=STRENGTH, subdiv_level=2))
-    np.testing.assert_allclose(local.vertices, first.vertices, atol=1e-12)
-    untouched = _plane("d")
-    displace_objects([untouched], Displacement(image, subdiv_level=2, min_vertices_for_subdiv=3))
+    # without smoothing the subdivided vertices stay where their UVs say: LOCAL x, y in [-1, 1] read the image as
+    # u = (x + 1) / 2, the same as these UVs (Catmull-Clark moves the positions off their linear UVs)
+    local, by_uv = _plane("c"), _plane("d")
+    displace_object([local], Displacement(image, strength=STRENGTH, subdiv_level=2, subdivision="SIMPLE"))
+    displace_object([by_uv], Displacement(image, strength=STRENGTH, subdiv_level=2, subdivision="SIMPLE",
+                                          texture_coords="UV"))
+    np.testing.assert_allclose(local.vertices, by_uv.vertices, atol=1e-12)
+    assert np.abs(local.vertices - first.vertices).max() > 0.01
+    untouched = _plane("e")
+    displace_object([untouched], Displacement(image, subdiv_level=2, min_vertices_for_subdiv=3))
     assert len(untouched.faces) == 2  # more vertices than min_vertices_for_subdiv: not subdivided (BlenderProc)
 
 
@@ -170,5 +180,7 @@ modules:
 """, write_config)
     floor, other = context.scene.by_name("floor"), context.scene.by_name("other")
     assert len(other.faces) == 2 and np.all(other.vertices[:, 2] == 0)
-    assert len(floor.faces) == 8  # one linear subdivision
+    assert len(floor.faces) == 8  # one Catmull-Clark level: four quads
     np.testing.assert_allclose(floor.vertices[:, 2], 0.5 * 0.3)  # (1 - mid_level 0.5) x strength along +z
+    # Blender 4.2's level 1 of its 2 m plane (bpy): x, y in {0, +-0.671875 (corners), +-0.916667 (edge middles)}
+    assert np.allclose(np.unique(np.abs(floor.vertices[:, :2]).round(6)), [0.0, 0.671875, 0.916667], atol=1e-6)

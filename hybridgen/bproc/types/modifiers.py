@@ -9,7 +9,9 @@ the triangles (:mod:`hybridgen.scene.polygon_recovery`); one from an all-triangl
 triangles. Consecutive modifiers share the polygon mesh, as a modifier stack does. SUBSURF subdivides
 ``render_levels`` times (what Blender renders), at most ``bproc.renderer.set_simplify_subdivision_render``'s
 limit (BlenderProc 2.8's init sets Blender's "Simplify" to 3); ``subdivision_type`` SIMPLE subdivides without
-smoothing.
+smoothing. DISPLACE reads a procedural texture (``bproc.material.create_procedural_texture``) or an image texture
+(``bproc.loader.load_texture``; :class:`hybridgen.scene.displacement_texture.ImageHeight`, Blender's image
+sampling), the same textures v1 configs' ``displace`` reads (:mod:`hybridgen.scene.displacement`).
 
 Differences: the modifier is applied at once, so a later change of the base mesh (a persisted transformation,
 ``set_shading_mode``) does not re-run it, and setting a modifier's attributes later changes nothing; UVs are
@@ -18,8 +20,6 @@ or a setting hybridgen does not reproduce, raises one line naming it.
 """
 from __future__ import annotations
 
-import os
-import re
 from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
@@ -49,20 +49,6 @@ APPLIED = {"SUBSURF": {"render_levels", "subdivision_type", "use_limit_surface",
            "DISPLACE": {"texture", "mid_level", "strength", "direction", "texture_coords"},
            "SOLIDIFY": {"thickness", "offset", "use_rim", "use_even_offset", "use_flip_normals"}}
 """Settings hybridgen reproduces (or that change nothing here); any other must keep its default."""
-_POLYGON_FACE = re.compile(rb"^f(?:[ \t]+\S+){4,}", re.MULTILINE)
-
-
-def _source_has_polygons(path: Any) -> bool:
-    """Whether the object's file may hold polygons of more than three corners (OBJ: a face line with four or
-    more vertices; PLY, STL, glTF: loaders give triangles; no file - a primitive - may)."""
-    if not isinstance(path, str) or not os.path.isfile(path):
-        return True
-    if not path.lower().endswith(".obj"):
-        return False
-    with open(path, "rb") as handle:
-        return _POLYGON_FACE.search(handle.read()) is not None
-
-
 class MeshModifiers:
     """Mixin of :class:`~hybridgen.bproc.types.MeshObject`: needs ``parts``, ``part_slots``, ``get_name``,
     ``get_cp`` / ``has_cp`` and ``get_local2world_mat``."""
@@ -76,7 +62,7 @@ class MeshModifiers:
 
     def _stack_mesh(self) -> "PolygonMesh":
         """The welded polygon mesh of the current parts (the one the last modifier left, while the parts are its)."""
-        from ...scene.polygon_mesh import from_parts
+        from ...scene.polygon_mesh import from_parts, source_has_polygons
 
         cached = self.__dict__.get("_modifier_mesh")
         if cached is not None and len(cached[0]) == len(self.parts) and all(
@@ -85,7 +71,7 @@ class MeshModifiers:
         if not self.parts:
             fail(f"bproc.types.MeshObject.add_modifier on '{self.get_name()}'", "its mesh has no faces")
         path = self.get_cp("model_path") if self.has_cp("model_path") else None
-        return from_parts(self.parts, polygons=_source_has_polygons(path))
+        return from_parts(self.parts, polygons=source_has_polygons(path))
 
     def _set_stack_mesh(self, mesh: "PolygonMesh") -> None:
         parts = mesh.to_parts(self.parts)
@@ -147,14 +133,18 @@ def _subsurf(obj: MeshModifiers, mesh: "PolygonMesh", s: dict[str, Any], call: s
 def _displace(obj: MeshModifiers, mesh: "PolygonMesh", s: dict[str, Any], call: str) -> "PolygonMesh":
     from ...scene.displace_modifier import displace
 
+    from ...scene.displacement_texture import ImageHeight
+
     texture = s["texture"]
-    if texture is None:
-        values: Callable[[np.ndarray], np.ndarray] = lambda points: np.ones(len(points))  # noqa: E731
-    elif hasattr(texture, "displacement"):
+    values: Callable[[np.ndarray], np.ndarray] | None = None  # no texture: every vertex reads 1
+    if hasattr(texture, "displacement"):
         values = texture.displacement
-    else:
+    elif getattr(texture, "type", None) == "IMAGE" and hasattr(getattr(texture, "image", None), "filepath"):
+        values = ImageHeight(texture.image.filepath, getattr(texture, "colorspace", None), obj.get_name())
+    elif texture is not None:
         fail(f"{call} with a {getattr(texture, 'type', type(texture).__name__)} texture",
-             "procedural textures of bproc.material.create_procedural_texture are")
+             "procedural textures of bproc.material.create_procedural_texture and image textures of "
+             "bproc.loader.load_texture are")
     for key in ("mid_level", "strength"):
         if not np.isfinite(float(s[key])):
             raise InputError(f"{call}: {key} must be finite, got {s[key]}")

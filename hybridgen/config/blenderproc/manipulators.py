@@ -53,12 +53,10 @@ def entity(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]
         cfg.pop("mode", None)  # the randomizer draws once for all or for each, as BlenderProc
     pop_mode(cfg, note)
     shading = take_shading(cfg)
-    for key in ("cf_add_modifier", "cf_add_uv_mapping"):
-        pop_ignored(cfg, key, note, "Blender modifiers (displacement, subdivision, UV projection) are not applied")
-    pop_ignored(cfg, "cf_add_displace_modifier_with_texture", note,
-                "Blender's procedural textures are not reproduced, so this displacement is not applied; "
-                "EntityManipulator's displace: {texture: <height image>, strength, mid_level, subdiv_level} "
-                "displaces the geometry")
+    pop_ignored(cfg, "cf_add_modifier", note, "Blender's Solidify modifier is not applied to v1 configs' objects")
+    pop_ignored(cfg, "cf_add_uv_mapping", note, "UV projection is not applied (the displacement reads LOCAL "
+                "coordinates, as BlenderProc's)")
+    displace(cfg, note)
     out = []
     randomize = cfg.pop("cf_randomize_materials", None)
     if randomize is not None:
@@ -81,6 +79,26 @@ def entity(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]
     if set(cfg) - {"selector"} or not out:
         out.insert(0, ("manipulators.EntityManipulator", cfg))
     return out
+
+
+DISPLACE_KEYS = ("texture", "mid_level", "subdiv_level", "strength", "min_vertices_for_subdiv")
+"""The keys BlenderProc 1.x's cf_add_displace_modifier_with_texture reads (it ignores any other)."""
+
+
+def displace(cfg: dict[str, Any], note: Note) -> None:
+    """``cf_add_displace_modifier_with_texture`` -> EntityManipulator's ``displace`` (Subdivision Surface + Displace
+    modifiers, hybridgen/scene/displacement.py); keys BlenderProc does not read are reported and dropped."""
+    value = cfg.pop("cf_add_displace_modifier_with_texture", None)
+    if value is None:
+        return
+    if not isinstance(value, dict):
+        raise ConfigError("must be a mapping {texture, mid_level, subdiv_level, strength, min_vertices_for_subdiv}",
+                          key="cf_add_displace_modifier_with_texture")
+    for key in value:
+        if key not in DISPLACE_KEYS:
+            note(f"ignored: BlenderProc reads only {', '.join(DISPLACE_KEYS)}",
+                 f"cf_add_displace_modifier_with_texture.{key}")
+    cfg["displace"] = {key: value[key] for key in DISPLACE_KEYS if key in value}
 
 
 _EXTRA_NAMES = {name: entry.key for name, entry in BY_BLENDER_NAME.items()}
