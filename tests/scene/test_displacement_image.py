@@ -128,3 +128,32 @@ def test_sampler_texture_draws_blenderprocs_types() -> None:
     points = np.random.default_rng(0).uniform(-3, 3, (50, 3))
     np.testing.assert_allclose(voronoi(points), displacement_value("VORONOI", voronoi.settings, points))
     assert voronoi.settings["noise_scale"] == 0.5 and texture(ctx, textures=["magic"]).kind == "MAGIC"
+
+
+def test_material_parts_of_one_object_are_displaced_together(tmp_path: Path) -> None:
+    """An OBJ object of two quads with two materials is two hybridgen parts but one Blender mesh: the seam's
+    vertices move once (the welded mesh's normal and texture value), so the parts stay joined."""
+    (tmp_path / "two.mtl").write_text("newmtl a\nKd 1 0 0\nnewmtl b\nKd 0 0 1\n")
+    (tmp_path / "two.obj").write_text("mtllib two.mtl\no Strip\nv -0.87 -1.03 0\nv 0.13 -1.03 0\nv 1.13 -1.03 0\n"
+                                      "v -0.87 0.97 0\nv 0.13 0.97 0\nv 1.13 0.97 0\n"
+                                      "usemtl a\nf 1 2 5 4\nusemtl b\nf 2 3 6 5\n")  # off the noise lattice
+    texture = {"provider": "sampler.Texture", "textures": ["CLOUDS"]}
+    _inputs(tmp_path)
+    context = run_config_text(tmp_path, _v1_config(tmp_path, texture, {"subdiv_level": 2, "strength": 2.0},
+                                                   tmp_path / "two.obj"))
+    parts = [obj for obj in context.scene.objects if obj.name == "Strip"]
+    assert len(parts) == 2
+    seams = [p.vertices[np.abs(p.vertices[:, 0] - 0.13) < 1e-9] for p in parts]  # x = 0.13: the shared edge
+    assert len(seams[0]) == len(seams[1]) == 5  # the edge's 2^2 + 1 vertices in each part
+    first, second = (np.unique(s.round(12), axis=0) for s in seams)
+    np.testing.assert_array_equal(first, second)
+    assert np.ptp(first[:, 1]) > 0.05  # the seam moved (along file +z: hybridgen's -y)
+
+
+def test_config_errors_are_one_line(tmp_path: Path) -> None:
+    from hybridgen.errors import ConfigError, InputError
+
+    with pytest.raises(ConfigError, match="no procedural texture 'BRICKS'"):
+        run_config_text(tmp_path, _v1_config(tmp_path, {"provider": "sampler.Texture", "textures": ["BRICKS"]}, {}))
+    with pytest.raises((ConfigError, InputError), match="cf_add_displace_modifier_with_texture|displace.texture"):
+        run_config_text(tmp_path, _v1_config(tmp_path, 7, {}))
