@@ -9,7 +9,8 @@ import numpy as np
 from .dust import Dust
 
 TEXTURE_SLOTS = ("base_color_texture", "roughness_texture", "metallic_texture", "alpha_texture",
-                 "normal_texture", "displacement_texture", "specular_texture", "emission_texture")
+                 "normal_texture", "displacement_texture", "specular_texture", "emission_texture",
+                 "coat_normal_texture")
 """The material's image inputs, all sampled with the mesh UVs."""
 ALPHA_MODES = ("BLEND", "CLIP")
 
@@ -34,6 +35,10 @@ class Material:
     - ``normal_texture``: tangent-space normal map, RGB = (x, y, z) * 0.5 + 0.5 with x along the mesh's +u
       and y along +v (OpenGL convention, ambientCG's ``_NormalGL``); ``normal_y_down`` reads DirectX maps
       (green along -v, ambientCG's ``_NormalDX`` and cc0textures' older ``_Normal``) by inverting green.
+    - ``coat_normal_texture``: the coat's own tangent-space normal map (Blender's Coat Normal input with a Normal
+      Map node linked), same conventions as ``normal_texture`` (``normal_y_down`` reads both). Blender 4.2's coat
+      bends only with it: with it unset the coat uses the surface's shading normal, not ``normal_texture``'s
+      (docs/principled_bsdf.md). Used only where ``extra["coat_weight"]`` > 0 (hybridgen's Principled BSDF).
     - ``displacement_texture``: height h in 0..1; the surface is displaced by (h - 0.5) x
       ``displacement_scale`` metres along its normal. Rendered as a bump (shading normals only, the geometry
       and so the labels stay undisplaced) - what Blender's default material displacement method "Bump
@@ -81,6 +86,7 @@ class Material:
     displacement_scale: float = 0.15  # metres per unit of height (Blender's Displacement node default in BlenderProc)
     specular_texture: Any = None
     emission_texture: Any = None  # path or HxWx{3,4} uint8 array, sRGB encoded, like base_color_texture
+    coat_normal_texture: Any = None  # tangent-space normal map of the coat (Coat Normal), as normal_texture
     emission_hidden_from_camera: bool = False
     missing_files: tuple[str, ...] = ()  # base-color files the mesh names that do not exist (texture_needs)
     extra: dict[str, Any] = field(default_factory=dict)

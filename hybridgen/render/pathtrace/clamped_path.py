@@ -105,6 +105,8 @@ def register(variant: str) -> None:
             self.caustics_refractive = bool(props.get("caustics_refractive", True))
             # hybridgen/render/pathtrace/camera_hidden_emission.py: emitters the camera sees as their BSDF (set after load)
             self.hidden_shapes: list[Any] = []
+            # hybridgen/render/pathtrace/layered_emission.py: emitters under a coat or sheen (set after load)
+            self.layered_emitters: list[Any] = []
             # hybridgen/render/pathtrace/world_guide.py: light samples of an enclosed constant world (set per keypoint)
             self.world_guide: Any = None  # world_guide.JitGuide
             # whether any material of the scene may_be_singular (set after load): False skips the per-lane test

@@ -17,7 +17,8 @@ from ...errors import InputError
 from ...scene.camera import Intrinsics
 from ...scene.depth_of_field import DepthOfField
 from ...scene.scene import Scene
-from . import camera_hidden_emission, clamped_path, pinhole_sensor, thin_lens_sensor, transparent_shadows
+from . import (camera_hidden_emission, clamped_path, layered_emission, pinhole_sensor, thin_lens_sensor,
+               transparent_shadows)
 from .adaptive_sampling import SamplingPlan, render_adaptive
 from .mitsuba_scene import scene_dict
 from .mitsuba_variant import activate, choose_variant, is_jit
@@ -133,6 +134,7 @@ class PathTraceView:
             integrator.singular_surfaces = any(clamped_path.may_be_singular(obj.material) for obj in scene.objects)
             if hidden:
                 integrator.hidden_shapes = camera_hidden_emission.hidden_shapes(description, hidden)
+            integrator.layered_emitters = layered_emission.emitters(scene, description)
         elif hidden:
             from ...config.notices import notice
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
-from . import glossy_filter, transparent_shadows, world_guide
+from . import glossy_filter, layered_emission, transparent_shadows, world_guide
 from .lobe_tests import is_singular, refracts, transmission
 
 
@@ -43,6 +43,8 @@ def path_vertex(active: Any, bsdf_ctx: Any, bsdf_delta_prev: Any, bsdf_pdf_prev:
                            world_guide.pdf(guide, si_prev.p, ray.d, active), em_pdf)
     mis_bsdf = dr.select(depth == 0, 1.0, mis_weight(bsdf_pdf_prev, em_pdf))
     emitted = throughput * mis_bsdf * ds.emitter.eval(si, active)
+    if self.layered_emitters:  # emission under a coat or sheen: what they leave towards this view
+        emitted *= layered_emission.weight(self.layered_emitters, si, active)
     if has_hidden:  # camera rays see such an emitter's BSDF only, other rays its emission only
         hidden = self._camera_hidden(si)
         emitted = dr.select(hidden & (depth == 0), 0.0, emitted)
@@ -71,6 +73,8 @@ def path_vertex(active: Any, bsdf_ctx: Any, bsdf_delta_prev: Any, bsdf_pdf_prev:
     else:
         blocked = scene.ray_test(si.spawn_ray_to(ds_em.p), needs_shadow_ray)
         em_weight = dr.select(blocked, 0.0, em_weight)
+    if self.layered_emitters:
+        em_weight *= layered_emission.light_weight(self.layered_emitters, scene, si, ds_em, needs_shadow_ray)
     mis_em = dr.select(ds_em.delta, 1.0, mis_weight(ds_em.pdf, bsdf_pdf))
     lit = dr.select(active_em, throughput * bsdf_val * em_weight * mis_em, 0.0)
     radiance += self._clamped(lit, depth >= 1)

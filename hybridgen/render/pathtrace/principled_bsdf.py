@@ -68,6 +68,13 @@ def register(variant: str) -> None:
         value = props.get(name, 1.0)
         return mi.ScalarColor3f(value) if not isinstance(value, (int, float)) else mi.ScalarColor3f(float(value))
 
+    def texture(props: Any, name: str) -> Any:
+        """The texture ``name`` (a constant RGB given as a color made one), or None."""
+        value = props.get(name, None)
+        if value is None or isinstance(value, mi.Texture):
+            return value
+        return mi.load_dict({"type": "rgb", "value": list(mi.ScalarColor3f(value))})
+
     class PrincipledBSDF(mi.BSDF):  # type: ignore[misc, name-defined]
         def __init__(self, props: Any) -> None:
             super().__init__(props)
@@ -90,6 +97,10 @@ def register(variant: str) -> None:
             self.sheen_rough = min(max(float(props.get("sheen_roughness", 0.5)), 0.0), 1.0)
             self.sheen_tint = color(props, "sheen_tint")
             self.subsurface = min(max(float(props.get("subsurface_weight", 0.0)), 0.0), 1.0)
+            # tangent-space normal maps of the Normal and Coat Normal inputs (principled_frames.py): given for a
+            # coated material, whose coat then bends only with its own map
+            self.normal_map, self.coat_normal_map = (texture(props, name) for name in ("normal_map", "coat_normal_map"))
+            self.layer_frames = self.normal_map is not None or self.coat_normal_map is not None
             components = [flags.DiffuseReflection | both, flags.GlossyReflection | both]
             if self.transmission > 0:
                 components.append(flags.GlossyTransmission | flags.NonSymmetric | both)
@@ -111,10 +122,11 @@ def register(variant: str) -> None:
                 sheen_tint=mi.Color3f(self.sheen_tint), subsurface=mi.Float(self.subsurface),
                 has_sheen=self.sheen > 0, has_subsurface=self.subsurface > 0)
 
-        def _frame(self, si: Any, active: Any) -> Any:
+        def _frame(self, si: Any, active: Any, base: Any = None) -> Any:
             """Rotation of local directions into the anisotropy frame: Blender's default tangent (radial about
             the object's Z axis, the mesh attribute :data:`~.principled_tangent.ATTRIBUTE`; Mitsuba's shading
-            tangent where a mesh has none) turned by the rotation."""
+            tangent where a mesh has none) turned by the rotation; ``base``: the base layer's frame in
+            shading-frame coordinates (a normal map's; None: the shading frame)."""
             angle = 2.0 * dr.pi * self.rotation
             c, s = mi.Float(dr.cos(angle)), mi.Float(dr.sin(angle))
             if self.aspect >= 1.0:
@@ -123,6 +135,8 @@ def register(variant: str) -> None:
 
             radial = si.shape.eval_attribute_3(ATTRIBUTE, si, active)
             tangent = si.sh_frame.to_local(mi.Vector3f(radial[0], radial[1], radial[2]))
+            if base is not None:
+                tangent = base.to_local(tangent)
             length2 = tangent.x * tangent.x + tangent.y * tangent.y
             found = length2 > 1e-20
             inv = dr.rsqrt(dr.maximum(length2, 1e-20))
@@ -144,7 +158,17 @@ def register(variant: str) -> None:
             inp = self._inputs(si, active)
             return inp, layers_mod.layers(inp, wi, flip), wi, flip, rot
 
+        def _layered(self, si: Any, active: Any) -> Any:
+            """The inputs, per-layer frames and layer weights where the coat's normal differs from the base's."""
+            from .principled_layered import setup
+
+            return setup(self, si, active)
+
         def eval_pdf(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> tuple[Any, Any]:
+            if self.layer_frames:
+                from .principled_layered import eval_pdf
+
+                return eval_pdf(self._layered(si, active), wo, active)
             inp, lay, wi, flip, rot = self._setup(si, active)
             value, pdf = layers_mod.eval_pdf(lay, wi, self._local(wo, flip, rot), inp.has_coat,
                                              inp.has_transmission, inp.has_sheen)
@@ -158,46 +182,37 @@ def register(variant: str) -> None:
             return self.eval_pdf(ctx, si, wo, active)[1]
 
         def sample(self, ctx: Any, si: Any, sample1: Any, sample2: Any, active: Any = True) -> tuple[Any, Any]:
-            from . import principled_lobes as lobes
+            from . import principled_sampling as sampling
 
+            if self.layer_frames:
+                from .principled_layered import sample
+
+                return sample(self._layered(si, active), sample1, sample2, active)
             inp, lay, wi, flip, rot = self._setup(si, active)
-            s = lay.shares
-            c_coat, c_metal = s[0], s[0] + s[1]
-            c_glass, c_spec = c_metal + s[2], c_metal + s[2] + s[3]
-            pick_coat, pick_glass, pick_diffuse = sample1 < c_coat, (sample1 >= c_metal) & (sample1 < c_glass), \
-                sample1 >= c_spec
-            alpha_x = dr.select(pick_coat, lay.alpha_coat, dr.select(pick_glass, lay.alpha_glass, lay.ax))
-            alpha_y = dr.select(pick_coat, lay.alpha_coat, dr.select(pick_glass, lay.alpha_glass, lay.ay))
-            h = lobes.sample_visible_normal(wi, alpha_x, alpha_y, sample2)
-            cos_hi = dr.dot(h, wi)
-            wo = 2.0 * cos_hi * h - wi
-            refract = mi.Bool(False)
-            if inp.has_transmission:
-                p_reflect, _, _ = layers_mod.glass_reflect_probability(lay, cos_hi)
-                u = (sample1 - c_metal) / dr.maximum(s[2], 1e-20)
-                _, cos_t = lobes.fresnel_dielectric(cos_hi, lay.eta_glass)
-                refract = pick_glass & (u >= p_reflect) & (cos_t > 0.0)
-                wo = dr.select(refract, lobes.refract(wi, h, cos_t, lay.eta_glass), wo)
-            wo = dr.select(pick_diffuse, mi.warp.square_to_cosine_hemisphere(sample2), wo)
-            if inp.has_sheen:  # the last share: sheen is sampled as a diffuse lobe (Cycles' label)
+            choice = sampling.choose(lay, sample1, inp.has_sheen)
+            alpha_x = dr.select(choice.pick_coat, lay.alpha_coat, dr.select(choice.pick_glass, lay.alpha_glass, lay.ax))
+            alpha_y = dr.select(choice.pick_coat, lay.alpha_coat, dr.select(choice.pick_glass, lay.alpha_glass, lay.ay))
+            wo, refract = sampling.draw(lay, wi, choice, sample2, alpha_x, alpha_y, inp.has_transmission)
+            if inp.has_sheen:
                 from . import principled_sheen as sheen
 
-                pick_sheen = sample1 >= c_spec + s[4]
-                wo = dr.select(pick_sheen, sheen.sample_sheen(lay.sheen_a, lay.sheen_b, lay.sheen_frame, sample2),
-                               wo)
+                wo = dr.select(choice.pick_sheen,
+                               sheen.sample_sheen(lay.sheen_a, lay.sheen_b, lay.sheen_frame, sample2), wo)
             value, pdf = layers_mod.eval_pdf(lay, wi, wo, inp.has_coat, inp.has_transmission, inp.has_sheen)
             ok = active & (wi.z > 0.0) & (pdf > 0.0) & dr.select(refract, wo.z < 0.0, wo.z > 0.0)
-            bs = dr.zeros(mi.BSDFSample3f)
-            bs.wo = self._world_local(wo, flip, rot)
-            bs.pdf = dr.select(ok, pdf, 0.0)
-            bs.eta = dr.select(refract, lay.eta_glass, 1.0)
-            bs.sampled_type = dr.select(pick_diffuse, mi.UInt32(+flags.DiffuseReflection),
-                                        dr.select(refract, mi.UInt32(+flags.GlossyTransmission),
-                                                  mi.UInt32(+flags.GlossyReflection)))
-            bs.sampled_component = dr.select(pick_diffuse, mi.UInt32(0), dr.select(refract, mi.UInt32(2),
-                                                                                   mi.UInt32(1)))
+            bs = sampling.sample_record(self._world_local(wo, flip, rot), pdf, ok, refract, choice, lay)
             weight = mi.Spectrum(value) / dr.maximum(pdf, 1e-20)
             return bs, dr.select(ok, weight, 0.0)
+
+        def emission_weight(self, si: Any, active: Any = True) -> Any:
+            """What the sheen and coat leave of this material's emission seen from ``si.wi`` (a color; Cycles
+            layers the emission under them)."""
+            if self.layer_frames:
+                from .principled_layered import emission_weight
+
+                return emission_weight(self, si, active)
+            wi = mi.Vector3f(si.wi.x, si.wi.y, dr.abs(si.wi.z))
+            return layers_mod.emission_weight(self._inputs(si, active), wi, wi)
 
         def eval_diffuse_reflectance(self, si: Any, active: Any = True) -> Any:
             return self.base_color.eval(si, active)

@@ -117,33 +117,60 @@ def _reflective_layer(rough: Any, mu: Any, eta: Any, f0: Any) -> tuple[Any, Any]
     return factor, factor * e * estimate
 
 
-def layers(inp: Inputs, wi: Any, backfacing: Any) -> Layers:
-    """The layer weights for the local view direction ``wi`` (cosine to the (flipped) normal: its z > 0)."""
-    white = mi.Color3f(1.0)
-    weight = white
+def _sheen_layer(inp: Inputs, mu: Any) -> tuple[Any, Any, Any, Any]:
+    """(LTC a, b, the sheen lobe's albedo (color), the weight it leaves below: 1 - its largest channel) for the
+    view cosine ``mu`` to the sheen's normal."""
+    a, b, albedo = tables.sheen_ltc(inp.sheen_rough, mu)
+    sheen_w = inp.sheen * inp.sheen_tint * albedo
+    return a, b, sheen_w, dr.clip(1.0 - _max(sheen_w), 0.0, 1.0)
+
+
+def _coat_layer(inp: Inputs, mu: Any, weight: Any) -> tuple[Any, Any, Any, Any]:
+    """(GGX alpha, lobe weight, sampling share, the weight left below) of the coat for the view cosine ``mu`` to
+    the coat's normal, under ``weight`` (what the sheen left)."""
+    alpha_coat = dr.maximum(dr.square(inp.coat_rough), lobes.MIN_ALPHA)
+    coat_f0 = mi.Color3f(lobes.f0_from_ior(inp.coat_ior))
+    factor, albedo = _reflective_layer(inp.coat_rough, mu, inp.coat_ior, coat_f0)
+    coat_w = inp.coat * factor
+    share_coat = inp.coat * _average(albedo)
+    if inp.has_sheen:  # under the sheen (a gray weight: the sheen takes its albedo's largest channel)
+        coat_w, share_coat = coat_w * weight, share_coat * _average(weight)
+    weight = weight * dr.clip(1.0 - inp.coat * _max(albedo), 0.0, 1.0)
+    if inp.has_coat_tint:
+        cos_t = dr.safe_sqrt(1.0 - (1.0 - mu * mu) / dr.square(inp.coat_ior))
+        absorbed = dr.power(inp.coat_tint, dr.rcp(dr.maximum(cos_t, 1e-4)))
+        weight = weight * dr.lerp(mi.Color3f(1.0), absorbed, inp.coat)
+    return alpha_coat, coat_w, share_coat, weight
+
+
+def emission_weight(inp: Inputs, wi_sheen: Any, wi_coat: Any) -> Any:
+    """What the sheen and coat leave of the emission (a color; Cycles' ``emission_setup`` under the layer weight
+    after sheen and coat) for the local view directions ``wi_sheen`` / ``wi_coat`` in those layers' frames."""
+    weight = mi.Color3f(1.0)
+    if inp.has_sheen:
+        weight = weight * _sheen_layer(inp, dr.maximum(wi_sheen.z, 1e-6))[3]
+    if inp.has_coat:
+        weight = _coat_layer(inp, dr.maximum(wi_coat.z, 1e-6), weight)[3]
+    return weight
+
+
+def layers(inp: Inputs, wi: Any, backfacing: Any, wi_coat: Any = None, wi_sheen: Any = None) -> Layers:
+    """The layer weights for the local view direction ``wi`` (cosine to the (flipped) normal: its z > 0);
+    ``wi_coat`` / ``wi_sheen``: the view in the coat's / sheen's own frame where their normals differ from the
+    base's (:mod:`.principled_frames`), else ``wi``."""
+    weight = mi.Color3f(1.0)
     mu = dr.maximum(wi.z, 1e-6)
     sheen_w, sheen_ab, share_sheen = None, (None, None), mi.Float(0.0)
     if inp.has_sheen:
-        a, b, albedo = tables.sheen_ltc(inp.sheen_rough, mu)
-        sheen_w = inp.sheen * inp.sheen_tint * albedo
+        a, b, sheen_w, leave = _sheen_layer(inp, mu if wi_sheen is None else dr.maximum(wi_sheen.z, 1e-6))
+        weight = weight * leave
         sheen_ab, share_sheen = (a, b), _average(sheen_w)
-        weight = weight * dr.clip(1.0 - _max(sheen_w), 0.0, 1.0)
     alpha = dr.maximum(dr.square(inp.rough), lobes.MIN_ALPHA)
     ax, ay = dr.minimum(alpha / inp.aspect, 1.0), alpha * inp.aspect
     coat_w, alpha_coat, share_coat = mi.Color3f(0.0), mi.Float(lobes.MIN_ALPHA), mi.Float(0.0)
     if inp.has_coat:
-        alpha_coat = dr.maximum(dr.square(inp.coat_rough), lobes.MIN_ALPHA)
-        coat_f0 = mi.Color3f(lobes.f0_from_ior(inp.coat_ior))
-        factor, albedo = _reflective_layer(inp.coat_rough, mu, inp.coat_ior, coat_f0)
-        coat_w = inp.coat * factor
-        share_coat = inp.coat * _average(albedo)
-        if inp.has_sheen:  # under the sheen (a gray weight: the sheen takes its albedo's largest channel)
-            coat_w, share_coat = coat_w * weight, share_coat * _average(weight)
-        weight = weight * dr.clip(1.0 - inp.coat * _max(albedo), 0.0, 1.0)
-        if inp.has_coat_tint:
-            cos_t = dr.safe_sqrt(1.0 - (1.0 - mu * mu) / dr.square(inp.coat_ior))
-            absorbed = dr.power(inp.coat_tint, dr.rcp(dr.maximum(cos_t, 1e-4)))
-            weight = weight * dr.lerp(white, absorbed, inp.coat)
+        alpha_coat, coat_w, share_coat, weight = _coat_layer(
+            inp, mu if wi_coat is None else dr.maximum(wi_coat.z, 1e-6), weight)
     f0_metal = dr.clip(inp.base, 0.0, 1.0)
     b_metal = lobes.f82_b(f0_metal, dr.minimum(inp.spec_tint, 1.0))
     e, e_avg = tables.ggx_energy(inp.rough, mu)
@@ -187,7 +214,8 @@ def layers(inp: Inputs, wi: Any, backfacing: Any) -> Layers:
                   metal_w=metal_w, f0_metal=f0_metal, b_metal=b_metal, glass_w=glass_w, eta_glass=eta_glass,
                   f0_glass=f0_glass, tint_glass=tint_glass, spec_w=spec_w, eta_spec=eta_spec, f0_spec=f0_spec,
                   diffuse_w=diffuse_w, shares=[f * norm for f in floored], sheen_w=sheen_w, sheen_a=sheen_ab[0],
-                  sheen_b=sheen_ab[1], sheen_frame=sheen.sheen_frame(wi) if inp.has_sheen else None)
+                  sheen_b=sheen_ab[1],
+                  sheen_frame=sheen.sheen_frame(wi if wi_sheen is None else wi_sheen) if inp.has_sheen else None)
 
 
 def glass_reflect_probability(lay: Layers, cos_hi: Any) -> tuple[Any, Any, Any]:
@@ -198,8 +226,13 @@ def glass_reflect_probability(lay: Layers, cos_hi: Any) -> tuple[Any, Any, Any]:
 
 
 def eval_pdf(lay: Layers, wi: Any, wo: Any, has_coat: bool, has_transmission: bool,
-             has_sheen: bool = False) -> tuple[Any, Any]:
-    """(BSDF x |cos(wo)| as RGB, pdf of :meth:`PrincipledBSDF.sample`) for local ``wi`` (upper) and ``wo``."""
+             has_sheen: bool = False, coat: tuple[Any, Any, Any] | None = None,
+             sheen_dirs: tuple[Any, Any, Any] | None = None, base_ok: Any = None) -> tuple[Any, Any]:
+    """(BSDF x |cos(wo)| as RGB, pdf of :meth:`PrincipledBSDF.sample`) for local ``wi`` (upper) and ``wo``.
+
+    ``coat`` / ``sheen_dirs``: (wi, wo, ok) in the coat's / sheen's own frame where it differs from the base's
+    (:mod:`.principled_frames`; ``ok``: the layer's value counts there), ``base_ok`` likewise for the base lobes;
+    the pdf is the mixture's whatever the masks."""
     refl, refl_pdf, cos_hi = lobes.reflection(wi, wo, lay.ax, lay.ay)
     value = lay.spec_w * lobes.fresnel_remapped(cos_hi, lay.eta_spec, lay.f0_spec) * refl
     value += lay.metal_w * lobes.fresnel_f82(cos_hi, lay.f0_metal, lay.b_metal) * refl
@@ -207,19 +240,29 @@ def eval_pdf(lay: Layers, wi: Any, wo: Any, has_coat: bool, has_transmission: bo
     upper = wo.z > 0.0
     value += dr.select(upper, lay.diffuse_w * wo.z * dr.inv_pi, 0.0)
     pdf += lay.shares[4] * dr.select(upper, wo.z * dr.inv_pi, 0.0)
-    if has_coat:
-        c_refl, c_pdf, c_cos = lobes.reflection(wi, wo, lay.alpha_coat, lay.alpha_coat)
-        value += lay.coat_w * lobes.fresnel_dielectric(c_cos, lay.coat_ior)[0] * c_refl
-        pdf += lay.shares[0] * c_pdf
     if has_transmission:
         g_refl, g_pdf, g_cos = lobes.reflection(wi, wo, lay.alpha_glass, lay.alpha_glass)
         p_reflect, f, _ = glass_reflect_probability(lay, g_cos)
         g_refr, t_pdf, t_cos = lobes.refraction(wi, wo, lay.alpha_glass, lay.eta_glass)
         p_reflect_t, _, t = glass_reflect_probability(lay, t_cos)
-        value += lay.glass_w * (f * g_refl + t * g_refr)
-        pdf += lay.shares[2] * (p_reflect * g_pdf + (1.0 - p_reflect_t) * t_pdf)
+        glass = lay.glass_w * (f * g_refl + t * g_refr)
+        glass_pdf = lay.shares[2] * (p_reflect * g_pdf + (1.0 - p_reflect_t) * t_pdf)
+    if base_ok is not None:
+        value = dr.select(base_ok, value, 0.0)
+        if has_transmission:
+            glass = dr.select(base_ok, glass, 0.0)
+    if has_coat:
+        wi_c, wo_c, ok_c = (wi, wo, None) if coat is None else coat
+        c_refl, c_pdf, c_cos = lobes.reflection(wi_c, wo_c, lay.alpha_coat, lay.alpha_coat)
+        coat_value = lay.coat_w * lobes.fresnel_dielectric(c_cos, lay.coat_ior)[0] * c_refl
+        value += coat_value if ok_c is None else dr.select(ok_c, coat_value, 0.0)
+        pdf += lay.shares[0] * c_pdf
+    if has_transmission:
+        value += glass
+        pdf += glass_pdf
     if has_sheen:
-        lobe = sheen.sheen_lobe(lay.sheen_a, lay.sheen_b, lay.sheen_frame, wo)
-        value += lay.sheen_w * lobe
+        wo_s, ok_s = (wo, None) if sheen_dirs is None else sheen_dirs[1:]
+        lobe = sheen.sheen_lobe(lay.sheen_a, lay.sheen_b, lay.sheen_frame, wo_s)
+        value += lay.sheen_w * lobe if ok_s is None else dr.select(ok_s, lay.sheen_w * lobe, 0.0)
         pdf += lay.shares[5] * lobe
     return value, pdf

@@ -79,3 +79,14 @@ def plugin_dict(material: Material, owner: str, base: dict[str, Any], roughness:
         if name not in RANDOM_WALK_ONLY:
             bsdf[name] = mi.ScalarColor3f(value) if name in COLOR_INPUTS else value
     return bsdf
+
+
+def layer_normals(material: Material) -> bool:
+    """Whether ``material``'s layers need frames of their own: a coat (Coat Weight > 0) and a normal map on the
+    Normal or Coat Normal input (Blender 4.2's coat ignores the Normal input's map; :mod:`.principled_frames`).
+    The plugin then takes the maps as ``normal_map`` / ``coat_normal_map``
+    (:func:`~.mitsuba_materials.bsdf_dict`) instead of sitting in a ``normalmap`` wrapper."""
+    coat = material.extra.get("coat_weight", 0.0)
+    has_coat = isinstance(coat, (int, float)) and coat > 0
+    return has_coat and (material.normal_texture is not None or material.coat_normal_texture is not None)
+

@@ -1,0 +1,104 @@
+"""hybridgen's Principled BSDF with a frame per layer: what :class:`~.principled_bsdf.PrincipledBSDF` evaluates and
+samples when it holds a normal map (``normal_map`` / ``coat_normal_map``, given for coated materials), so that the
+base bends with the Normal input's map, the coat with the Coat Normal input's (unlinked: the shading normal) and
+the sheen with their mix, as Blender 4.2 does (:mod:`.principled_frames`).
+
+Directions ``wo`` are in Mitsuba's shading-frame coordinates (``si.sh_frame``), as the BSDF interface passes them;
+each layer's lobes see them in its own local coordinates. A layer's value counts only where ``wo`` lies on the
+same side of its normal as of the shading normal (Mitsuba's ``normalmap`` test, so an uncoated material's base
+renders as under that wrapper); the pdf is the whole mixture's. Sampling picks a lobe as the single-frame BSDF
+does and draws it in its layer's frame. Dr.Jit values of the active variant.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import drjit as dr
+import mitsuba as mi
+
+from . import principled_layers as layers_mod
+from . import principled_lobes as lobes
+from . import principled_sampling as sampling
+from .principled_frames import LayerFrame, layer_frame, normal_map_frame, reflects_in, sheen_frame
+
+
+@dataclass
+class Layered:
+    """One shading point: inputs, layer weights (None when not asked for), the frames and the view in each."""
+
+    inp: Any
+    lay: Any
+    base: LayerFrame
+    coat: LayerFrame
+    sheen: LayerFrame | None
+    si_wi: Any  # the view, shading-frame coordinates
+    wi: Any  # ... in the base's local coordinates
+    wi_coat: Any
+    wi_sheen: Any
+
+
+def setup(bsdf: Any, si: Any, active: Any, weights: bool = True) -> Layered:
+    """The frames of ``bsdf`` (a :class:`~.principled_bsdf.PrincipledBSDF`) at ``si`` and, with ``weights``, its
+    layer weights for the view ``si.wi``."""
+    base_map = None if bsdf.normal_map is None else normal_map_frame(bsdf.normal_map.eval_3(si, active), si.wi)
+    base = layer_frame(base_map, si.wi, bsdf._frame(si, active, base_map))
+    coat_map = None if bsdf.coat_normal_map is None else normal_map_frame(bsdf.coat_normal_map.eval_3(si, active),
+                                                                          si.wi)
+    coat = layer_frame(coat_map, si.wi)
+    sheen = sheen_frame(base, coat, mi.Float(bsdf.coat)) if bsdf.sheen > 0 else None
+    inp = bsdf._inputs(si, active)
+    wi, wi_coat = base.local(si.wi), coat.local(si.wi)
+    wi_sheen = sheen.local(si.wi) if sheen is not None else wi
+    lay = layers_mod.layers(inp, wi, base.flip, wi_coat=wi_coat, wi_sheen=wi_sheen) if weights else None
+    return Layered(inp, lay, base, coat, sheen, si.wi, wi, wi_coat, wi_sheen)
+
+
+def eval_pdf(state: Layered, wo: Any, active: Any) -> tuple[Any, Any]:
+    """(BSDF x |cos| as a Spectrum, pdf) for ``wo`` in shading-frame coordinates."""
+    inp = state.inp
+    coat = (state.wi_coat, state.coat.local(wo), state.coat.same_side(wo)) if inp.has_coat else None
+    sheen = None
+    if state.sheen is not None:
+        sheen = (state.wi_sheen, state.sheen.local(wo), reflects_in(state.sheen, state.si_wi, wo))
+    base_ok = state.base.same_side(wo) if state.base.frame is not None else None
+    value, pdf = layers_mod.eval_pdf(state.lay, state.wi, state.base.local(wo), inp.has_coat,
+                                     inp.has_transmission, inp.has_sheen, coat=coat, sheen_dirs=sheen,
+                                     base_ok=base_ok)
+    ok = active & (state.wi.z > 0.0)
+    return dr.select(ok, mi.Spectrum(value), 0.0), dr.select(ok, pdf, 0.0)
+
+
+def sample(state: Layered, sample1: Any, sample2: Any, active: Any) -> tuple[Any, Any]:
+    """(BSDFSample3f, weight) as :meth:`~.principled_bsdf.PrincipledBSDF.sample`: the lobe picked by ``sample1``
+    drawn in its layer's frame with ``sample2``."""
+    inp, lay, wi = state.inp, state.lay, state.wi
+    choice = sampling.choose(lay, sample1, inp.has_sheen)
+    alpha_x = dr.select(choice.pick_glass, lay.alpha_glass, lay.ax)
+    alpha_y = dr.select(choice.pick_glass, lay.alpha_glass, lay.ay)
+    wo, refract = sampling.draw(lay, wi, choice, sample2, alpha_x, alpha_y, inp.has_transmission)
+    side = dr.select(refract, wo.z < 0.0, wo.z > 0.0)  # the drawn lobe's hemisphere in its own frame
+    wo = state.base.shading(wo)
+    if inp.has_coat:
+        wi_c = state.wi_coat
+        h_c = lobes.sample_visible_normal(wi_c, lay.alpha_coat, lay.alpha_coat, sample2)
+        wo_c = 2.0 * dr.dot(h_c, wi_c) * h_c - wi_c
+        wo = dr.select(choice.pick_coat, state.coat.shading(wo_c), wo)
+        side = dr.select(choice.pick_coat, wo_c.z > 0.0, side)
+    if inp.has_sheen:
+        from . import principled_sheen as sheen
+
+        assert state.sheen is not None
+        wo_s = sheen.sample_sheen(lay.sheen_a, lay.sheen_b, lay.sheen_frame, sample2)
+        wo = dr.select(choice.pick_sheen, state.sheen.shading(wo_s), wo)
+        side = dr.select(choice.pick_sheen, wo_s.z > 0.0, side)
+    value, pdf = eval_pdf(state, wo, active)
+    ok = active & (wi.z > 0.0) & (pdf > 0.0) & side
+    bs = sampling.sample_record(wo, pdf, ok, refract, choice, lay)
+    return bs, dr.select(ok, value / dr.maximum(pdf, 1e-20), 0.0)
+
+
+def emission_weight(bsdf: Any, si: Any, active: Any) -> Any:
+    """What the sheen and coat of ``bsdf`` leave of its emission seen from ``si.wi``, in their own frames."""
+    state = setup(bsdf, si, active, weights=False)
+    return layers_mod.emission_weight(state.inp, state.wi_sheen, state.wi_coat)
