@@ -13,6 +13,10 @@ class MemorySink:
     """Collects ``frames[i][key]`` for every keypoint i; ``records`` and ``attributes`` as given by renderers.
     ``wanted``: on-request passes to receive too (e.g. ``amodal_masks``; :mod:`hybridgen.render.passes`)."""
 
+    values_only = True
+    """``write`` keeps the values it is given and reads nothing else (so the keypoint loop may write a keypoint
+    after the scene moved on to the next one: :func:`hybridgen.render.keypoint_loop.run_keypoints`)."""
+
     def __init__(self, wanted: Iterable[str] = ()) -> None:
         self.wanted = tuple(wanted)
         self.frames: list[dict[str, Any]] = []

@@ -32,7 +32,9 @@ class Producer(Protocol):
     keypoints (:mod:`hybridgen.scene.object_keyframes`), and ``use_encodings(accepted)``, told before the first
     keypoint which passes every sink receiving them stores in one encoded form (key -> storage tag, see
     :func:`_accepted_encodings`): it may hand those over as
-    :class:`~hybridgen.io.label_encoding.EncodedArray` of that tag.
+    :class:`~hybridgen.io.label_encoding.EncodedArray` of that tag. ``produce_later(index, cam2world)`` makes the
+    values of ``produce`` but returns a call that gives them, so that the producer's last steps (the color's
+    denoising) run while the loop goes on to the next keypoint (see :func:`run_keypoints`).
     """
 
     def layouts(self) -> list[PassLayout]: ...
@@ -101,9 +103,25 @@ def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Prod
         bar = progress(n, what) if progress else None
         prefetching = [p for p in producers if hasattr(p, "prefetch")]
         keypoints = scene.camera.keypoints
+        # one keypoint in flight: its producers' last steps finish while the next one is produced, and it is
+        # written after that - unless the objects move between keypoints and a sink may read them when written
+        later = [] if varies and not all(getattr(sink, "values_only", False) for sink in sinks) else \
+            [p for p in producers if hasattr(p, "produce_later")]
+
+        def write(local: int, parts: list[Any]) -> None:
+            values: dict[str, Any] = {}
+            for part in parts:  # in the producers' order
+                values.update(part() if callable(part) else part)
+            for sink, route in zip(sinks, routes):
+                sink.write(local, values if len(route) == len(keys) else
+                           {k: v for k, v in values.items() if k in route})
+            if bar is not None:
+                bar.update(1)
+
         if chosen:
             for producer in prefetching:
                 producer.prefetch(chosen[0], keypoints[chosen[0]])  # type: ignore[attr-defined]
+        pending: tuple[int, list[Any]] | None = None
         for local, index in enumerate(chosen):
             stop_request.raise_if_requested()  # a SIGTERM whose SystemExit a finalizer swallowed
             pose_objects(index)
@@ -113,14 +131,16 @@ def run_keypoints(scene: Scene, sinks: Iterable[FrameSink], producers: list[Prod
             if ahead is not None:  # the next keypoint draws while this one is read back and processed
                 for producer in prefetching:
                     producer.prefetch(ahead, keypoints[ahead])  # type: ignore[attr-defined]
-            values: dict[str, Any] = {}
-            for producer in producers:
-                values.update(producer.produce(index, keypoints[index]))
-            for sink, route in zip(sinks, routes):
-                sink.write(local, values if len(route) == len(keys) else
-                           {k: v for k, v in values.items() if k in route})
-            if bar is not None:
-                bar.update(1)
+            parts = [producer.produce_later(index, keypoints[index]) if producer in later  # type: ignore[attr-defined]
+                     else producer.produce(index, keypoints[index]) for producer in producers]
+            if pending is not None:
+                write(*pending)
+            pending = (local, parts)
+            if not later:  # nothing to finish later: written now, before the objects move on
+                write(*pending)
+                pending = None
+        if pending is not None:
+            write(*pending)
         if bar is not None:
             bar.close()
         stop_request.raise_if_requested()  # never finish (seal) the sinks' output after a stop request

@@ -1,8 +1,9 @@
 """Python API: path-traced color of every keypoint (plus, optionally, the labels) into frame sinks."""
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from functools import partial
-from typing import Any, Iterable, Sequence
+from typing import Any, Callable, Iterable, Sequence
 
 import numpy as np
 
@@ -47,6 +48,7 @@ class ColorProducer:
         self.keep_raw, self.sample_counts = keep_raw and denoise, sample_counts
         self._guides: DenoiseGuides | None = None
         self._worker: GuideWorker | None = None
+        self._denoiser: ThreadPoolExecutor | None = None  # denoising and encoding, one keypoint at a time
         if denoise and raster is None and not denoise_guides.FOLLOW_SPECULAR:
             # guides of their own: drawn on a thread of their own, its GL context made while Mitsuba starts
             self._worker = GuideWorker(scene)
@@ -92,6 +94,13 @@ class ColorProducer:
         return {}
 
     def produce(self, index: int, cam2world: np.ndarray, eye: int = 0) -> dict[str, Any]:
+        return self.produce_later(index, cam2world, eye)()
+
+    def produce_later(self, index: int, cam2world: np.ndarray, eye: int = 0) -> Callable[[], dict[str, Any]]:
+        """Traces keypoint ``index`` now and returns the call that gives its values: with ``denoise`` the
+        denoising and encoding run meanwhile on a thread of their own, so that the keypoint loop can trace the
+        next keypoint while Open Image Denoise works on this one (:func:`hybridgen.render.keypoint_loop.run_keypoints`;
+        the same values as in order)."""
         worker = self._worker  # guides drawn on their own thread while the samples are traced
         drawing = worker.submit(cam2world, self.view.filter_width) if worker is not None else None
         plan = self.settings.plan()
@@ -107,10 +116,23 @@ class ColorProducer:
             values["colors_raw"] = to_srgb8(linear)
         if self.sample_counts:
             values["sample_counts"] = counts
-        if worker is not None and drawing is not None:
+        if drawing is None and guides is None and self._guides is not None:  # drawn here: the GL context's thread
+            guides = self._guides.render(cam2world, self.view)
+        finish = partial(self._finish, values, linear, worker if drawing is not None else None, drawing, guides)
+        if not self.denoise:
+            return finish
+        if self._denoiser is None:
+            self._denoiser = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hybridgen-denoise")
+        return self._denoiser.submit(finish).result
+
+    def _finish(self, values: dict[str, Any], linear: np.ndarray, worker: GuideWorker | None, drawing: Any,
+                guides: tuple[np.ndarray, np.ndarray] | None) -> dict[str, Any]:
+        """``values`` completed with the keypoint's colors: ``linear`` denoised with the guides (drawn, or
+        ``worker``'s ``drawing``) when denoising, then encoded."""
+        if worker is not None:
             linear = oidn_denoise(linear, *worker.result(drawing))
-        elif self._guides is not None:
-            linear = oidn_denoise(linear, *(guides or self._guides.render(cam2world, self.view)))
+        elif guides is not None:
+            linear = oidn_denoise(linear, *guides)
         values["colors"] = to_srgb8(linear)
         if self.hdr:
             values["colors_hdr"] = linear.astype(np.float16)
@@ -122,7 +144,11 @@ class ColorProducer:
         self.view = PathTraceView(self.scene, self.settings, variant=self.view.variant)
 
     def close(self) -> None:
-        """Release the denoising guides' GL resources and thread (the Mitsuba scene goes with this producer)."""
+        """Release the denoising guides' GL resources and thread and the denoising thread (the Mitsuba scene goes
+        with this producer)."""
+        if self._denoiser is not None:
+            denoiser, self._denoiser = self._denoiser, None
+            denoiser.shutdown(wait=True)
         if self._guides is not None:
             self._guides.release()
             self._guides = None

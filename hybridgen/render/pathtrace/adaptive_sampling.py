@@ -110,7 +110,8 @@ class SamplingPlan:
         if self.adaptive and not 2 <= self.min_samples <= self.max_samples:
             raise InputError(f"min_samples must be in 2..samples ({self.max_samples}), got {self.min_samples}")
         if not 0 <= self.edge_min_samples <= self.max_samples:
-            raise InputError(f"edge_min_samples must be in 0..samples ({self.max_samples}), got {self.edge_min_samples}")
+            raise InputError(f"edge_min_samples must be in 0..samples ({self.max_samples}), "
+                             f"got {self.edge_min_samples}")
 
     @property
     def adaptive(self) -> bool:
