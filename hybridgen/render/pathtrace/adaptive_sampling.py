@@ -196,8 +196,9 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
                 a, b = tracer.trace(pixels, spp, seed, first=count[pixels])
             else:
                 a, b = tracer.trace(pixels, spp, round_seed(seed, round_index, chunk))
-            sum_a[pixels] += a
-            sum_b[pixels] += b
-        count[active] += spp
+            rows = slice(start, start + len(pixels)) if len(active) == h * w else pixels  # all: no index lists
+            sum_a[rows] += a
+            sum_b[rows] += b
+        count[active if len(active) < h * w else slice(None)] += spp
     image = (sum_a + sum_b) / np.maximum(count, 1)[:, None]
     return image.reshape(h, w, 3).astype(np.float32), count.reshape(h, w)
