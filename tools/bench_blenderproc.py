@@ -22,7 +22,9 @@ tree that others are editing can be half-way through a change.
 
 ``--profile`` adds one hybridgen run through tools/bproc_launch.py ``--profile`` (not timed against BlenderProc) and
 prints where its time goes: start-up (interpreter and exit: the whole process minus what ran in it), imports,
-scene load, Mitsuba scene build, kernel compilation, sampling, labels, denoising guides, denoising, writing.
+scene load, Mitsuba scene build, kernel compilation, sampling, labels, denoising guides, waiting for the denoiser,
+writing - the render loop's thread, adding up to the whole process - and, beside them, Open Image Denoise on the
+color producer's own thread (it overlaps the next frame's sampling).
 """
 from __future__ import annotations
 
@@ -51,7 +53,8 @@ SEED_ENV = {"BLENDER_PROC_RANDOM_SEED": "1"}
 GOAL = 5.0
 """The issue's goal: hybridgen's whole process at least this many times faster, at equal or better PSNR."""
 STAGES = ("imports", "scene_load", "mitsuba_scene", "kernel_compile", "sampling", "labels", "denoise_guides",
-          "denoise", "write")
+          "denoise_wait", "write")
+"""The stages of the render loop's thread, in order (``denoise`` runs on a thread of its own beside them)."""
 
 
 HYBRIDGEN_TREE: list[Path | None] = [None]
@@ -126,7 +129,8 @@ def print_profile(spent: dict[str, float], markdown: bool) -> None:
     rows = [("start-up and exit (interpreter)", spent["startup_and_exit"])]
     rows += [(stage, spent.get(stage, 0.0)) for stage in STAGES if stage != "sampling"]
     rows.insert(5, ("sampling (kernel compile excluded)", sampling))
-    inside = spent.get("render", 0.0) - sum(spent.get(s, 0.0) for s in STAGES[2:8])
+    # kernel_compile is part of sampling
+    inside = spent.get("render", 0.0) - sum(spent.get(s, 0.0) for s in STAGES[2:8] if s != "kernel_compile")
     rows.append(("render() other (scene conversion, tonemap, segmaps)", inside))
     rows.append(("script's own and other", spent["in_process"] - spent.get("imports", 0.0)
                  - spent.get("scene_load", 0.0) - spent.get("render", 0.0) - spent.get("write", 0.0)))
@@ -135,6 +139,8 @@ def print_profile(spent: dict[str, float], markdown: bool) -> None:
     for name, seconds in rows:
         table.row(name, seconds, seconds / spent["whole_process"])
     table.row("whole process", spent["whole_process"], 1.0)
+    table.row("denoise (own thread, beside the next frame)", spent.get("denoise", 0.0),
+              spent.get("denoise", 0.0) / spent["whole_process"])
 
 
 def main() -> None:

@@ -23,9 +23,10 @@ render, ``{"K": 3x3, "cam2world": [4x4 per frame, Blender camera axes], "objects
 ``--profile PATH`` (hybridgen only) writes a JSON object of wall seconds per stage: ``imports`` (hybridgen and
 its bproc layer), ``scene_load`` (``bproc.loader.*``), ``render`` (``bproc.renderer.render`` as a whole) and, within
 it, ``mitsuba_scene`` (building Mitsuba's scene), ``sampling`` (path tracing, split by Dr.Jit's kernel history into
-``kernel_compile`` and the rest), ``labels`` (raster label passes), ``denoise_guides`` (waiting for the guides),
-``denoise`` (Open Image Denoise), then ``write`` (``bproc.writer.*``) and ``in_process`` (everything after the
-interpreter started, to exit).
+``kernel_compile`` and the rest), ``labels`` (raster label passes), ``denoise_guides`` (drawing or waiting for the
+guides), ``denoise`` (Open Image Denoise: on the color producer's own thread, overlapping the next keypoint's
+sampling), ``denoise_wait`` (the render loop waiting for a keypoint's denoised colors), then ``write``
+(``bproc.writer.*``) and ``in_process`` (everything after the interpreter started, to exit).
 """
 from __future__ import annotations
 
@@ -135,6 +136,12 @@ def instrument_hybridgen(spent: dict[str, float]) -> None:
     DenoiseGuides.render = accumulating(spent, "denoise_guides", DenoiseGuides.render)
     GuideWorker.result = accumulating(spent, "denoise_guides", GuideWorker.result)
     render_color.oidn_denoise = accumulating(spent, "denoise", render_color.oidn_denoise)
+    produce_later = render_color.ColorProducer.produce_later
+
+    def later(*args: Any, **kwargs: Any) -> Any:  # the call that waits for the keypoint's denoised colors
+        return accumulating(spent, "denoise_wait", produce_later(*args, **kwargs))
+
+    render_color.ColorProducer.produce_later = later
     dr.set_flag(dr.JitFlag.KernelHistory, True)
     render = PathTraceView.render_with_counts
 
