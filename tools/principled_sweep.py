@@ -3,7 +3,9 @@ the sphere-grid scenes, the small test views and the per-object masks (analytic 
 
 The scene: rows of :data:`COLUMNS` spheres (0.36 m across) over a grey Lambertian floor, each sphere one material
 of a sweep (:data:`GROUPS`), lit either by a sun (3 W/m^2, 50 degrees above the horizon) under a uniform grey-blue
-sky (``sun``), or by the generated sky HDRI of tools/color_quality.py with its small bright sun (``hdri``).
+sky (``sun``), by the generated sky HDRI of tools/color_quality.py with its small bright sun (``hdri``), or by
+nothing (``dark``: black world, no lights, for emissive spheres). Spheres with a normal map (the ``bumps`` value of
+a texture field) are UV spheres (:func:`uv_sphere`) carrying :func:`bumps`; the others hybridgen's icosphere.
 Units: metres, linear RGB.
 """
 from __future__ import annotations
@@ -74,16 +76,57 @@ SWEEP_SUBSURFACE: list[tuple[str, tuple[float, float, float], dict[str, Any]]] =
     ("ss1_s005_skin", SKIN, dict(roughness=0.5, specular=0.5, extra=dict(subsurface_weight=1.0,
                                                                          subsurface_method="RANDOM_WALK_SKIN"))),
 ]
-GROUPS = {"principled": SWEEP, "layers": SWEEP_LAYERS, "subsurface": SWEEP_SUBSURFACE}
+DARK = (0.03, 0.03, 0.03)
+COAT1 = dict(coat_weight=1.0, coat_roughness=0.25)
+SWEEP_COAT_NORMAL: list[tuple[str, tuple[float, float, float], dict[str, Any]]] = [
+    # UV spheres with the strong procedural normal map :func:`bumps` on Normal and / or Coat Normal (Blender: a Normal
+    # Map node in tangent space on the sphere's UV map linked to the input)
+    ("cn_nocoat_map", (0.6, 0.1, 0.1), dict(roughness=0.3, specular=0.5, normal_texture="bumps")),
+    ("cn_base_map", DARK, dict(roughness=0.4, specular=0.5, normal_texture="bumps", extra=COAT1)),
+    ("cn_coat_map", DARK, dict(roughness=0.4, specular=0.5, coat_normal_texture="bumps", extra=COAT1)),
+    ("cn_both_maps", DARK, dict(roughness=0.4, specular=0.5, normal_texture="bumps", coat_normal_texture="bumps",
+                                extra=COAT1)),
+    ("cn_red_base_map", (0.8, 0.1, 0.1), dict(roughness=0.5, specular=0.5, normal_texture="bumps", extra=dict(
+        coat_weight=1.0, coat_roughness=0.3))),
+    ("cn_sheen_coat_map", (0.3, 0.2, 0.1), dict(roughness=0.5, specular=0.5, normal_texture="bumps", extra=dict(
+        coat_weight=0.5, coat_roughness=0.3, sheen_weight=1.0, sheen_roughness=0.4))),
+]
+EMISSIVE = dict(roughness=0.4, specular=0.5, emission=(1.0, 0.6, 0.3), emission_strength=2.0)
+SWEEP_EMISSION: list[tuple[str, tuple[float, float, float], dict[str, Any]]] = [
+    # emissive spheres (Principled Emission (1, 0.6, 0.3) x 2) under coat and sheen; seen under the ``dark`` lighting
+    ("em_c0", (0.2, 0.2, 0.2), dict(EMISSIVE)),
+    ("em_c05", (0.2, 0.2, 0.2), dict(EMISSIVE, extra=dict(coat_weight=0.5))),
+    ("em_c1", (0.2, 0.2, 0.2), dict(EMISSIVE, extra=dict(coat_weight=1.0))),
+    ("em_c1_tint", (0.2, 0.2, 0.2), dict(EMISSIVE, extra=dict(coat_weight=1.0, coat_tint=(1.0, 0.7, 0.4)))),
+    ("em_c1_r05_ior2", (0.2, 0.2, 0.2), dict(EMISSIVE, extra=dict(coat_weight=1.0, coat_roughness=0.5,
+                                                                  coat_ior=2.0))),
+    ("em_sheen1", (0.2, 0.2, 0.2), dict(EMISSIVE, extra=dict(sheen_weight=1.0, sheen_roughness=0.3))),
+    ("em_sheen_coat", (0.2, 0.2, 0.2), dict(EMISSIVE, extra=dict(sheen_weight=1.0, sheen_roughness=0.3,
+                                                                 coat_weight=1.0, coat_tint=(0.8, 0.9, 1.0)))),
+]
+GROUPS = {"principled": SWEEP, "layers": SWEEP_LAYERS, "subsurface": SWEEP_SUBSURFACE,
+          "coat_normal": SWEEP_COAT_NORMAL, "emission": SWEEP_EMISSION}
 """The sweeps, each rendered as a scene of its own (``--group``): the first sweep of issue 32, the sheen /
-subsurface one (both stored for the tests), and subsurface weights x radius scales (measured for the docs)."""
+subsurface one (both stored for the tests), subsurface weights x radius scales (measured for the docs), the coat
+normal rule (a normal map on Normal and / or Coat Normal of coated spheres) and emission under coat and sheen."""
+GROUP_LIGHTINGS = {"emission": ("dark",)}
+"""Lightings a group is rendered under when not the default :data:`LIGHTINGS` (``dark``: black world, no lights:
+only the spheres' own emission)."""
 COLUMNS, SPACING, DIAMETER = 6, 0.46, 0.36
 LIGHTINGS = ("sun", "hdri")
+ALL_LIGHTINGS = ("sun", "hdri", "dark")
 
 
 TEST_OBJECTS = ("red_s1_r03", "white_s05_r05", "grey_m1_r06", "copper_m1_r1")
 """The spheres of the small test view (``--store``; tests/render/test_principled_vs_cycles.py): objects whose
 color Mitsuba's principled got 7-55 % wrong."""
+
+
+TEST_COAT_NORMAL_OBJECTS = ("cn_base_map", "cn_coat_map", "cn_red_base_map", "cn_sheen_coat_map")
+"""The spheres of the coat-normal test view: the base's map alone, the coat's alone, a red base under a coat, and
+sheen over a half coat (the sheen's mixed normal)."""
+TEST_EMISSION_OBJECTS = ("em_c0", "em_c1", "em_c1_tint", "em_sheen_coat")
+"""The spheres of the emission test view (``dark`` lighting): no layer, a coat, a tinted coat, sheen over coat."""
 
 
 TEST_LAYER_OBJECTS = ("red_sheen1_r05", "velvet_sheen1_r03", "skin_ss1_r0", "aniso_metal")
@@ -122,15 +165,23 @@ def build_scene(lighting: str, width: int, height: int, workdir: Path,
     scene.add(floor)
     entries = sweep(names, group)
     for index, ((name, color, values), center) in enumerate(zip(entries, sphere_centers(len(entries)))):
-        ball = hg.make_primitive("sphere", DIAMETER, name=name, category_id=index + 2, color=color,
-                                 local2world=hg.object_pose(list(center)))
+        mapped = any(value == "bumps" for value in values.values())
+        if mapped:  # a UV sphere for the normal maps
+            ball = uv_sphere(name, DIAMETER)
+            ball.category_id, ball.local2world = index + 2, hg.object_pose(list(center))
+            ball.material.base_color = (*color, 1.0)
+        else:
+            ball = hg.make_primitive("sphere", DIAMETER, name=name, category_id=index + 2, color=color,
+                                     local2world=hg.object_pose(list(center)))
         for key, value in values.items():
             if key == "extra":
                 ball.material.extra = dict(value)
             else:
-                setattr(ball.material, key, value)
+                setattr(ball.material, key, bumps() if value == "bumps" else value)
         scene.add(ball)
-    if lighting == "sun":
+    if lighting == "dark":
+        scene.world.color, scene.world.strength = (0.0, 0.0, 0.0), 0.0
+    elif lighting == "sun":
         scene.world.color, scene.world.strength = (0.3, 0.35, 0.45), 1.0
         scene.add_light(hg.Light("sun", "SUN", energy=3.0,
                                  local2world=hg.object_pose([0, 0, 5], [math.radians(40), 0, math.radians(30)])))
@@ -144,6 +195,38 @@ def build_scene(lighting: str, width: int, height: int, workdir: Path,
     location = [0.0, -2.6, 1.9] if names is None else [0.0, -1.9, 1.1]
     scene.camera.add_keypoint(hg.look_at(location, [0.0, 0.05, 0.1]))
     return scene
+
+
+def uv_sphere(name: str, diameter: float, segments: int = 64, rings: int = 32) -> Any:
+    """A smooth sphere (m, object frame, centred) with a latitude-longitude UV map: u = azimuth / 2 pi from +X
+    towards +Y, v = 1 at the north pole (+Z) and 0 at the south pole; the seam's vertices doubled."""
+    import hybridgen as hg
+
+    theta = np.pi * np.arange(rings + 1) / rings
+    phi = 2.0 * np.pi * np.arange(segments + 1) / segments
+    tt, pp = np.meshgrid(theta, phi, indexing="ij")
+    normals = np.stack([np.sin(tt) * np.cos(pp), np.sin(tt) * np.sin(pp), np.cos(tt)], -1).reshape(-1, 3)
+    uvs = np.stack([pp / (2.0 * np.pi), 1.0 - tt / np.pi], -1).reshape(-1, 2)
+    faces = []
+    for i in range(rings):
+        for j in range(segments):
+            a, b = i * (segments + 1) + j, (i + 1) * (segments + 1) + j
+            if i > 0:
+                faces.append([a, b, a + 1])
+            if i < rings - 1:
+                faces.append([a + 1, b, b + 1])
+    return hg.MeshObject(name, normals * diameter / 2.0, np.array(faces), vertex_normals=normals, uvs=uvs)
+
+
+def bumps(width: int = 512, height: int = 256, strength: float = 0.8) -> np.ndarray:
+    """The sweep's normal map (uint8 H x W x 3, OpenGL tangent space: x along +u, y along +v, rows top-down):
+    an egg-crate of 16 x 8 bumps whose normals tilt up to atan(``strength``) (39 degrees)."""
+    u = (np.arange(width) + 0.5) / width
+    v = 1.0 - (np.arange(height) + 0.5) / height
+    a, b = np.meshgrid(2.0 * np.pi * 16 * u, 2.0 * np.pi * 8 * v)
+    n = np.stack([-strength * np.cos(a) * np.sin(b), -strength * np.sin(a) * np.cos(b), np.ones_like(a)], -1)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    return np.round((n * 0.5 + 0.5) * 255.0).astype(np.uint8)
 
 
 def object_masks(scene: Any, names: tuple[str, ...] | None = None, margin: float = 0.8,

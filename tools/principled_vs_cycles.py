@@ -39,13 +39,21 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tools"))
-from principled_sweep import (GROUPS, LIGHTINGS, TEST_LAYER_OBJECTS, TEST_OBJECTS,  # noqa: E402,F401
-                              build_scene, object_masks, object_means)
+from principled_sweep import (GROUP_LIGHTINGS, GROUPS, LIGHTINGS, TEST_COAT_NORMAL_OBJECTS,  # noqa: E402,F401
+                              TEST_EMISSION_OBJECTS, TEST_LAYER_OBJECTS, TEST_OBJECTS, build_scene, object_masks,
+                              object_means)
 
 LAYER_INPUTS = ("sheen_", "subsurface_")
 """Prefixes of the ``extra`` inputs the ``layers`` sweep's "before" drops."""
-TEST_VIEWS = {"principled": ("test_view", TEST_OBJECTS), "layers": ("test_view_layers", TEST_LAYER_OBJECTS)}
+TEST_VIEWS = {"principled": ("test_view", TEST_OBJECTS), "layers": ("test_view_layers", TEST_LAYER_OBJECTS),
+              "coat_normal": ("test_view_coat_normal", TEST_COAT_NORMAL_OBJECTS),
+              "emission": ("test_view_emission", TEST_EMISSION_OBJECTS)}
 """Per sweep group: the stored table's key of its small test view and the view's spheres."""
+BEFORE = {"principled": "mitsuba", "layers": "before", "coat_normal": "flat_coat", "emission": "unlayered_emission",
+          "subsurface": "before"}
+"""Per group, the model its "before" column renders: Mitsuba's ``principled``; hybridgen's BSDF without the sheen
+and subsurface inputs; the coat bent by the base's normal map (the ``normalmap`` wrapper around the whole BSDF,
+the coat normal map ignored); emission not weighted by the coat and sheen above it."""
 
 
 def hybridgen_settings(bounces: int) -> Any:
@@ -60,13 +68,17 @@ def hybridgen_settings(bounces: int) -> Any:
 def render_hybridgen(scene: Any, model: str, spp: int, bounces: int, seed: int = 0) -> tuple[np.ndarray, float]:
     """(linear RGB H x W x 3, seconds of rendering) with principled materials as ``model`` ("mitsuba" or
     "blender", :data:`hybridgen.render.pathtrace.principled_material.ENV_VARIABLE`; "before": "blender" without
-    the :data:`LAYER_INPUTS`)."""
+    the :data:`LAYER_INPUTS`; "flat_coat" / "unlayered_emission": see :data:`BEFORE`)."""
     import time
 
+    from hybridgen.render.pathtrace import principled_material
     from hybridgen.render.pathtrace.path_trace import PathTraceView
     from hybridgen.render.pathtrace.principled_material import ENV_VARIABLE
 
-    os.environ[ENV_VARIABLE] = "blender" if model == "before" else model
+    os.environ[ENV_VARIABLE] = "mitsuba" if model == "mitsuba" else "blender"
+    layer_normals = principled_material.layer_normals
+    if model == "flat_coat":
+        principled_material.layer_normals = lambda material: False
     extras = {obj.name: obj.material.extra for obj in scene.objects}
     for obj in scene.objects:  # Mitsuba's principled has no coat, tint, anisotropy, sheen or subsurface
         if model == "mitsuba":
@@ -76,8 +88,11 @@ def render_hybridgen(scene: Any, model: str, spp: int, bounces: int, seed: int =
     try:
         view = PathTraceView(scene, hybridgen_settings(bounces), variant="llvm_ad_rgb")
     finally:
+        principled_material.layer_normals = layer_normals
         for obj in scene.objects:
             obj.material.extra = extras[obj.name]
+    if model == "unlayered_emission":
+        view.mi_scene.integrator().layered_emitters = []
     view.render(scene.camera.keypoints[0], seed=seed + 1, spp=4)  # kernels compiled outside the timing
     start = time.perf_counter()
     image = view.render(scene.camera.keypoints[0], seed=seed, spp=spp)
@@ -90,13 +105,19 @@ def render_cycles(scene: Any, spp: int, bounces: int, workdir: Path) -> np.ndarr
 
     sys.path.insert(0, str(REPO / "tools"))
     from cycles_export import export_for_cycles
+    from cycles_render_layers import export_layers, needs_layers
+    from cycles_render_layers import worker as layers_worker
     from cycles_worker import CyclesWorker, ensure_bpy_venv
 
     python = ensure_bpy_venv(REPO / ".venv-bpy")
     if python is None:
         raise SystemExit("no bpy venv (.venv-bpy): Cycles cannot run here")
     export_for_cycles(scene, workdir / "scene.npz", spp, bounces, bounces)
-    worker = CyclesWorker(python, workdir / "scene.npz")
+    if needs_layers(scene):  # normal maps, emission under coat / sheen: tools/cycles_render_layers.py
+        export_layers(scene, workdir / "scene.npz")
+        worker = layers_worker(python, workdir / "scene.npz")
+    else:
+        worker = CyclesWorker(python, workdir / "scene.npz")
     try:
         exr = workdir / "cycles.exr"
         worker.render(0, False, 0, exr, cycles={"sample_clamp_indirect": 0.0, "sample_clamp_direct": 0.0,
@@ -112,14 +133,22 @@ def render_cycles(scene: Any, spp: int, bounces: int, workdir: Path) -> np.ndarr
 TEST_RES, TEST_CYCLES_SPP = (64, 48), 4096
 
 
-def test_view(bounces: int, objects: tuple[str, ...] = TEST_OBJECTS) -> dict[str, Any]:
-    """Cycles' per-object means of a small test view (``objects`` under the sun, :data:`TEST_RES`)."""
+def test_view(bounces: int, objects: tuple[str, ...] = TEST_OBJECTS, lighting: str = "sun") -> dict[str, Any]:
+    """Cycles' per-object means of a small test view (``objects`` under ``lighting``, :data:`TEST_RES`)."""
     with tempfile.TemporaryDirectory() as tmp:
-        scene = build_scene("sun", *TEST_RES, Path(tmp), objects)
+        scene = build_scene(lighting, *TEST_RES, Path(tmp), objects)
         masks = object_masks(scene, objects)
         cycles = object_means(render_cycles(scene, TEST_CYCLES_SPP, bounces, Path(tmp)), masks)
-    return {"lighting": "sun", "res": list(TEST_RES), "cycles_spp": TEST_CYCLES_SPP, "bounces": bounces,
+    return {"lighting": lighting, "res": list(TEST_RES), "cycles_spp": TEST_CYCLES_SPP, "bounces": bounces,
             "objects": list(objects), "pixels": {n: int(m.sum()) for n, m in masks.items()}, "cycles": cycles}
+
+
+def pixel_errors(image: np.ndarray, reference: np.ndarray, masks: dict[str, np.ndarray]) -> dict[str, float]:
+    """Per object: the RMS over its pixels of (image - reference) in the mean of R, G, B, over the reference's mean
+    there (both engines' noise included: compare models rendered alike)."""
+    a, b = image.mean(axis=-1), reference.mean(axis=-1)
+    return {name: float(np.sqrt(np.mean((a[m] - b[m]) ** 2)) / max(float(b[m].mean()), 1e-12))
+            for name, m in masks.items()}
 
 
 def ratio_row(name: str, cycles: list[float], ours: dict[str, list[float]]) -> str:
@@ -137,7 +166,7 @@ def main() -> None:
     parser.add_argument("--spp", type=int, default=256, help="hybridgen's samples per pixel")
     parser.add_argument("--cycles-spp", type=int, default=256)
     parser.add_argument("--bounces", type=int, default=4)
-    parser.add_argument("--lighting", default=",".join(LIGHTINGS))
+    parser.add_argument("--lighting", help="default: sun,hdri (the emission group: dark)")
     parser.add_argument("--store", type=Path, help="write Cycles' per-object means into this JSON table")
     parser.add_argument("--reuse-cycles", action="store_true", help="Cycles' means from the --store table")
     parser.add_argument("--time-scene", help="only time a color benchmark scene (tabletop, materials, ...) per "
@@ -155,31 +184,37 @@ def main() -> None:
     if not args.reuse_cycles:
         part.update({"res": [width, height], "cycles_spp": args.cycles_spp, "bounces": args.bounces,
                      "blender": None, "lightings": {}})
-    models = ("mitsuba", "blender") if args.group == "principled" else ("before", "blender")
-    for lighting in args.lighting.split(","):
+    models = (BEFORE[args.group], "blender")
+    lightings = args.lighting.split(",") if args.lighting else GROUP_LIGHTINGS.get(args.group, LIGHTINGS)
+    for lighting in lightings:
         with tempfile.TemporaryDirectory() as tmp:
             workdir = Path(tmp)
             scene = build_scene(lighting, width, height, workdir, group=args.group)
             masks = object_masks(scene, group=args.group)
-            cycles = part["lightings"][lighting]["cycles"] if args.reuse_cycles else object_means(
-                render_cycles(scene, args.cycles_spp, args.bounces, workdir), masks)
-            ours, seconds = {}, {}
+            reference = None if args.reuse_cycles else render_cycles(scene, args.cycles_spp, args.bounces, workdir)
+            cycles = part["lightings"][lighting]["cycles"] if reference is None else object_means(reference, masks)
+            ours, seconds, errors = {}, {}, {}
             for model in models:
                 image, seconds[model] = render_hybridgen(scene, model, args.spp, args.bounces)
                 ours[model] = object_means(image, masks)
+                if reference is not None:
+                    errors[model] = pixel_errors(image, reference, masks)
         print(f"\n{lighting}: {width}x{height}, hybridgen {args.spp} spp ("
               + ", ".join(f"{m} {seconds[m]:.1f} s" for m in models) + f"), Cycles {args.cycles_spp} spp, "
               f"{args.bounces} bounces")
         print(f"{'object':17s} | {'Cycles R G B':23s} | " + " | ".join(f"{m} / Cycles (mean)" for m in models))
         for name in masks:
             print(ratio_row(name, cycles[name], {m: ours[m][name] for m in ours}))
+        if errors:  # the images' per-pixel agreement (sees a highlight or a pattern moved, which a mean may not)
+            print("per-pixel relative RMS difference to Cycles: " + "; ".join(
+                f"{name} " + " / ".join(f"{errors[m][name]:.3f}" for m in models) for name in masks))
         if not args.reuse_cycles:
             part["lightings"][lighting] = {"pixels": {n: int(m.sum()) for n, m in masks.items()},
                                            "cycles": cycles, "hybridgen": ours["blender"]}
     if args.store and not args.reuse_cycles:
         if args.group in TEST_VIEWS:
             key, objects = TEST_VIEWS[args.group]
-            stored[key] = test_view(args.bounces, objects)
+            stored[key] = test_view(args.bounces, objects, lightings[0])
         args.store.parent.mkdir(parents=True, exist_ok=True)
         args.store.write_text(json.dumps(stored, indent=1) + "\n")
         print(f"stored {args.store}")

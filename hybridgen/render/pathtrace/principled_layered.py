@@ -4,10 +4,10 @@ base bends with the Normal input's map, the coat with the Coat Normal input's (u
 the sheen with their mix, as Blender 4.2 does (:mod:`.principled_frames`).
 
 Directions ``wo`` are in Mitsuba's shading-frame coordinates (``si.sh_frame``), as the BSDF interface passes them;
-each layer's lobes see them in its own local coordinates. A layer's value counts only where ``wo`` lies on the
-same side of its normal as of the shading normal (Mitsuba's ``normalmap`` test, so an uncoated material's base
-renders as under that wrapper); the pdf is the whole mixture's. Sampling picks a lobe as the single-frame BSDF
-does and draws it in its layer's frame. Dr.Jit values of the active variant.
+each layer's lobes see them in its own local coordinates. Reflections count where ``wo`` lies on the viewer's side
+of the geometric surface, the glass's refraction on the other (Cycles' test; :mod:`.principled_frames`); the pdf is
+the whole mixture's. Sampling picks a lobe as the single-frame BSDF does and draws it in its layer's frame. Dr.Jit
+values of the active variant.
 """
 from __future__ import annotations
 
@@ -20,7 +20,8 @@ import mitsuba as mi
 from . import principled_layers as layers_mod
 from . import principled_lobes as lobes
 from . import principled_sampling as sampling
-from .principled_frames import LayerFrame, layer_frame, normal_map_frame, reflects_in, sheen_frame
+from .principled_frames import (LayerFrame, bump_shadowing, layer_frame, normal_map_frame, reflects,
+                               sheen_frame)
 
 
 @dataclass
@@ -33,6 +34,7 @@ class Layered:
     coat: LayerFrame
     sheen: LayerFrame | None
     si_wi: Any  # the view, shading-frame coordinates
+    ng: Any  # the geometric normal, shading-frame coordinates
     wi: Any  # ... in the base's local coordinates
     wi_coat: Any
     wi_sheen: Any
@@ -41,30 +43,34 @@ class Layered:
 def setup(bsdf: Any, si: Any, active: Any, weights: bool = True) -> Layered:
     """The frames of ``bsdf`` (a :class:`~.principled_bsdf.PrincipledBSDF`) at ``si`` and, with ``weights``, its
     layer weights for the view ``si.wi``."""
-    base_map = None if bsdf.normal_map is None else normal_map_frame(bsdf.normal_map.eval_3(si, active), si.wi)
+    ng = si.to_local(si.n)
+    base_map = coat_map = None
+    if bsdf.normal_map is not None:
+        base_map = normal_map_frame(bsdf.normal_map.eval_3(si, active), si.wi, ng)
+    if bsdf.coat_normal_map is not None:
+        coat_map = normal_map_frame(bsdf.coat_normal_map.eval_3(si, active), si.wi, ng)
     base = layer_frame(base_map, si.wi, bsdf._frame(si, active, base_map))
-    coat_map = None if bsdf.coat_normal_map is None else normal_map_frame(bsdf.coat_normal_map.eval_3(si, active),
-                                                                          si.wi)
     coat = layer_frame(coat_map, si.wi)
     sheen = sheen_frame(base, coat, mi.Float(bsdf.coat)) if bsdf.sheen > 0 else None
     inp = bsdf._inputs(si, active)
     wi, wi_coat = base.local(si.wi), coat.local(si.wi)
     wi_sheen = sheen.local(si.wi) if sheen is not None else wi
     lay = layers_mod.layers(inp, wi, base.flip, wi_coat=wi_coat, wi_sheen=wi_sheen) if weights else None
-    return Layered(inp, lay, base, coat, sheen, si.wi, wi, wi_coat, wi_sheen)
+    return Layered(inp, lay, base, coat, sheen, si.wi, ng, wi, wi_coat, wi_sheen)
 
 
 def eval_pdf(state: Layered, wo: Any, active: Any) -> tuple[Any, Any]:
     """(BSDF x |cos| as a Spectrum, pdf) for ``wo`` in shading-frame coordinates."""
     inp = state.inp
-    coat = (state.wi_coat, state.coat.local(wo), state.coat.same_side(wo)) if inp.has_coat else None
-    sheen = None
-    if state.sheen is not None:
-        sheen = (state.wi_sheen, state.sheen.local(wo), reflects_in(state.sheen, state.si_wi, wo))
-    base_ok = state.base.same_side(wo) if state.base.frame is not None else None
+    reflected = reflects(state.ng, state.si_wi, wo)
+    coat = (state.wi_coat, state.coat.local(wo), reflected) if inp.has_coat else None
+    sheen = (state.wi_sheen, state.sheen.local(wo), reflected) if state.sheen is not None else None
+    smooth = dr.select(state.si_wi.z < 0.0, -1.0, 1.0) * mi.Vector3f(0.0, 0.0, 1.0)
+    diffuse_scale = (mi.Float(1.0) if state.base.frame is None else bump_shadowing(smooth, state.base.normal(), wo),
+                     mi.Float(1.0) if state.sheen is None else bump_shadowing(smooth, state.sheen.normal(), wo))
     value, pdf = layers_mod.eval_pdf(state.lay, state.wi, state.base.local(wo), inp.has_coat,
                                      inp.has_transmission, inp.has_sheen, coat=coat, sheen_dirs=sheen,
-                                     base_ok=base_ok)
+                                     base_ok=reflected, diffuse_scale=diffuse_scale)
     ok = active & (state.wi.z > 0.0)
     return dr.select(ok, mi.Spectrum(value), 0.0), dr.select(ok, pdf, 0.0)
 

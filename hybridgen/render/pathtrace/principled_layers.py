@@ -227,30 +227,34 @@ def glass_reflect_probability(lay: Layers, cos_hi: Any) -> tuple[Any, Any, Any]:
 
 def eval_pdf(lay: Layers, wi: Any, wo: Any, has_coat: bool, has_transmission: bool,
              has_sheen: bool = False, coat: tuple[Any, Any, Any] | None = None,
-             sheen_dirs: tuple[Any, Any, Any] | None = None, base_ok: Any = None) -> tuple[Any, Any]:
+             sheen_dirs: tuple[Any, Any, Any] | None = None, base_ok: Any = None,
+             diffuse_scale: Any = None) -> tuple[Any, Any]:
     """(BSDF x |cos(wo)| as RGB, pdf of :meth:`PrincipledBSDF.sample`) for local ``wi`` (upper) and ``wo``.
 
     ``coat`` / ``sheen_dirs``: (wi, wo, ok) in the coat's / sheen's own frame where it differs from the base's
-    (:mod:`.principled_frames`; ``ok``: the layer's value counts there), ``base_ok`` likewise for the base lobes;
-    the pdf is the mixture's whatever the masks."""
+    (:mod:`.principled_frames`; ``ok``: the layer's value counts there), ``base_ok`` likewise for the base's
+    reflections (its refraction counts where it is false); ``diffuse_scale``: (diffuse lobe, sheen lobe) factors
+    (Cycles' bump shadowing of diffuse closures); the pdf is the mixture's whatever the masks and factors."""
     refl, refl_pdf, cos_hi = lobes.reflection(wi, wo, lay.ax, lay.ay)
     value = lay.spec_w * lobes.fresnel_remapped(cos_hi, lay.eta_spec, lay.f0_spec) * refl
     value += lay.metal_w * lobes.fresnel_f82(cos_hi, lay.f0_metal, lay.b_metal) * refl
     pdf = (lay.shares[1] + lay.shares[3]) * refl_pdf
     upper = wo.z > 0.0
-    value += dr.select(upper, lay.diffuse_w * wo.z * dr.inv_pi, 0.0)
+    diffuse = lay.diffuse_w * wo.z * dr.inv_pi
+    value += dr.select(upper, diffuse if diffuse_scale is None else diffuse * diffuse_scale[0], 0.0)
     pdf += lay.shares[4] * dr.select(upper, wo.z * dr.inv_pi, 0.0)
     if has_transmission:
         g_refl, g_pdf, g_cos = lobes.reflection(wi, wo, lay.alpha_glass, lay.alpha_glass)
         p_reflect, f, _ = glass_reflect_probability(lay, g_cos)
         g_refr, t_pdf, t_cos = lobes.refraction(wi, wo, lay.alpha_glass, lay.eta_glass)
         p_reflect_t, _, t = glass_reflect_probability(lay, t_cos)
-        glass = lay.glass_w * (f * g_refl + t * g_refr)
+        if base_ok is None:
+            glass = lay.glass_w * (f * g_refl + t * g_refr)
+        else:  # a reflection on the viewer's side of the surface, a refraction on the other
+            glass = lay.glass_w * dr.select(base_ok, f * g_refl, t * g_refr)
         glass_pdf = lay.shares[2] * (p_reflect * g_pdf + (1.0 - p_reflect_t) * t_pdf)
     if base_ok is not None:
         value = dr.select(base_ok, value, 0.0)
-        if has_transmission:
-            glass = dr.select(base_ok, glass, 0.0)
     if has_coat:
         wi_c, wo_c, ok_c = (wi, wo, None) if coat is None else coat
         c_refl, c_pdf, c_cos = lobes.reflection(wi_c, wo_c, lay.alpha_coat, lay.alpha_coat)
@@ -263,6 +267,7 @@ def eval_pdf(lay: Layers, wi: Any, wo: Any, has_coat: bool, has_transmission: bo
     if has_sheen:
         wo_s, ok_s = (wo, None) if sheen_dirs is None else sheen_dirs[1:]
         lobe = sheen.sheen_lobe(lay.sheen_a, lay.sheen_b, lay.sheen_frame, wo_s)
-        value += lay.sheen_w * lobe if ok_s is None else dr.select(ok_s, lay.sheen_w * lobe, 0.0)
+        sheen_value = lay.sheen_w * lobe if diffuse_scale is None else lay.sheen_w * lobe * diffuse_scale[1]
+        value += sheen_value if ok_s is None else dr.select(ok_s, sheen_value, 0.0)
         pdf += lay.shares[5] * lobe
     return value, pdf
