@@ -4,8 +4,10 @@
 
 The scene (metres, world Z up): a 2 m cube ``Box`` at (0, 0, 1) turned 0.3 rad about Z, with the material
 ``Painted`` (Principled BSDF: base color image ``checker.png`` - 4 x 4 texels, written next to OUT -, roughness
-0.35, metallic 0.2) and custom properties ``category_id`` 7 and ``label`` "box"; a 10 m plane ``Ground``
-with ``Floor`` (base color (0.2, 0.4, 0.6), roughness 0.8) and ``category_id`` 1, scaled 1.5 in Blender;
+0.35, metallic 0.2, Coat Weight 0.8, Coat Roughness 0.2, the same image as a Non-Color coat normal map through a
+Normal Map node) and custom properties ``category_id`` 7 and ``label`` "box"; a 10 m plane ``Ground``
+with ``Floor`` (base color (0.2, 0.4, 0.6), roughness 0.8, Specular Tint (1, 0.9, 0.8), Sheen Roughness 0.2
+without sheen) and ``category_id`` 1, scaled 1.5 in Blender;
 a point light ``Lamp`` of 500 W at (2, -2, 4), color (1, 0.9, 0.8); an empty ``Target`` at (0, 0, 1);
 the world background (0.1, 0.2, 0.3) at strength 0.5.
 """
@@ -51,6 +53,14 @@ def main(out: Path) -> None:
     texture = painted.node_tree.nodes.new("ShaderNodeTexImage")
     texture.image = bpy.data.images.load(str(image_path))
     painted.node_tree.links.new(texture.outputs["Color"], node.inputs["Base Color"])
+    node.inputs["Coat Weight"].default_value = 0.8
+    node.inputs["Coat Roughness"].default_value = 0.2
+    coat_map = painted.node_tree.nodes.new("ShaderNodeTexImage")
+    coat_map.image = bpy.data.images.load(str(image_path))
+    coat_map.image.colorspace_settings.name = "Non-Color"
+    normal_map = painted.node_tree.nodes.new("ShaderNodeNormalMap")
+    painted.node_tree.links.new(coat_map.outputs["Color"], normal_map.inputs["Color"])
+    painted.node_tree.links.new(normal_map.outputs["Normal"], node.inputs["Coat Normal"])
     box.data.materials.append(painted)
 
     bpy.ops.mesh.primitive_plane_add(size=10.0)
@@ -61,6 +71,8 @@ def main(out: Path) -> None:
     floor, node = _principled("Floor")
     node.inputs["Base Color"].default_value = (0.2, 0.4, 0.6, 1.0)
     node.inputs["Roughness"].default_value = 0.8
+    node.inputs["Specular Tint"].default_value = (1.0, 0.9, 0.8, 1.0)
+    node.inputs["Sheen Roughness"].default_value = 0.2  # no effect: Sheen Weight stays 0
     ground.data.materials.append(floor)
 
     lamp = bpy.data.lights.new("Lamp", type="POINT")

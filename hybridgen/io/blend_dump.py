@@ -8,8 +8,9 @@ world Z up; ``matrix_world`` is the object's 4x4 local-to-world matrix (row-majo
 evaluated meshes (modifiers applied), triangulated, as one vertex per triangle corner (``<i>_positions``
 (3T, 3) object-local, ``<i>_normals`` Blender's corner normals - flat or smooth as Blender shades -,
 ``<i>_uvs`` (3T, 2) of the active UV map, ``<i>_material`` (T,) slot index). Materials are read from a
-Principled BSDF feeding the output (values and the image linked to an input); images packed in the file are
-written into OUT_DIR.
+Principled BSDF feeding the output (values and the image linked to an input - Normal and Coat Normal through a
+Normal Map node -; the inputs ``OPTIONS["extra_inputs"]`` names, {key: socket name or node property}, under
+``extra``); images packed in the file are written into OUT_DIR.
 
 Subdivision Surface (and Multires) modifiers are evaluated at the level a render uses, not the viewport's:
 their ``render_levels`` (``OPTIONS["render_levels"]`` replaces it: an int for every object, a dict by object
@@ -74,7 +75,7 @@ def _linked_image(socket, out_dir: str) -> str | None:
     return None
 
 
-def _material(material, out_dir: str) -> dict:
+def _material(material, out_dir: str, options: dict) -> dict:
     out = {"name": material.name if material else "default", "custom_properties": {}}
     if material is None:
         return out
@@ -95,11 +96,19 @@ def _material(material, out_dir: str) -> dict:
         image = _linked_image(socket, out_dir)
         if image is not None:
             textures[key] = image
-    if "Normal" in principled.inputs:
-        normal = _linked_image(principled.inputs["Normal"], out_dir)
-        if normal is not None:
-            textures["normal"] = normal
-    out.update(principled=values, textures=textures)
+    for key, name in (("normal", "Normal"), ("coat_normal", "Coat Normal")):
+        if name in principled.inputs:
+            normal = _linked_image(principled.inputs[name], out_dir)
+            if normal is not None:
+                textures[key] = normal
+    extra = {}
+    for key, name in options.get("extra_inputs", {}).items():  # coat, sheen, ...: {key: socket name}
+        if name in principled.inputs:
+            value = principled.inputs[name].default_value
+            extra[key] = list(value) if hasattr(value, "__len__") else float(value)
+        elif hasattr(principled, name):  # a node property (subsurface_method)
+            extra[key] = getattr(principled, name)
+    out.update(principled=values, textures=textures, extra=extra)
     return out
 
 
@@ -197,7 +206,7 @@ def main(blend: str, out_dir: str, options: dict) -> None:
         if obj.type == "MESH" and "MESH" in types:
             prefix = f"m{len(objects)}"
             record.update(arrays=prefix, **_mesh_arrays(obj, depsgraph, prefix, arrays))
-            record["materials"] = [_material(slot.material, out_dir) for slot in obj.material_slots]
+            record["materials"] = [_material(slot.material, out_dir, options) for slot in obj.material_slots]
         elif obj.type == "LIGHT" and "LIGHT" in types:
             record["light"] = _light(obj)
         elif obj.type == "EMPTY" and "EMPTY" in types:

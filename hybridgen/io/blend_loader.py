@@ -31,6 +31,7 @@ import numpy as np
 
 from ..errors import InputError, SystemSetupError
 from ..input_paths import not_found
+from ..scene import principled_inputs
 from ..scene.light import Light
 from ..scene.material import Material
 from ..scene.mesh_object import MeshObject
@@ -43,7 +44,10 @@ TIMEOUT_S = 600.0
 SIMPLIFY_SUBDIVISION_RENDER = 3
 """BlenderProc's ``DefaultConfig.simplify_subdivision_render``: the renderer caps subdivision levels at 3."""
 _LINEAR_MAPS = {"roughness": "roughness_texture", "metallic": "metallic_texture", "specular": "specular_texture",
-                "alpha": "alpha_texture", "normal": "normal_texture"}
+                "alpha": "alpha_texture", "normal": "normal_texture", "coat_normal": "coat_normal_texture"}
+EXTRA_SOCKETS = {entry.key: entry.blender for entry in principled_inputs.INPUTS}
+"""The Principled inputs the dump reads into ``extra`` (coat, sheen, ...: key -> Blender 4's socket name, or
+the node's property for ``subsurface_method``)."""
 
 
 @dataclass
@@ -88,7 +92,7 @@ def load_blend(path: str | Path, *, obj_types: Sequence[str] = ("mesh", "empty",
     python = bpy_python()
     options = {"obj_types": [str(t).lower() for t in obj_types], "entities": entities,
                "render_levels": render_levels if isinstance(render_levels, int) else dict(render_levels or {}),
-               "simplify_subdivision_render": simplify_subdivision_render}
+               "simplify_subdivision_render": simplify_subdivision_render, "extra_inputs": EXTRA_SOCKETS}
     with tempfile.TemporaryDirectory(prefix="hybridgen-blend-") as out:
         command = [str(python), str(DUMP_SCRIPT), str(file.resolve()), out, json.dumps(options)]
         try:
@@ -178,6 +182,7 @@ def _material(record: dict[str, Any], out: Path, file: Path) -> Material:
     for key, slot in _LINEAR_MAPS.items():
         if key in textures:
             setattr(material, slot, _texture(textures[key], out, file))
+    material.extra = principled_inputs.from_node(record.get("extra", {}))
     return material
 
 

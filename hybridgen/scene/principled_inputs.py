@@ -90,3 +90,28 @@ def checked(key: str, value: Any) -> Any:
     if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
         raise ValueError(f"must be a finite number, got {value!r}")
     return float(value)
+
+
+_GATES = (("coat_", "coat_weight"), ("sheen_", "sheen_weight"), ("subsurface_", "subsurface_weight"),
+          ("anisotropic_rotation", "anisotropic"))
+"""(key prefix, the weight that switches those inputs on): a layer's other inputs matter only where it is."""
+
+
+def from_node(values: dict[str, Any]) -> dict[str, Any]:
+    """``extra`` of a Principled BSDF node read from a file (``values``: key -> socket value, as :data:`BY_KEY`
+    names them): the checked values that differ from Blender's defaults, a layer's inputs only where its weight
+    is above 0 (a coat roughness without a coat changes nothing, and a material without any stays Lambertian
+    where hybridgen renders it so). Values no renderer can use are left out."""
+    out: dict[str, Any] = {}
+    for key, value in values.items():
+        try:
+            value = checked(key, value)
+        except ValueError:
+            continue
+        if value != DEFAULTS[key]:
+            out[key] = value
+    for prefix, weight in _GATES:
+        if out.get(weight, 0.0) <= 0:
+            out = {k: v for k, v in out.items() if not k.startswith(prefix)}
+    return out
+

@@ -44,3 +44,26 @@ def test_what_cannot_be_set_is_one_line(bproc) -> None:  # noqa: F811
     with pytest.raises(InputError, match="Subsurface Color' is not supported"):  # Blender 3 only, no Blender 4 input
         material.set_principled_shader_value("Subsurface Color", [1.0, 0.0, 0.0, 1.0])
     assert material.blender_obj.extra == {}
+
+
+def test_normal_sockets_keep_tangent_space_maps(bproc, tmp_path) -> None:  # noqa: F811
+    """Normal / Coat Normal: the material's tangent-space maps read back as linked images; a value unlinks the map
+    (BlenderProc removes the socket's link; Blender ignores an unlinked normal socket's value); an image linked
+    straight to the socket (what BlenderProc's call builds: no Normal Map node) is refused in one line."""
+    material = bproc.material.create("lacquer")
+    assert material.get_principled_shader_value("Coat Normal") == [0.0, 0.0, 0.0]
+    material.blender_obj.coat_normal_texture = str(tmp_path / "coat_n.png")
+    material.blender_obj.normal_texture = str(tmp_path / "base_n.png")
+    assert material.get_principled_shader_value("Coat Normal").filepath == str(tmp_path / "coat_n.png")
+    assert material.get_principled_shader_value("Normal").filepath == str(tmp_path / "base_n.png")
+    material.set_principled_shader_value("Coat Normal", [0.0, 0.0, 1.0])
+    assert material.blender_obj.coat_normal_texture is None
+    assert material.blender_obj.normal_texture == str(tmp_path / "base_n.png")  # the other socket keeps its map
+    image = type("Image", (), {"filepath": str(tmp_path / "coat_n.png")})()  # bpy.data.images.load's, to the call
+    for name in ("Coat Normal", "Normal"):
+        with pytest.raises(InputError) as error:
+            material.set_principled_shader_value(name, image)
+        line = str(error.value)
+        assert "\n" not in line and "world-space normal" in line and "normal_texture" in line
+    with pytest.raises(InputError, match="'Coat Normal' takes 3 numbers"):
+        material.set_principled_shader_value("Coat Normal", 0.5)

@@ -74,6 +74,12 @@ def test_a_blend_scene_reads_as_blender_shows_it(fixture_blend):
     assert box.uvs is not None and box.uvs.shape == (36, 2) and 0 <= box.uvs.min() and box.uvs.max() <= 1
     assert ground.material.base_color == pytest.approx((0.2, 0.4, 0.6, 1.0))
     assert ground.material.roughness == pytest.approx(0.8) and ground.material.base_color_texture is None
+    # Principled inputs beyond the model's fields: the coat and its own normal map (a Normal Map node on Coat
+    # Normal); a sheen input without sheen is left out, a specular tint kept
+    assert box.material.extra == {"coat_weight": pytest.approx(0.8), "coat_roughness": pytest.approx(0.2)}
+    assert Path(box.material.coat_normal_texture) == fixture_blend.with_name("checker.png")
+    assert box.material.normal_texture is None
+    assert ground.material.extra == {"specular_tint": pytest.approx((1.0, 0.9, 0.8))}
     # the light, the empty, the world
     (lamp,) = content.lights
     assert (lamp.name, lamp.type, lamp.energy) == ("Lamp", "POINT", pytest.approx(500.0))

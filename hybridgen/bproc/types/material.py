@@ -39,6 +39,12 @@ INPUTS: dict[str, tuple[str, str | None]] = {
 }
 """Principled BSDF input (Blender 3 and 4 names) -> (hybridgen material field, its texture field or None)."""
 COLOR_FIELDS = ("base_color", "emission")
+NORMAL_INPUTS = {"Normal": "normal_texture", "Coat Normal": "coat_normal_texture"}
+"""Normal sockets -> the tangent-space map hybridgen keeps for them. BlenderProc's ``set_principled_shader_value``
+links an image's Color straight into such a socket (no Normal Map node), which Cycles reads as a world-space
+normal; hybridgen keeps tangent-space maps only (set by its loaders, config ``material:`` keys or
+``blender_obj``). A value (Blender ignores an unlinked normal socket's value: the surface's own normal) unlinks
+the map, as BlenderProc does."""
 
 
 def _is_image(value: Any) -> bool:
@@ -62,6 +68,23 @@ def _set_extra(mat: SceneMaterial, input_name: str, value: Any) -> None:
         mat.extra[key] = principled_inputs.checked(key, list(value) if hasattr(value, "__len__") else value)
     except ValueError as error:
         raise InputError(f"Principled BSDF input '{input_name}' {error}") from None
+
+
+def _set_normal(mat: SceneMaterial, input_name: str, value: Any) -> None:
+    """A value on a normal socket (:data:`NORMAL_INPUTS`): unlinks its map; an image or socket: one line."""
+    if _is_image(value):
+        raise InputError(f"an image linked straight to Principled BSDF input '{input_name}' is not supported by "
+                         "hybridgen (Blender reads its colors as a world-space normal: BlenderProc adds no Normal Map "
+                         f"node); a tangent-space normal map is the material's {NORMAL_INPUTS[input_name]}")
+    if hasattr(value, "is_output_socket"):
+        raise InputError(f"linking a node socket to '{input_name}' is not supported by hybridgen yet")
+    try:
+        vector = [float(v) for v in value]
+    except (TypeError, ValueError):
+        vector = []
+    if len(vector) != 3:
+        raise InputError(f"'{input_name}' takes 3 numbers, got {value!r}")
+    setattr(mat, NORMAL_INPUTS[input_name], None)
 
 
 def _get_extra(mat: SceneMaterial, input_name: str) -> Any:
@@ -102,6 +125,9 @@ class Material(Struct):
         if input_name in principled_inputs.BY_BLENDER_NAME:
             _set_extra(self.blender_obj, input_name, value)
             return
+        if input_name in NORMAL_INPUTS:
+            _set_normal(self.blender_obj, input_name, value)
+            return
         field, texture = _input(input_name)
         mat = self.blender_obj
         if _is_image(value):
@@ -123,11 +149,17 @@ class Material(Struct):
             setattr(mat, field, float(value))
 
     def get_principled_shader_value(self, input_name: str) -> Any:
-        """The input's value (colors as RGBA lists), or the linked image (an object with ``filepath``)."""
+        """The input's value (colors as RGBA lists), or the linked image (an object with ``filepath``; a normal
+        socket's tangent-space map)."""
         if input_name in principled_inputs.BY_BLENDER_NAME:
             return _get_extra(self.blender_obj, input_name)
-        field, texture = _input(input_name)
         mat = self.blender_obj
+        if input_name in NORMAL_INPUTS:
+            field, texture = "", NORMAL_INPUTS[input_name]
+            if getattr(mat, texture) is None:
+                return [0.0, 0.0, 0.0]  # the socket's (unused) default value
+        else:
+            field, texture = _input(input_name)
         if texture is not None and getattr(mat, texture) is not None:
             from ..bpy_standin import Image
 
