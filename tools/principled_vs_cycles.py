@@ -131,16 +131,24 @@ def render_cycles(scene: Any, spp: int, bounces: int, workdir: Path) -> np.ndarr
 
 
 TEST_RES, TEST_CYCLES_SPP = (64, 48), 4096
+TEST_VIEW_RES = {"coat_normal": (128, 64)}
+"""Test views larger than :data:`TEST_RES` (the coat normal map's pattern is compared pixel by pixel)."""
+IMAGES = "principled_cycles_images.npz"
+"""Beside the ``--store`` table: Cycles' images (float32 H x W x 3) of the test views stored since issue 32's
+coat normal and emission groups, under the views' keys."""
 
 
-def test_view(bounces: int, objects: tuple[str, ...] = TEST_OBJECTS, lighting: str = "sun") -> dict[str, Any]:
-    """Cycles' per-object means of a small test view (``objects`` under ``lighting``, :data:`TEST_RES`)."""
+def test_view(bounces: int, objects: tuple[str, ...] = TEST_OBJECTS, lighting: str = "sun",
+              res: tuple[int, int] = TEST_RES) -> tuple[dict[str, Any], np.ndarray]:
+    """Cycles' per-object means of a small test view (``objects`` under ``lighting`` at ``res``) and its image."""
     with tempfile.TemporaryDirectory() as tmp:
-        scene = build_scene(lighting, *TEST_RES, Path(tmp), objects)
+        scene = build_scene(lighting, *res, Path(tmp), objects)
         masks = object_masks(scene, objects)
-        cycles = object_means(render_cycles(scene, TEST_CYCLES_SPP, bounces, Path(tmp)), masks)
-    return {"lighting": lighting, "res": list(TEST_RES), "cycles_spp": TEST_CYCLES_SPP, "bounces": bounces,
-            "objects": list(objects), "pixels": {n: int(m.sum()) for n, m in masks.items()}, "cycles": cycles}
+        image = render_cycles(scene, TEST_CYCLES_SPP, bounces, Path(tmp))
+        cycles = object_means(image, masks)
+    return {"lighting": lighting, "res": list(res), "cycles_spp": TEST_CYCLES_SPP, "bounces": bounces,
+            "objects": list(objects), "pixels": {n: int(m.sum()) for n, m in masks.items()},
+            "cycles": cycles}, image.astype(np.float32)
 
 
 def pixel_errors(image: np.ndarray, reference: np.ndarray, masks: dict[str, np.ndarray]) -> dict[str, float]:
@@ -172,6 +180,8 @@ def main() -> None:
     parser.add_argument("--time-scene", help="only time a color benchmark scene (tabletop, materials, ...) per "
                         "sample with each model, at --res and --spp, alternating --repeats times")
     parser.add_argument("--repeats", type=int, default=8)
+    parser.add_argument("--test-view-only", action="store_true", help="with --store: render and store only the "
+                        "group's test view (the sweep's stored values kept)")
     args = parser.parse_args()
     width, height = (int(v) for v in args.res.split("x"))
     if args.time_scene:
@@ -181,12 +191,12 @@ def main() -> None:
         return
     stored = json.loads(args.store.read_text()) if args.store and args.store.exists() else {}
     part = stored if args.group == "principled" else stored.setdefault(args.group, {})
-    if not args.reuse_cycles:
+    if not args.reuse_cycles and not args.test_view_only:
         part.update({"res": [width, height], "cycles_spp": args.cycles_spp, "bounces": args.bounces,
                      "blender": None, "lightings": {}})
     models = (BEFORE[args.group], "blender")
     lightings = args.lighting.split(",") if args.lighting else GROUP_LIGHTINGS.get(args.group, LIGHTINGS)
-    for lighting in lightings:
+    for lighting in () if args.test_view_only else lightings:
         with tempfile.TemporaryDirectory() as tmp:
             workdir = Path(tmp)
             scene = build_scene(lighting, width, height, workdir, group=args.group)
@@ -214,7 +224,12 @@ def main() -> None:
     if args.store and not args.reuse_cycles:
         if args.group in TEST_VIEWS:
             key, objects = TEST_VIEWS[args.group]
-            stored[key] = test_view(args.bounces, objects, lightings[0])
+            stored[key], image = test_view(args.bounces, objects, lightings[0],
+                                           TEST_VIEW_RES.get(args.group, TEST_RES))
+            if args.group in ("coat_normal", "emission"):
+                images_file = args.store.with_name(IMAGES)
+                images = dict(np.load(images_file)) if images_file.exists() else {}
+                np.savez_compressed(images_file, **{**images, key: image})
         args.store.parent.mkdir(parents=True, exist_ok=True)
         args.store.write_text(json.dumps(stored, indent=1) + "\n")
         print(f"stored {args.store}")
