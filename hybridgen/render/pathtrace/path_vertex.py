@@ -43,8 +43,10 @@ def path_vertex(active: Any, bsdf_ctx: Any, bsdf_delta_prev: Any, bsdf_pdf_prev:
                            world_guide.pdf(guide, si_prev.p, ray.d, active), em_pdf)
     mis_bsdf = dr.select(depth == 0, 1.0, mis_weight(bsdf_pdf_prev, em_pdf))
     emitted = throughput * mis_bsdf * ds.emitter.eval(si, active)
-    if self.layered_emitters:  # emission under a coat or sheen: what they leave towards this view
-        emitted *= layered_emission.weight(self.layered_emitters, si, active)
+    if self.layered_emitters:  # emission under a coat or sheen: what they leave towards this view, where the
+        # path goes on (Cycles evaluates no layers at a path's last vertex nor for light samples)
+        emitted *= layered_emission.weight(self.layered_emitters, si, active,
+                                           (depth + 1 < max_depth) & ~last_segment)
     if has_hidden:  # camera rays see such an emitter's BSDF only, other rays its emission only
         hidden = self._camera_hidden(si)
         emitted = dr.select(hidden & (depth == 0), 0.0, emitted)
@@ -73,7 +75,7 @@ def path_vertex(active: Any, bsdf_ctx: Any, bsdf_delta_prev: Any, bsdf_pdf_prev:
     else:
         blocked = scene.ray_test(si.spawn_ray_to(ds_em.p), needs_shadow_ray)
         em_weight = dr.select(blocked, 0.0, em_weight)
-    if self.layered_emitters:
+    if self.layered_emitters and layered_emission.tinted(self.layered_emitters):  # a coat tint's absorption
         em_weight *= layered_emission.light_weight(self.layered_emitters, scene, si, ds_em, needs_shadow_ray)
     mis_em = dr.select(ds_em.delta, 1.0, mis_weight(ds_em.pdf, bsdf_pdf))
     lit = dr.select(active_em, throughput * bsdf_val * em_weight * mis_em, 0.0)

@@ -204,15 +204,16 @@ def register(variant: str) -> None:
             weight = mi.Spectrum(value) / dr.maximum(pdf, 1e-20)
             return bs, dr.select(ok, weight, 0.0)
 
-        def emission_weight(self, si: Any, active: Any = True) -> Any:
+        def emission_weight(self, si: Any, active: Any = True, layers: bool = True) -> Any:
             """What the sheen and coat leave of this material's emission seen from ``si.wi`` (a color; Cycles
-            layers the emission under them)."""
+            layers the emission under them; ``layers`` False: the coat tint's absorption alone,
+            :func:`~.principled_layers.emission_weight`)."""
             if self.layer_frames:
                 from .principled_layered import emission_weight
 
-                return emission_weight(self, si, active)
+                return emission_weight(self, si, active, layers)
             wi = mi.Vector3f(si.wi.x, si.wi.y, dr.abs(si.wi.z))
-            return layers_mod.emission_weight(self._inputs(si, active), wi, wi)
+            return layers_mod.emission_weight(self._inputs(si, active), wi, wi, layers)
 
         def eval_diffuse_reflectance(self, si: Any, active: Any = True) -> Any:
             return self.base_color.eval(si, active)

@@ -104,7 +104,8 @@ def sample(state: Layered, sample1: Any, sample2: Any, active: Any) -> tuple[Any
     return bs, dr.select(ok, value / dr.maximum(pdf, 1e-20), 0.0)
 
 
-def emission_weight(bsdf: Any, si: Any, active: Any) -> Any:
-    """What the sheen and coat of ``bsdf`` leave of its emission seen from ``si.wi``, in their own frames."""
+def emission_weight(bsdf: Any, si: Any, active: Any, layers: bool = True) -> Any:
+    """What the sheen and coat of ``bsdf`` leave of its emission seen from ``si.wi``, in their own frames
+    (``layers``: see :func:`~.principled_layers.emission_weight`)."""
     state = setup(bsdf, si, active, weights=False)
-    return layers_mod.emission_weight(state.inp, state.wi_sheen, state.wi_coat)
+    return layers_mod.emission_weight(state.inp, state.wi_sheen, state.wi_coat, layers)

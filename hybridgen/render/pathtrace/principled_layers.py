@@ -137,16 +137,26 @@ def _coat_layer(inp: Inputs, mu: Any, weight: Any) -> tuple[Any, Any, Any, Any]:
         coat_w, share_coat = coat_w * weight, share_coat * _average(weight)
     weight = weight * dr.clip(1.0 - inp.coat * _max(albedo), 0.0, 1.0)
     if inp.has_coat_tint:
-        cos_t = dr.safe_sqrt(1.0 - (1.0 - mu * mu) / dr.square(inp.coat_ior))
-        absorbed = dr.power(inp.coat_tint, dr.rcp(dr.maximum(cos_t, 1e-4)))
-        weight = weight * dr.lerp(mi.Color3f(1.0), absorbed, inp.coat)
+        weight = weight * _coat_absorption(inp, mu)
     return alpha_coat, coat_w, share_coat, weight
 
 
-def emission_weight(inp: Inputs, wi_sheen: Any, wi_coat: Any) -> Any:
+def _coat_absorption(inp: Inputs, mu: Any) -> Any:
+    """The coat tint's transmittance (a color) for the view cosine ``mu``: Beer's law over the coat's unit
+    thickness along the view refracted into it, lerp(1, tint^(1 / cos_t), Coat Weight)."""
+    cos_t = dr.safe_sqrt(1.0 - (1.0 - mu * mu) / dr.square(inp.coat_ior))
+    absorbed = dr.power(inp.coat_tint, dr.rcp(dr.maximum(cos_t, 1e-4)))
+    return dr.lerp(mi.Color3f(1.0), absorbed, inp.coat)
+
+
+def emission_weight(inp: Inputs, wi_sheen: Any, wi_coat: Any, layers: bool = True) -> Any:
     """What the sheen and coat leave of the emission (a color; Cycles' ``emission_setup`` under the layer weight
-    after sheen and coat) for the local view directions ``wi_sheen`` / ``wi_coat`` in those layers' frames."""
+    after sheen and coat) for the local view directions ``wi_sheen`` / ``wi_coat`` in those layers' frames.
+    ``layers`` False: only the coat tint's absorption - what Cycles applies where it sets up no closures (light
+    samples, a path's last vertex), the tint being applied outside the coat closure's allocation."""
     weight = mi.Color3f(1.0)
+    if not layers:
+        return weight * _coat_absorption(inp, dr.maximum(wi_coat.z, 1e-6)) if inp.has_coat_tint else weight
     if inp.has_sheen:
         weight = weight * _sheen_layer(inp, dr.maximum(wi_sheen.z, 1e-6))[3]
     if inp.has_coat:
