@@ -202,6 +202,11 @@ def test_emission_weight_under_coat_and_sheen(mi, mu) -> None:
     np.testing.assert_allclose(tinted[0], coat[0], rtol=1e-6)
     sheen = np.array(bsdf(mi, sheen_weight=1.0, sheen_roughness=0.3).emission_weight(si)).ravel()
     assert 0.3 < sheen[0] < 1.0
+    # without the layers (what Cycles leaves at light samples and last vertices): the tint's absorption alone
+    bare = np.array(bsdf(mi, **COAT, sheen_weight=1.0).emission_weight(si, True, False)).ravel()
+    np.testing.assert_allclose(bare, 1.0)
+    absorbed = np.array(bsdf(mi, **COAT, coat_tint=tint, coat_ior=ior).emission_weight(si, True, False)).ravel()
+    np.testing.assert_allclose(absorbed, [t ** (1.0 / cos_t) for t in tint], rtol=1e-5)
 
 
 def test_coat_normal_texture_reaches_the_plugin_only_for_coated_materials(mi, tmp_path) -> None:
