@@ -8,8 +8,10 @@ Run: .venv/bin/python tools/principled_vs_cycles.py [--group principled|layers|s
 
 The scenes (tools/principled_sweep.py): rows of spheres over a grey Lambertian floor, each sphere one material
 of a sweep - ``principled``: base colors x roughness x metallic x Specular IOR Level x coat x transmission x
-anisotropy; ``layers``: sheen and subsurface; ``subsurface``: subsurface weights x radius scales (no test view)
-- under a sun and sky (``sun``) or a sky HDRI (``hdri``). Both engines render the same meshes and vertex
+anisotropy; ``layers``: sheen and subsurface; ``subsurface``: subsurface weights x radius scales (no test view);
+``coat_normal``: a normal map on Normal and / or Coat Normal of coated UV spheres; ``emission``: emissive spheres
+under coat and sheen - under a sun and sky (``sun``), a sky HDRI (``hdri``) or nothing (``dark``, the emission
+group's). Scenes with normal maps or layered emission render in Cycles through tools/cycles_render_layers.py. Both engines render the same meshes and vertex
 normals at fixed sample counts with equal bounces in every lobe (``--bounces`` Cycles bounces = Mitsuba
 depth + 2), no clamping, no glossy filter, a one-pixel box filter, no denoising, no light tree: converged
 estimates of the same integral. Cycles runs through ``bpy`` 4.2 in ``.venv-bpy`` (tools/cycles_render.py,
@@ -18,9 +20,11 @@ the color benchmark's worker; BlenderProc 2.8's Blender).
 Printed for each object: its mean linear radiance over the pixels well inside its silhouette (masks from an
 analytic ray cast of the spheres and the floor), and the ratio hybridgen / Cycles per channel for "before"
 and hybridgen's Principled BSDF ("after", ``HYBRIDGEN_PRINCIPLED=blender``), with each image's overall ratio.
-Before is Mitsuba's ``principled`` (``HYBRIDGEN_PRINCIPLED=mitsuba``) for the ``principled`` sweep, and
-hybridgen's BSDF with the sheen and subsurface inputs dropped (as it rendered them before it had them) for
-``layers``. ``--reuse-cycles`` takes Cycles' means from the ``--store`` table instead of rendering (hybridgen
+"Before" is per group (:data:`BEFORE`): Mitsuba's ``principled`` (``HYBRIDGEN_PRINCIPLED=mitsuba``) for the
+``principled`` sweep, hybridgen's BSDF with the sheen and subsurface inputs dropped for ``layers``, the coat bent by
+the base's map for ``coat_normal``, emission unweighted by the layers for ``emission``; when Cycles is rendered, the
+per-pixel relative RMS difference of each model's image to Cycles' is printed per object too.
+``--test-view-only`` (with ``--store``) renders and stores only the group's test view. ``--reuse-cycles`` takes Cycles' means from the ``--store`` table instead of rendering (hybridgen
 changed, Cycles did not). ``--store`` writes the scene settings and Cycles' per-object means of the group's
 sweep and test view into the JSON table tests/render/test_principled_vs_cycles.py checks (the other group's
 entries are kept).

@@ -34,7 +34,7 @@ PLACEMENT_PARAMS: tuple[Param, ...] = (
           doc="principled values replacing the file's: base_color, roughness, metallic, specular, transmission, ior, "
               "alpha, alpha_mode, emission, emission_strength, and maps (paths): base_color_texture, "
               "roughness_texture, metallic_texture, alpha_texture, normal_texture (normal_y_down), "
-              "displacement_texture (displacement_scale), specular_texture, emission_texture"),
+              "displacement_texture (displacement_scale), specular_texture, emission_texture, coat_normal_texture"),
 )
 
 
