@@ -10,26 +10,10 @@ import math
 import numpy as np
 import pytest
 
-from tests.render.test_principled_bsdf import sphere_grid
+from tests.render.test_principled_bsdf import mi, sphere_grid  # noqa: F401 - mi: the variant fixture
 
 SAMPLES = 1 << 16
 TILT = np.array([0.45, -0.25, 0.857])  # a constant tangent-space normal, 31 degrees off the surface's
-
-
-@pytest.fixture(scope="module")
-def mi(request: pytest.FixtureRequest):
-    from hybridgen.render.pathtrace.mitsuba_variant import choose_variant, is_jit
-
-    variant = choose_variant(None)
-    if not is_jit(variant):
-        pytest.skip("hybridgen's Principled BSDF renders in the JIT variants")
-    import mitsuba
-
-    mitsuba.set_variant(variant)
-    from hybridgen.render.pathtrace.principled_bsdf import register
-
-    register(variant)
-    return mitsuba
 
 
 def _map(mi, normal=TILT):
