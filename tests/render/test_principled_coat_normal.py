@@ -193,9 +193,11 @@ def test_emission_weight_under_coat_and_sheen(mi, mu) -> None:
     np.testing.assert_allclose(absorbed, [t ** (1.0 / cos_t) for t in tint], rtol=1e-5)
 
 
-def test_coat_normal_texture_reaches_the_plugin_only_for_coated_materials(mi, tmp_path) -> None:
-    """The material's maps go into the plugin (no ``normalmap`` wrapper) when it has a coat; without a coat the
-    base's map keeps Mitsuba's wrapper (materials without a coat render as before) and the coat's is unused."""
+def test_normal_maps_reach_the_plugin_coat_normal_only_for_coated_materials(mi, tmp_path) -> None:
+    """The material's maps go into the plugin (no ``normalmap`` wrapper, Cycles' normal-map rules); without a coat
+    the base's map still does and the coat's is unused; a Lambertian material keeps Mitsuba's wrapper."""
+    from dataclasses import replace
+
     from PIL import Image
 
     from hybridgen.config.material_config import apply_material_config
@@ -210,5 +212,10 @@ def test_coat_normal_texture_reaches_the_plugin_only_for_coated_materials(mi, tm
     assert material.coat_normal_texture == str(path) and material.uses_uvs
     coated = bsdf_dict(material, "ball")
     assert coated["type"] != "normalmap" and {"normal_map", "coat_normal_map"} <= set(coated)
-    uncoated = bsdf_dict(apply_material_config(material, {"coat_weight": 0.0}), "ball")
-    assert uncoated["type"] == "normalmap" and "coat_normal_map" not in uncoated["bsdf"]
+    uncoated_material = apply_material_config(material, {"coat_weight": 0.0})
+    uncoated = bsdf_dict(uncoated_material, "ball")
+    assert uncoated["type"] != "normalmap" and "normal_map" in uncoated and "coat_normal_map" not in uncoated
+    coat_map_only = bsdf_dict(replace(uncoated_material, normal_texture=None), "ball")
+    assert coat_map_only["type"] != "normalmap" and not {"normal_map", "coat_normal_map"} & set(coat_map_only)
+    lambertian = bsdf_dict(apply_material_config(Material(specular=0.0), {"normal_texture": str(path)}), "ball")
+    assert lambertian["type"] == "twosided" and lambertian["material"]["type"] == "normalmap"

@@ -10,9 +10,9 @@ The BSDF is built inside out:
   of a few specular amounts per texel (:func:`specular_levels`);
 - ``normalmap`` around it for a tangent-space normal map (Mitsuba's tangent frame: x = dP/du projected
   into the surface, y = n x x, i.e. +v for a right-handed UV layout, the OpenGL convention; DirectX maps
-  get their green channel inverted first) - except for a coated material in hybridgen's Principled BSDF, which
-  takes the map (and the coat's own, ``coat_normal_texture``) itself: Blender's coat does not bend with the
-  base's map (:mod:`.principled_frames`);
+  get their green channel inverted first) - except in hybridgen's Principled BSDF, which takes the map (and a
+  coat's own, ``coat_normal_texture``) itself and follows Cycles' normal-map rules: Blender's coat does not bend
+  with the base's map, and Cycles lifts and tests mapped normals differently (:mod:`.principled_frames`);
 - ``bumpmap`` for a displacement map: shading normals of the surface displaced by h x scale metres (the
   texture's gradient with respect to UV times ``displacement_scale``; the 0.5 mid level of Blender's node
   does not change a gradient);
@@ -219,8 +219,9 @@ def bsdf_dict(material: Material, owner: str, *, vertex_colors: bool = False, uv
     else:
         bsdf = _specular_bsdf(material, owner, base, levels, weights)
     if blender and bsdf.get("type") != "diffuse" and principled_material.layer_normals(material):
+        coated = principled_material.has_coat(material)  # uncoated: the Coat Normal map changes nothing
         for key, slot in (("normal_map", "normal_texture"), ("coat_normal_map", "coat_normal_texture")):
-            if getattr(material, slot) is not None:  # a frame per layer, inside the BSDF
+            if getattr(material, slot) is not None and (coated or key == "normal_map"):  # a frame per layer
                 bsdf[key] = data_texture(getattr(material, slot), owner, slot, channels=3,
                                          invert_green=material.normal_y_down)
     elif material.normal_texture is not None:

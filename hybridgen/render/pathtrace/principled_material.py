@@ -82,11 +82,17 @@ def plugin_dict(material: Material, owner: str, base: dict[str, Any], roughness:
 
 
 def layer_normals(material: Material) -> bool:
-    """Whether ``material``'s layers need frames of their own: a coat (Coat Weight > 0) and a normal map on the
-    Normal or Coat Normal input (Blender 4.2's coat ignores the Normal input's map; :mod:`.principled_frames`).
-    The plugin then takes the maps as ``normal_map`` / ``coat_normal_map``
-    (:func:`~.mitsuba_materials.bsdf_dict`) instead of sitting in a ``normalmap`` wrapper."""
-    coat = material.extra.get("coat_weight", 0.0)
-    has_coat = isinstance(coat, (int, float)) and coat > 0
-    return has_coat and (material.normal_texture is not None or material.coat_normal_texture is not None)
+    """Whether ``material``'s normal maps go into the BSDF, evaluated with a frame per layer and Cycles'
+    normal-map rules (:mod:`.principled_frames`): a normal map on the Normal input, or a coat (Coat Weight > 0)
+    with one on Coat Normal (Blender 4.2's coat ignores the Normal input's map; without a coat the Coat Normal
+    map changes nothing). The plugin then takes the maps as ``normal_map`` / ``coat_normal_map``
+    (:func:`~.mitsuba_materials.bsdf_dict`) instead of sitting in Mitsuba's ``normalmap`` wrapper, whose rules
+    (mirrored tangent part, same-side test against the interpolated normal) differ from Cycles' at steep normals
+    (docs/principled_bsdf.md)."""
+    return material.normal_texture is not None or (has_coat(material) and material.coat_normal_texture is not None)
 
+
+def has_coat(material: Material) -> bool:
+    """Whether ``material`` has a coat (Coat Weight > 0 in ``extra``)."""
+    coat = material.extra.get("coat_weight", 0.0)
+    return isinstance(coat, (int, float)) and coat > 0
