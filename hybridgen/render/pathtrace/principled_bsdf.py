@@ -97,8 +97,8 @@ def register(variant: str) -> None:
             self.sheen_rough = min(max(float(props.get("sheen_roughness", 0.5)), 0.0), 1.0)
             self.sheen_tint = color(props, "sheen_tint")
             self.subsurface = min(max(float(props.get("subsurface_weight", 0.0)), 0.0), 1.0)
-            # tangent-space normal maps of the Normal and Coat Normal inputs (principled_frames.py): given for a
-            # coated material, whose coat then bends only with its own map
+            # tangent-space normal maps of the Normal and Coat Normal inputs (principled_frames.py, Cycles' rules):
+            # a coat bends only with its own map
             self.normal_map, self.coat_normal_map = (texture(props, name) for name in ("normal_map", "coat_normal_map"))
             self.layer_frames = self.normal_map is not None or self.coat_normal_map is not None
             components = [flags.DiffuseReflection | both, flags.GlossyReflection | both]

@@ -1,7 +1,7 @@
 """hybridgen's Principled BSDF with a frame per layer: what :class:`~.principled_bsdf.PrincipledBSDF` evaluates and
-samples when it holds a normal map (``normal_map`` / ``coat_normal_map``, given for coated materials), so that the
-base bends with the Normal input's map, the coat with the Coat Normal input's (unlinked: the shading normal) and
-the sheen with their mix, as Blender 4.2 does (:mod:`.principled_frames`).
+samples when it holds a normal map (``normal_map``: any material with a Normal map; ``coat_normal_map``: a coated
+one with a Coat Normal map), so that the base bends with the Normal input's map, the coat with the Coat Normal
+input's (unlinked: the shading normal) and the sheen with their mix, as Blender 4.2 does (:mod:`.principled_frames`).
 
 Directions ``wo`` are in Mitsuba's shading-frame coordinates (``si.sh_frame``), as the BSDF interface passes them;
 each layer's lobes see them in its own local coordinates. Reflections count where ``wo`` lies on the viewer's side
