@@ -264,14 +264,17 @@ def save_sample_counts(scene: bpy.types.Scene, path: str) -> None:
     (float32 H x W) in ``path``
     (.npy): written through an uncompressed multilayer EXR next to it, which is removed."""
     settings = scene.render.image_settings
-    saved = (settings.media_type, settings.exr_codec, settings.color_depth)
+    # Blender 5 picks a multilayer EXR by media_type, Blender 4.2 (BlenderProc's) by file_format
+    kind, multilayer = (("media_type", "MULTI_LAYER_IMAGE") if hasattr(settings, "media_type")
+                        else ("file_format", "OPEN_EXR_MULTILAYER"))
+    saved = (getattr(settings, kind), settings.exr_codec, settings.color_depth)
     exr = path + ".exr"
-    settings.media_type = "MULTI_LAYER_IMAGE"
+    setattr(settings, kind, multilayer)
     settings.exr_codec, settings.color_depth = "NONE", "32"
     try:
         bpy.data.images["Render Result"].save_render(exr, scene=scene)
     finally:
-        settings.media_type = saved[0]
+        setattr(settings, kind, saved[0])
         settings.exr_codec, settings.color_depth = saved[1], saved[2]
     channels = read_exr_channels(exr)
     os.remove(exr)
