@@ -139,7 +139,7 @@ def print_profile(spent: dict[str, float], markdown: bool) -> None:
     for name, seconds in rows:
         table.row(name, seconds, seconds / spent["whole_process"])
     table.row("whole process", spent["whole_process"], 1.0)
-    table.row("denoise (own thread, beside the next frame)", spent.get("denoise", 0.0),
+    table.row("denoise, guide filtering (own thread, beside)", spent.get("denoise", 0.0),
               spent.get("denoise", 0.0) / spent["whole_process"])
 
 

@@ -23,9 +23,9 @@ render, ``{"K": 3x3, "cam2world": [4x4 per frame, Blender camera axes], "objects
 ``--profile PATH`` (hybridgen only) writes a JSON object of wall seconds per stage: ``imports`` (hybridgen and
 its bproc layer), ``scene_load`` (``bproc.loader.*``), ``render`` (``bproc.renderer.render`` as a whole) and, within
 it, ``mitsuba_scene`` (building Mitsuba's scene), ``sampling`` (path tracing, split by Dr.Jit's kernel history into
-``kernel_compile`` and the rest), ``labels`` (raster label passes), ``denoise_guides`` (drawing or waiting for the
-guides), ``denoise`` (Open Image Denoise: on the color producer's own thread, overlapping the next keypoint's
-sampling), ``denoise_wait`` (the render loop waiting for a keypoint's denoised colors), then ``write``
+``kernel_compile`` and the rest), ``labels`` (raster label passes), ``denoise_guides`` (drawing, filtering or
+waiting for the guides on the render loop's thread), ``denoise`` (Open Image Denoise and the guides' filtering on the
+color producer's own thread, overlapping the next keypoint's sampling), ``denoise_wait`` (the render loop waiting for a keypoint's denoised colors), then ``write``
 (``bproc.writer.*``) and ``in_process`` (everything after the interpreter started, to exit).
 """
 from __future__ import annotations
@@ -35,6 +35,7 @@ import atexit
 import json
 import os
 import sys
+import threading
 import time
 from typing import Any
 
@@ -133,7 +134,14 @@ def instrument_hybridgen(spent: dict[str, float]) -> None:
                 setattr(module, name, accumulating(spent, stage, getattr(module, name)))
     PathTraceView.__init__ = accumulating(spent, "mitsuba_scene", PathTraceView.__init__)
     LabelProducer.produce = accumulating(spent, "labels", LabelProducer.produce)
-    DenoiseGuides.render = accumulating(spent, "denoise_guides", DenoiseGuides.render)
+    DenoiseGuides.draw = accumulating(spent, "denoise_guides", DenoiseGuides.draw)
+    filtered = DenoiseGuides.filtered
+
+    def filter_guides(*args: Any, **kwargs: Any) -> Any:  # the render loop's thread, or the denoising thread
+        stage = "denoise_guides" if threading.current_thread() is threading.main_thread() else "denoise"
+        return accumulating(spent, stage, filtered)(*args, **kwargs)
+
+    DenoiseGuides.filtered = filter_guides
     GuideWorker.result = accumulating(spent, "denoise_guides", GuideWorker.result)
     render_color.oidn_denoise = accumulating(spent, "denoise", render_color.oidn_denoise)
     produce_later = render_color.ColorProducer.produce_later

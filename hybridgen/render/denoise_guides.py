@@ -70,6 +70,15 @@ class DenoiseGuides:
         """(albedo, normals) of one keypoint (OpenCV-axes ``cam2world``); with ``path_view`` (the color's
         :class:`~hybridgen.render.pathtrace.path_trace.PathTraceView`, JIT variants) and ``follow_specular`` they follow
         sharp specular surfaces (:mod:`hybridgen.render.pathtrace.specular_guides`)."""
+        return self.filtered(self.draw(cam2world, path_view))
+
+    def filtered(self, fine: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """(albedo, normals) at the image's resolution from :meth:`draw`'s supersampled ones: NumPy only, so any
+        thread may do it (the GL context's thread draws)."""
+        return self._box(fine[0]), self._box(fine[1])
+
+    def draw(self, cam2world: np.ndarray, path_view: Any = None) -> tuple[np.ndarray, np.ndarray]:
+        """The supersampled (albedo, normals) of :meth:`render`, before :meth:`filtered`."""
         tracer = self._tracer_for(path_view)
         fine = self.fine
         albedo = self.raster.albedo.render(cam2world, intrinsics=fine)
@@ -81,7 +90,7 @@ class DenoiseGuides:
             normals = np.array(normals, dtype=np.float32)
             self.traced_subpixels = tracer.apply(cam2world, fine, np.asarray(passes["instance_segmaps"]),
                                                  albedo, normals)
-        return self._box(albedo), self._box(normals)
+        return albedo, normals
 
     def _tracer_for(self, path_view: Any) -> SpecularGuideTracer | None:
         """The tracer of ``path_view``'s Mitsuba scene (rebuilt with it), or None where nothing is traced."""

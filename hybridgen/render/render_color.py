@@ -81,8 +81,7 @@ class ColorProducer:
                 "noise_threshold": plan.noise_threshold, "adaptive_sampling": plan.adaptive,
                 "clamp_indirect": s.clamp_indirect if self.view.clamped else 0.0,
                 "filter_glossy": s.filter_glossy if self.view.own_integrator else 0.0,
-                **({"edge_min_samples": plan.edge_min_samples}
-                   if plan.adaptive and plan.edge_min_samples and self.denoise else {}),
+                **({"edge_min_samples": plan.edge_min_samples} if plan.edge_floor and self.denoise else {}),
                 "pixel_filter": (f"Blackman-Harris, filter_width {self.view.filter_width} px" if self.view.filter_width
                                  else "box, 1 px"),
                 "min_bounces": s.min_bounces, "max_bounces": s.max_bounces, "mitsuba_max_depth": s.max_bounces + 2,
@@ -106,7 +105,7 @@ class ColorProducer:
         plan = self.settings.plan()
         guides = None
         edges = None
-        if self.denoise and plan.adaptive and plan.edge_min_samples:  # the guides' edges get more samples
+        if self.denoise and plan.edge_floor:  # the guides' edges get more samples
             if drawing is None and self._guides is not None:  # the shared raster: guides drawn first
                 guides = self._guides.render(cam2world, self.view)
             edges = partial(_edges_of, worker, drawing, guides)
@@ -116,9 +115,10 @@ class ColorProducer:
             values["colors_raw"] = to_srgb8(linear)
         if self.sample_counts:
             values["sample_counts"] = counts
-        if drawing is None and guides is None and self._guides is not None:  # drawn here: the GL context's thread
-            guides = self._guides.render(cam2world, self.view)
-        finish = partial(self._finish, values, linear, worker if drawing is not None else None, drawing, guides)
+        fine = None  # drawn here, on the GL context's thread, and filtered on the denoising thread
+        if drawing is None and guides is None and self._guides is not None:
+            fine = self._guides.draw(cam2world, self.view)
+        finish = partial(self._finish, values, linear, worker if drawing is not None else None, drawing, guides, fine)
         if not self.denoise:
             return finish
         if self._denoiser is None:
@@ -126,13 +126,15 @@ class ColorProducer:
         return self._denoiser.submit(finish).result
 
     def _finish(self, values: dict[str, Any], linear: np.ndarray, worker: GuideWorker | None, drawing: Any,
-                guides: tuple[np.ndarray, np.ndarray] | None) -> dict[str, Any]:
-        """``values`` completed with the keypoint's colors: ``linear`` denoised with the guides (drawn, or
-        ``worker``'s ``drawing``) when denoising, then encoded."""
+                guides: tuple[np.ndarray, np.ndarray] | None,
+                fine: tuple[np.ndarray, np.ndarray] | None) -> dict[str, Any]:
+        """``values`` completed with the keypoint's colors: ``linear`` denoised with the guides (``guides``, the
+        supersampled ``fine`` ones filtered here, or ``worker``'s ``drawing``) when denoising, then encoded."""
         if worker is not None:
             linear = oidn_denoise(linear, *worker.result(drawing))
-        elif guides is not None:
-            linear = oidn_denoise(linear, *guides)
+        elif guides is not None or fine is not None:
+            assert self._guides is not None
+            linear = oidn_denoise(linear, *(guides if guides is not None else self._guides.filtered(fine)))
         values["colors"] = to_srgb8(linear)
         if self.hdr:
             values["colors_hdr"] = linear.astype(np.float16)

@@ -117,6 +117,11 @@ class SamplingPlan:
     def adaptive(self) -> bool:
         return self.noise_threshold > 0
 
+    @property
+    def edge_floor(self) -> bool:
+        """Whether ``edge_min_samples`` gives some pixels more samples than the first round."""
+        return self.adaptive and self.edge_min_samples > self.rounds()[0]
+
     def rounds(self) -> list[int]:
         """Samples added to every still-active pixel in each round. Adaptive rounds add even counts (the two
         halves stay equal), so an odd ``max_samples`` is rounded down by one there."""
@@ -180,7 +185,7 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
             unconverged = np.zeros(h * w, dtype=bool)
             unconverged[active] = error >= plan.noise_threshold * CYCLES_THRESHOLD_SCALE
             keep = dilate(unconverged.reshape(h, w)).ravel()
-            if plan.edge_min_samples and edges is not None:
+            if plan.edge_floor and edges is not None:
                 if floor is None:
                     found = edges()
                     floor = np.zeros(h * w, dtype=bool) if found is None else np.asarray(found, dtype=bool).ravel()
