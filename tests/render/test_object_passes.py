@@ -107,18 +107,18 @@ def test_labels_and_denoising_guides_share_one_raster_view(gl_context, monkeypat
     alone = own.render(scene.camera.keypoints[0])
     own.release()
     built, guides = [], []
-    original_init, original_render = raster.RasterView.__init__, DenoiseGuides.render
+    original_init, original_filtered = raster.RasterView.__init__, DenoiseGuides.filtered
 
     def counting_init(self, *args, **kwargs):
         built.append(self)
         original_init(self, *args, **kwargs)
 
-    def keeping_render(self, cam2world, path_view=None):
-        guides.append(original_render(self, cam2world, path_view))
+    def keeping_filtered(self, fine):  # drawn on the shared view, filtered on the denoising thread
+        guides.append(original_filtered(self, fine))
         return guides[-1]
 
     monkeypatch.setattr(raster.RasterView, "__init__", counting_init)
-    monkeypatch.setattr(DenoiseGuides, "render", keeping_render)
+    monkeypatch.setattr(DenoiseGuides, "filtered", keeping_filtered)
     sink = MemorySink()
     render_color(scene, [sink], PathTraceSettings(samples=2, max_bounces=1), labels=hg.LabelRequest(albedo=True),
                  denoise=True)
