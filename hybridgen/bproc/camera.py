@@ -205,8 +205,7 @@ def get_camera_frustum_as_object(clip_start: float | None = None, clip_end: floa
     part = cube.parts[0]
     signs = (part.vertices > 0).astype(int)  # Blender's cube: vertex (sx, sy, sz) is product's index 4x + 2y + z
     part.vertices = corners[signs @ np.array([4, 2, 1])]
-    for derived in ("face_normals", "is_closed"):
-        part.__dict__.pop(derived, None)
+    part.forget_derived()
     return cube
 
 

@@ -210,7 +210,7 @@ def load_objects(path: str | Path, *, name: str | None = None, category_id: int 
     if obj_names is not None:  # keep the file's object order (trimesh lists them last-first)
         order = {n: i for i, n in enumerate(obj_names)}
         parts.sort(key=lambda part: order[part[0]])
-    smoothing = smooth_objects(file) if file_type == "obj" else {}
+    smoothing: dict[str | None, bool | None] | None = None if file_type == "obj" else {}  # read when first needed
     distinct = list(dict.fromkeys(p[0] for p in parts))
     counts = {n: sum(1 for p in parts if p[0] == n) for n in distinct}
     split = [n for n in distinct if counts[n] > 1]
@@ -231,7 +231,9 @@ def load_objects(path: str | Path, *, name: str | None = None, category_id: int 
             vertices = np.asarray(geometry.vertices, dtype=np.float64) @ rotation.T
             normals = (np.asarray(geometry.vertex_normals, dtype=np.float64) @ rotation.T
                        if _has_loaded_normals(geometry) else None)
-            shading = smoothing.get(part_name if obj_names is not None else None, False)
+            if normals is None and smoothing is None:  # only OBJ objects without normals need the s lines
+                smoothing = smooth_objects(file)
+            shading = False if smoothing is None else smoothing.get(part_name if obj_names is not None else None, False)
             if normals is None and shading:  # s 1 without vn: Blender shades smooth (io/obj_smoothing)
                 normals = blender_smooth_normals(vertices, np.asarray(geometry.faces), weld=uv is not None)
             elif normals is None and shading is None and notify is not None:

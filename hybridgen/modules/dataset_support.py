@@ -64,8 +64,7 @@ def move_origin_to_bottom_centre(objects: list[MeshObject]) -> None:
     for obj in objects:
         shift_local = np.linalg.solve(obj.local2world[:3, :3], shift_world)
         obj.vertices = obj.vertices + shift_local
-        obj.__dict__.pop("is_closed", None)  # cached properties of the old vertices
-        obj.__dict__.pop("face_normals", None)
+        obj.forget_derived()
 
 
 def nonnegative(value: Any, key: str) -> float:

@@ -169,7 +169,6 @@ class IKEALoader(_ModelLoader):
             obj.name = chosen.parent.name
             if scale != 1.0:
                 obj.vertices = obj.vertices * scale
-                obj.__dict__.pop("face_normals", None)
-                obj.__dict__.pop("is_closed", None)
+                obj.forget_derived()
         move_origin_to_bottom_centre(objects)
         self._add(context, objects)

@@ -42,8 +42,7 @@ def shade_objects(objects: list[MeshObject], mode: str, angle_deg: float) -> Non
         shaded = done[key]
         obj.vertices, obj.faces, obj.vertex_normals = shaded.vertices, shaded.faces, shaded.vertex_normals
         obj.uvs, obj.vertex_colors = shaded.uvs, shaded.vertex_colors
-        obj.__dict__.pop("face_normals", None)  # cached properties of the old arrays
-        obj.__dict__.pop("is_closed", None)
+        obj.forget_derived()
 
 
 @register_module("object.Shading")

@@ -35,7 +35,6 @@ for GLOBAL coordinates and white NOISE, whose values differ per object.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -125,7 +124,6 @@ def displaced_parts(parts: list[MeshObject], modifier: Displacement,
     return out  # type: ignore[return-value]
 
 
-_CACHED = [name for name, value in vars(MeshObject).items() if isinstance(value, cached_property)]
 _ARRAYS = ("vertices", "faces", "uvs", "vertex_normals", "vertex_colors")
 
 
@@ -143,6 +141,5 @@ def displace_object(parts: list[MeshObject], modifier: Displacement,
     for part, result in zip(parts, done[key][1]):
         for name in _ARRAYS:
             setattr(part, name, getattr(result, name))
-        for name in _CACHED:
-            part.__dict__.pop(name, None)
+        part.forget_derived()
         part.validate()

@@ -132,9 +132,14 @@ class MeshObject:
         self.vertices = np.ascontiguousarray(vertices, dtype=np.float64).reshape(-1, 3)
         self.faces = np.ascontiguousarray(faces, dtype=np.int64).reshape(-1, 3)
         self.uvs, self.vertex_normals, self.vertex_colors = uvs, vertex_normals, None
-        for name in ("face_normals", "is_closed"):
-            self.__dict__.pop(name, None)
+        self.forget_derived()
         self.validate()
+
+    def forget_derived(self) -> None:
+        """Drop what was computed from the mesh arrays (the cached properties: face normals, closedness); call it
+        after changing ``vertices`` or ``faces`` in place or on a copy."""
+        for name in _DERIVED:
+            self.__dict__.pop(name, None)
 
     def world_vertices(self) -> np.ndarray:
         """(V, 3) vertices in world coordinates."""
@@ -146,6 +151,10 @@ class MeshObject:
         record.update({k: v for k, v in self.attributes.items() if _is_json_scalar(v)})
         record["local2world"] = self.local2world.tolist()
         return record
+
+
+_DERIVED = tuple(name for name, value in vars(MeshObject).items() if isinstance(value, cached_property))
+"""The cached properties of :class:`MeshObject` (derived from its arrays)."""
 
 
 def _is_json_scalar(value: Any) -> bool:

@@ -117,8 +117,7 @@ class PolygonMesh:
                                           return_inverse=True)
             chosen = used[first]
             twin = copy.copy(template)
-            for derived in ("face_normals", "is_closed"):
-                twin.__dict__.pop(derived, None)
+            twin.forget_derived()
             twin.vertices = self.positions[self.corners[chosen]]
             twin.faces = inverse.reshape(-1, 3).astype(np.int64)
             for name in ATTRIBUTES:

@@ -24,8 +24,7 @@ def transformed_part(part: ScenePart, matrix: np.ndarray) -> ScenePart:
     """A copy of ``part`` with its vertices (and vertex normals) moved by the 4x4 ``matrix``."""
     linear = matrix[:3, :3]
     twin = copy.copy(part)
-    for derived in ("face_normals", "is_closed"):
-        twin.__dict__.pop(derived, None)
+    twin.forget_derived()
     twin.vertices = part.vertices @ linear.T + matrix[:3, 3]
     if part.vertex_normals is not None:
         normals = part.vertex_normals @ np.linalg.inv(linear)
@@ -66,8 +65,7 @@ class MeshEditing:
             source, uvs, new_faces = corner_vertices(part.faces, corner_uvs[start:start + count])
             start += count
             twin = copy.copy(part)
-            for derived in ("face_normals", "is_closed"):
-                twin.__dict__.pop(derived, None)
+            twin.forget_derived()
             twin.vertices, twin.faces, twin.uvs = part.vertices[source], new_faces, uvs
             if part.vertex_normals is not None:
                 twin.vertex_normals = part.vertex_normals[source]
