@@ -32,8 +32,11 @@ def mi(request: pytest.FixtureRequest):
 
 
 def bsdf(mi, base=(1.0, 1.0, 1.0), **inputs):
+    """The plugin with ``inputs``; refraction valued only where a microfacet connects the pair (``physical``)
+    unless ``refraction_pairs`` says otherwise, so that eval and pdf integrate to what sampling returns."""
     from hybridgen.render.pathtrace.principled_bsdf import PLUGIN_NAME
 
+    inputs.setdefault("refraction_pairs", "physical")
     for name in ("specular_tint", "coat_tint", "sheen_tint"):
         if name in inputs:
             inputs[name] = mi.ScalarColor3f(inputs[name])
@@ -297,3 +300,43 @@ def test_sheen_lobe_matches_cycles_measured_lobe(mi) -> None:
                                 mi.Vector3f(light[:, k].T.astype(np.float32))), np.float64)[0]
         cycles = data["value"][:, k].astype(np.float64)
         assert np.abs(value - cycles).sum() <= tolerance * cycles.sum() + 1e-4, (mu, rough)
+
+
+@pytest.mark.parametrize("back", [False, True])
+@pytest.mark.parametrize("roughness,mu", [(0.5, 0.6), (0.8, 0.3)])
+def test_cycles_refraction_pairs_add_only_unconnected_pairs(mi, back, roughness, mu) -> None:
+    """``refraction_pairs="cycles"`` (the default, Blender 4.2's evaluation) samples exactly as ``physical`` and values
+    every physically connected pair alike; it adds values only where no microfacet refracts one direction into
+    the other (the generalized half vector on the wrong side of either direction), which light samples reach."""
+    inputs = dict(base=(0.3, 0.9, 0.4), roughness=roughness, transmission=1.0, ior=1.45)
+    physical, cycles = bsdf(mi, **inputs), bsdf(mi, **inputs, refraction_pairs="cycles")
+    from hybridgen.render.pathtrace.principled_bsdf import PLUGIN_NAME
+
+    assert mi.load_dict({"type": PLUGIN_NAME}).refraction_pairs == "cycles"  # Blender's, the default
+    wo_p, w_p, pdf_p = sampled(mi, physical, mu, back, n=1 << 14)
+    wo_c, w_c, pdf_c = sampled(mi, cycles, mu, back, n=1 << 14)
+    np.testing.assert_array_equal(wo_c, wo_p)
+    np.testing.assert_allclose(w_c, w_p, rtol=1e-5, atol=1e-7)
+    np.testing.assert_allclose(pdf_c, pdf_p, rtol=1e-5, atol=1e-7)
+    directions, cell = sphere_grid()
+    si = interaction(mi, mu, len(directions), back)
+    wo = mi.Vector3f(directions.T.astype(np.float32))
+    values = {}
+    for name, b in (("physical", physical), ("cycles", cycles)):
+        value, _ = b.eval_pdf(mi.BSDFContext(), si, wo)
+        values[name] = np.array(value, np.float64).T.mean(axis=1)
+    # the pair's generalized half vector in the flipped frame (view up), as Walter et al. define it
+    wi = np.array([math.sqrt(1.0 - mu * mu), 0.0, mu])
+    local = directions * np.array([1.0, 1.0, -1.0 if back else 1.0])
+    eta = 1.0 / 1.45 if back else 1.45
+    h = wi[None, :] + eta * local
+    h = -h if eta > 1.0 else h
+    h /= np.linalg.norm(h, axis=1, keepdims=True)
+    below = local[:, 2] < 0.0
+    connected = below & (h[:, 2] > 0.0) & (h @ wi > 0.0) & (np.sum(h * local, axis=1) < 0.0)
+    np.testing.assert_allclose(values["cycles"][connected], values["physical"][connected], rtol=1e-4, atol=1e-9)
+    np.testing.assert_allclose(values["cycles"][~below], values["physical"][~below], rtol=1e-4, atol=1e-9)
+    extra = below & ~connected
+    assert np.all(values["physical"][extra] <= 1e-7)
+    added = float(values["cycles"][extra].sum() * cell)
+    assert added > 0.01, added  # a rough glass gains visibly where only light samples go

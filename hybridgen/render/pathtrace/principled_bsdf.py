@@ -15,7 +15,10 @@ stays the scene's area emitter and alpha the ``mask`` wrapper (:mod:`.mitsuba_ma
 Sampling picks one lobe with probability proportional to its estimated albedo (Cycles' sample weights, plus
 :data:`~.principled_layers.MIN_LOBE_SHARE`), draws a direction from it (visible GGX normals, a cosine
 lobe for the diffuse base, the transformed cosine for sheen) and returns the whole BSDF's value over the whole
-mixture's pdf, so ``sample``, ``eval``, ``pdf`` and ``eval_pdf`` agree exactly. The BSDF answers
+mixture's pdf, so ``sample``, ``eval``, ``pdf`` and ``eval_pdf`` agree exactly at every sampled direction.
+``refraction_pairs`` (:data:`REFRACTION_PAIRS`): ``cycles`` (the default) also values the refraction pairs no
+microfacet connects, as Cycles 4.2 does (light samples reach them, BSDF samples never), ``physical`` values only
+real refractions, so that ``eval`` and ``pdf`` integrate to what sampling returns. The BSDF answers
 ``has_attribute`` / ``eval_attribute_1`` for ``roughness``, ``metallic`` and ``spec_trans`` (the transmission weight) as Mitsuba's ``principled`` does,
 which the path tracer's singular-surface test reads.
 
@@ -30,6 +33,11 @@ from typing import Any
 from .mitsuba_variant import is_jit
 
 PLUGIN_NAME = "hybridgen_principled"
+REFRACTION_PAIRS = ("cycles", "physical")
+"""Values of the plugin's ``refraction_pairs``: which direction pairs the rough refraction lobe values
+(:func:`~.principled_lobes.refraction`: ``cycles`` = every pair across the surface, Blender 4.2's evaluation;
+``physical`` = the pairs some microfacet refracts into each other)."""
+DEFAULT_REFRACTION_PAIRS = "cycles"
 
 
 def available(variant: str) -> bool:
@@ -97,6 +105,9 @@ def register(variant: str) -> None:
             self.sheen_rough = min(max(float(props.get("sheen_roughness", 0.5)), 0.0), 1.0)
             self.sheen_tint = color(props, "sheen_tint")
             self.subsurface = min(max(float(props.get("subsurface_weight", 0.0)), 0.0), 1.0)
+            self.refraction_pairs = str(props.get("refraction_pairs", DEFAULT_REFRACTION_PAIRS))
+            if self.refraction_pairs not in REFRACTION_PAIRS:
+                raise ValueError(f"refraction_pairs must be one of {REFRACTION_PAIRS}, got '{self.refraction_pairs}'")
             # tangent-space normal maps of the Normal and Coat Normal inputs (principled_frames.py, Cycles' rules):
             # a coat bends only with its own map
             self.normal_map, self.coat_normal_map = (texture(props, name) for name in ("normal_map", "coat_normal_map"))
@@ -120,7 +131,8 @@ def register(variant: str) -> None:
                 has_transmission=self.transmission > 0, has_coat_tint=any(c != 1.0 for c in self.coat_tint),
                 sheen=mi.Float(self.sheen), sheen_rough=mi.Float(self.sheen_rough),
                 sheen_tint=mi.Color3f(self.sheen_tint), subsurface=mi.Float(self.subsurface),
-                has_sheen=self.sheen > 0, has_subsurface=self.subsurface > 0)
+                has_sheen=self.sheen > 0, has_subsurface=self.subsurface > 0,
+                every_refraction_pair=self.refraction_pairs == "cycles")
 
         def _frame(self, si: Any, active: Any, base: Any = None) -> Any:
             """Rotation of local directions into the anisotropy frame: Blender's default tangent (radial about

@@ -67,6 +67,7 @@ class Inputs:
     subsurface: Any = 0.0  # Subsurface Weight 0..1
     has_sheen: bool = False
     has_subsurface: bool = False
+    every_refraction_pair: bool = True  # Cycles' refraction evaluation (principled_lobes.refraction)
 
 
 @dataclass
@@ -96,6 +97,7 @@ class Layers:
     sheen_a: Any = None
     sheen_b: Any = None
     sheen_frame: Any = None
+    every_refraction_pair: bool = True  # see Inputs
 
 
 def _average(color: Any) -> Any:
@@ -225,7 +227,8 @@ def layers(inp: Inputs, wi: Any, backfacing: Any, wi_coat: Any = None, wi_sheen:
                   f0_glass=f0_glass, tint_glass=tint_glass, spec_w=spec_w, eta_spec=eta_spec, f0_spec=f0_spec,
                   diffuse_w=diffuse_w, shares=[f * norm for f in floored], sheen_w=sheen_w, sheen_a=sheen_ab[0],
                   sheen_b=sheen_ab[1],
-                  sheen_frame=sheen.sheen_frame(wi if wi_sheen is None else wi_sheen) if inp.has_sheen else None)
+                  sheen_frame=sheen.sheen_frame(wi if wi_sheen is None else wi_sheen) if inp.has_sheen else None,
+                  every_refraction_pair=inp.every_refraction_pair)
 
 
 def glass_reflect_probability(lay: Layers, cos_hi: Any) -> tuple[Any, Any, Any]:
@@ -256,7 +259,7 @@ def eval_pdf(lay: Layers, wi: Any, wo: Any, has_coat: bool, has_transmission: bo
     if has_transmission:
         g_refl, g_pdf, g_cos = lobes.reflection(wi, wo, lay.alpha_glass, lay.alpha_glass)
         p_reflect, f, _ = glass_reflect_probability(lay, g_cos)
-        g_refr, t_pdf, t_cos = lobes.refraction(wi, wo, lay.alpha_glass, lay.eta_glass)
+        g_refr, t_pdf, t_cos = lobes.refraction(wi, wo, lay.alpha_glass, lay.eta_glass, lay.every_refraction_pair)
         p_reflect_t, _, t = glass_reflect_probability(lay, t_cos)
         if base_ok is None:
             glass = lay.glass_w * (f * g_refl + t * g_refr)

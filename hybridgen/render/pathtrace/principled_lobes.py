@@ -131,13 +131,23 @@ def reflection(wi: Any, wo: Any, ax: Any, ay: Any) -> tuple[Any, Any, Any]:
     return value, pdf, dr.dot(h, wi)
 
 
-def refraction(wi: Any, wo: Any, alpha: Any, eta: Any) -> tuple[Any, Any, Any]:
+def refraction(wi: Any, wo: Any, alpha: Any, eta: Any, every_pair: bool = False) -> tuple[Any, Any, Any]:
     """Isotropic GGX refraction into relative IOR ``eta`` without Fresnel: (D G2 |h.wi| |h.wo| eta^2 /
-    (cos_i (h.wi + eta h.wo)^2), its visible-normal pdf, cos(h, wi)); zero unless ``wo`` is below."""
+    (cos_i (h.wi + eta h.wo)^2), its visible-normal pdf, cos(h, wi)); zero unless ``wo`` is below.
+
+    ``every_pair`` False: only pairs some microfacet refracts into each other (h up, h.wi > 0 > h.wo) have a value.
+    True: Cycles 4.2's evaluation, which skips that test (its "check if the refraction configuration is valid"
+    TODO) and values every pair with ``wo`` below by the same formula, h folded into the upper hemisphere (its D
+    depends on cos^2). Sampling never draws those pairs; they are reached by light samples only, so a rough glass
+    lit by small lights is brighter than the physical one (docs/principled_bsdf.md, "Refraction pairs")."""
     raw = wi + eta * wo  # the generalized half vector (Walter et al. 2007) points up for physical refractions
     h = dr.normalize(dr.select(eta > 1.0, -raw, raw))
+    if every_pair:
+        h = dr.select(h.z < 0.0, -h, h)
     cos_hi, cos_ho = dr.dot(h, wi), dr.dot(h, wo)
-    valid = (wo.z < 0.0) & (wi.z > 0.0) & (h.z > 0.0) & (cos_hi > 0.0) & (cos_ho < 0.0)
+    valid = (wo.z < 0.0) & (wi.z > 0.0)
+    if not every_pair:
+        valid &= (h.z > 0.0) & (cos_hi > 0.0) & (cos_ho < 0.0)
     d = ggx_d(h, alpha, alpha)
     li, lo = ggx_lambda(wi, alpha, alpha), ggx_lambda(wo, alpha, alpha)
     jacobian = eta * eta * dr.abs(cos_hi * cos_ho) / dr.maximum(dr.square(cos_hi + eta * cos_ho), 1e-12)
