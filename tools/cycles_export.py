@@ -47,9 +47,12 @@ def export_for_cycles(scene: Any, path: Path, spp: int, bounces: int, min_bounce
                         # existing exports (and the benchmark's reference digests) stay byte-identical
                         **({"extra": {k: list(v) if isinstance(v, (list, tuple)) else v for k, v in m.extra.items()}}
                            if m.extra else {})})
+    # AREA lights carry their edge ("size", m); tools/cycles_render_layers.py gives them to Cycles (a square of that
+    # edge, spread 180 degrees): scenes without one export as before (the benchmark's reference digests)
     lights = [{"type": light.type, "energy": float(light.energy), "color": [float(c) for c in light.color],
-               "radius": float(light.radius), "local2world": np.asarray(light.local2world).tolist()}
-              for light in scene.lights if light.type in ("POINT", "SUN")]
+               "radius": float(light.radius), "local2world": np.asarray(light.local2world).tolist(),
+               **({"size": float(light.size)} if light.type == "AREA" else {})}
+              for light in scene.lights if light.type in ("POINT", "SUN", "AREA")]
     world = scene.world
     intr = scene.camera.intrinsics
     meta = {"objects": objects, "world": (np.asarray(world.color)[:3] * world.strength).tolist(), "lights": lights,

@@ -1,22 +1,27 @@
-"""tools/cycles_render.py's Cycles worker with the Principled inputs its export leaves out: normal maps on the Normal
-and Coat Normal inputs, and emission through the Principled BSDF's own Emission inputs (under its coat and sheen).
+"""tools/cycles_render.py's Cycles worker with what its scene build leaves out: normal maps on the Principled BSDF's
+Normal and Coat Normal inputs, emission through the BSDF's own Emission inputs (under its coat and sheen), and the
+size of AREA lights.
 
 tools/cycles_render.py builds an emissive material as its BSDF plus an Emission shader (the same light for a
-material without coat or sheen) and links no normal map; its code is part of the color benchmark's Cycles
-reference digests (tools/reference_cache.py), so these additions live here, for the scenes that need them
-(:func:`needs_layers`), and the benchmark's exports and references stay as they were.
+material without coat or sheen), links no normal map and leaves an AREA light at Blender's default size; its code
+is part of the color benchmark's Cycles reference digests (tools/reference_cache.py), so these additions live
+here, for the scenes that need them (:func:`needs_layers`), and the benchmark's exports and references stay as
+they were.
 
 - hybridgen side (the project's venv): :func:`export_layers` adds to an export of tools/cycles_export.py the
   arrays ``nrm<i>`` / ``cnrm<i>`` (uint8 H x W x 3 tangent-space maps, OpenGL convention: a DirectX map's green
   inverted, rows top-down) with ``uv<i>``, and ``"principled_emission": true`` on objects whose emission lies
-  under a coat or sheen; :class:`LayersWorker` runs this file as the worker.
+  under a coat or sheen (tools/cycles_export.py already writes an AREA light's ``size``); :class:`LayersWorker`
+  runs this file as the worker.
 - bpy side (run as a script in ``.venv-bpy``, same protocol as tools/cycles_render.py)::
 
       .venv-bpy/bin/python tools/cycles_render_layers.py SCENE.npz
 
   builds the scene with tools/cycles_render.py's ``build``, then links each map through an Image Texture node
   (Non-Color, linear interpolation) and a Normal Map node (tangent space, the mesh's ``uv`` map, strength 1) to
-  the Principled BSDF's Normal / Coat Normal, and moves an emission into the BSDF's Emission Color / Strength.
+  the Principled BSDF's Normal / Coat Normal, moves an emission into the BSDF's Emission Color / Strength, and
+  makes each AREA light a square of the exported edge (m) with spread 180 degrees (a Lambertian emitter, one-sided:
+  its local -z side, as hybridgen's rectangle of radiance P / (size^2 pi)).
 """
 from __future__ import annotations
 
@@ -38,10 +43,11 @@ def _layered_emission(material: Any) -> bool:
 
 
 def needs_layers(scene: Any) -> bool:
-    """Whether a hybridgen scene has what tools/cycles_render.py does not export: a normal map, a coat normal
-    map, or emission under a coat or sheen."""
+    """Whether a hybridgen scene has what tools/cycles_render.py does not build: a normal map, a coat normal
+    map, emission under a coat or sheen, or an AREA light."""
     return any(o.material.normal_texture is not None or o.material.coat_normal_texture is not None
-               or _layered_emission(o.material) for o in scene.objects)
+               or _layered_emission(o.material) for o in scene.objects) \
+        or any(light.type == "AREA" for light in scene.lights)
 
 
 def _map(texture: Any, y_down: bool) -> np.ndarray:
@@ -124,11 +130,16 @@ def _principled_emission(material: Any) -> None:
 
 
 def add_layers(path: str) -> None:
-    """Link the export's normal maps and move its flagged emissions (the scene tools/cycles_render.py built)."""
+    """Link the export's normal maps, move its flagged emissions and size its AREA lights (the scene
+    tools/cycles_render.py built)."""
     import bpy
 
     data = np.load(path, allow_pickle=False)
     meta = json.loads(str(data["meta"]))
+    for index, spec in enumerate(meta.get("lights", [])):  # tools/cycles_render.py names them light<index>
+        if spec["type"] == "AREA":
+            light = bpy.data.lights[f"light{index}"]
+            light.shape, light.size, light.spread = "SQUARE", spec["size"], np.pi
     for i, spec in enumerate(meta["objects"]):
         material = bpy.data.objects[spec["name"]].data.materials[0]
         for key, socket in (("nrm", "Normal"), ("cnrm", "Coat Normal")):

@@ -3,9 +3,11 @@ the sphere-grid scenes, the small test views and the per-object masks (analytic 
 
 The scene: rows of :data:`COLUMNS` spheres (0.36 m across) over a grey Lambertian floor, each sphere one material
 of a sweep (:data:`GROUPS`), lit either by a sun (3 W/m^2, 50 degrees above the horizon) under a uniform grey-blue
-sky (``sun``), by the generated sky HDRI of tools/color_quality.py with its small bright sun (``hdri``), or by
-nothing (``dark``: black world, no lights, for emissive spheres). Spheres with a normal map (the ``bumps`` value of
-a texture field) are UV spheres (:func:`uv_sphere`) carrying :func:`bumps`; the others hybridgen's icosphere.
+sky (``sun``), by a square area light (:data:`AREA_LIGHT`: 1 m edge, 60 W, 2.5 m above the floor, tilted towards
+the spheres) under a black world (``area``), by the generated sky HDRI of tools/color_quality.py with its small
+bright sun (``hdri``), or by nothing (``dark``: black world, no lights, for emissive spheres). Spheres with a normal
+map (the ``bumps`` value of a texture field) are UV spheres (:func:`uv_sphere`) carrying :func:`bumps`; the others
+hybridgen's icosphere.
 Units: metres, linear RGB.
 """
 from __future__ import annotations
@@ -113,13 +115,24 @@ GROUP_LIGHTINGS = {"emission": ("dark",)}
 """Lightings a group is rendered under when not the default :data:`LIGHTINGS` (``dark``: black world, no lights:
 only the spheres' own emission)."""
 COLUMNS, SPACING, DIAMETER = 6, 0.46, 0.36
-LIGHTINGS = ("sun", "hdri")
-ALL_LIGHTINGS = ("sun", "hdri", "dark")
+LIGHTINGS = ("sun", "area", "hdri")
+ALL_LIGHTINGS = ("sun", "area", "hdri", "dark")
+AREA_LIGHT = dict(location=(0.4, -0.5, 2.5), rotation=(math.radians(16.0), 0.0, math.radians(36.0)), size=1.0,
+                  energy=60.0)
+"""The ``area`` lighting's light: a square Blender AREA light (Cycles: shape SQUARE, spread 180 degrees, one-sided)
+of edge ``size`` (m) and power ``energy`` (W) at ``location`` (m, world), turned by the XYZ Euler ``rotation``
+(rad) so its emitting side (local -z) faces the grid's centre from above the camera's side: about 3 W/m^2 on the
+spheres' tops, as the sun, and a highlight in every glossy sphere."""
 
 
 TEST_OBJECTS = ("red_s1_r03", "white_s05_r05", "grey_m1_r06", "copper_m1_r1")
 """The spheres of the small test view (``--store``; tests/render/test_principled_vs_cycles.py): objects whose
 color Mitsuba's principled got 7-55 % wrong."""
+
+
+TEST_AREA_OBJECTS = ("grey_s1_r01", "white_s05_r05", "gold_m1_r03", "red_coat")
+"""The spheres of the area-light test view: the area light's square mirrored sharply (roughness 0.1, a coat of
+0.1) and broadly (roughness 0.3 metal, 0.5 dielectric), compared with Cycles' image pixel by pixel too."""
 
 
 TEST_COAT_NORMAL_OBJECTS = ("cn_base_map", "cn_coat_map", "cn_red_base_map", "cn_sheen_coat_map")
@@ -156,7 +169,7 @@ def sphere_centers(count: int) -> list[tuple[float, float, float]]:
 def build_scene(lighting: str, width: int, height: int, workdir: Path,
                 names: tuple[str, ...] | None = None, group: str = "principled") -> Any:
     """The sweep scene of ``group`` (or only the spheres ``names``, in one row, framed closer) under
-    ``lighting`` (:data:`LIGHTINGS`) at ``width`` x ``height`` px."""
+    ``lighting`` (:data:`ALL_LIGHTINGS`) at ``width`` x ``height`` px."""
     import hybridgen as hg
 
     scene = hg.Scene()
@@ -185,12 +198,19 @@ def build_scene(lighting: str, width: int, height: int, workdir: Path,
         scene.world.color, scene.world.strength = (0.3, 0.35, 0.45), 1.0
         scene.add_light(hg.Light("sun", "SUN", energy=3.0,
                                  local2world=hg.object_pose([0, 0, 5], [math.radians(40), 0, math.radians(30)])))
-    else:
+    elif lighting == "area":  # a black world: Cycles' lights let rays through, hybridgen's rectangle would hide it
+        scene.world.color, scene.world.strength = (0.0, 0.0, 0.0), 0.0
+        pose = hg.object_pose(list(AREA_LIGHT["location"]), list(AREA_LIGHT["rotation"]))
+        scene.add_light(hg.Light("area", "AREA", energy=AREA_LIGHT["energy"], size=AREA_LIGHT["size"],
+                                 local2world=pose))
+    elif lighting == "hdri":
         sys.path.insert(0, str(REPO / "tools"))
         from color_quality import sky_hdri
 
         scene.world.hdri_path = str(sky_hdri(workdir / "sky.exr"))
         scene.world.strength, scene.world.hdri_rotation = 1.0, 0.3
+    else:
+        raise ValueError(f"lighting must be one of {ALL_LIGHTINGS}, got {lighting!r}")
     scene.camera.intrinsics = hg.Intrinsics.from_fov(0.75, width, height, clip_start=0.01)
     location = [0.0, -2.6, 1.9] if names is None else [0.0, -1.9, 1.1]
     scene.camera.add_keypoint(hg.look_at(location, [0.0, 0.05, 0.1]))

@@ -1,7 +1,7 @@
 """hybridgen's color against Blender 4.2's Cycles, object by object, on sweeps of Principled materials.
 
 Run: .venv/bin/python tools/principled_vs_cycles.py [--group principled|layers|subsurface] [--res 360x240]
-         [--spp 256] [--cycles-spp 256] [--bounces 4] [--lighting sun,hdri] [--reuse-cycles]
+         [--spp 256] [--cycles-spp 256] [--bounces 4] [--lighting sun,area,hdri] [--reuse-cycles]
          [--store tests/render/data/principled_cycles.json]
      .venv/bin/python tools/principled_vs_cycles.py --time-scene tabletop --res 160x120 --spp 64
          (time per sample of a color benchmark scene with each principled model, no Cycles)
@@ -10,8 +10,9 @@ The scenes (tools/principled_sweep.py): rows of spheres over a grey Lambertian f
 of a sweep - ``principled``: base colors x roughness x metallic x Specular IOR Level x coat x transmission x
 anisotropy; ``layers``: sheen and subsurface; ``subsurface``: subsurface weights x radius scales (no test view);
 ``coat_normal``: a normal map on Normal and / or Coat Normal of coated UV spheres; ``emission``: emissive spheres
-under coat and sheen - under a sun and sky (``sun``), a sky HDRI (``hdri``) or nothing (``dark``, the emission
-group's). Scenes with normal maps or layered emission render in Cycles through tools/cycles_render_layers.py. Both engines render the same meshes and vertex
+under coat and sheen - under a sun and sky (``sun``), a square area light in a black world (``area``), a sky HDRI
+(``hdri``) or nothing (``dark``, the emission group's). Scenes with normal maps, layered emission or an area light
+render in Cycles through tools/cycles_render_layers.py. Both engines render the same meshes and vertex
 normals at fixed sample counts with equal bounces in every lobe (``--bounces`` Cycles bounces = Mitsuba
 depth + 2), no clamping, no glossy filter, a one-pixel box filter, no denoising, no light tree: converged
 estimates of the same integral. Cycles runs through ``bpy`` 4.2 in ``.venv-bpy`` (tools/cycles_render.py,
@@ -24,10 +25,11 @@ and hybridgen's Principled BSDF ("after", ``HYBRIDGEN_PRINCIPLED=blender``), wit
 ``principled`` sweep, hybridgen's BSDF with the sheen and subsurface inputs dropped for ``layers``, the coat bent by
 the base's map for ``coat_normal``, emission unweighted by the layers for ``emission``; when Cycles is rendered, the
 per-pixel relative RMS difference of each model's image to Cycles' is printed per object too.
-``--test-view-only`` (with ``--store``) renders and stores only the group's test view. ``--reuse-cycles`` takes Cycles' means from the ``--store`` table instead of rendering (hybridgen
-changed, Cycles did not). ``--store`` writes the scene settings and Cycles' per-object means of the group's
-sweep and test view into the JSON table tests/render/test_principled_vs_cycles.py checks (the other group's
-entries are kept).
+``--test-view-only`` (with ``--store``) renders and stores only the group's test views (:data:`TEST_VIEWS`) under
+the lightings asked for. ``--reuse-cycles`` takes Cycles' means from the ``--store`` table instead of rendering
+(hybridgen changed, Cycles did not). ``--store`` writes the scene settings and Cycles' per-object means of the
+group's sweep and test views into the JSON table tests/render/test_principled_vs_cycles.py checks (the other
+groups' entries are kept, and the group's other lightings when res, spp and bounces are the same).
 """
 from __future__ import annotations
 
@@ -43,16 +45,21 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tools"))
-from principled_sweep import (GROUP_LIGHTINGS, GROUPS, LIGHTINGS, TEST_COAT_NORMAL_OBJECTS,  # noqa: E402,F401
-                              TEST_EMISSION_OBJECTS, TEST_LAYER_OBJECTS, TEST_OBJECTS, build_scene, object_masks,
-                              object_means)
+from principled_sweep import (GROUP_LIGHTINGS, GROUPS, LIGHTINGS, TEST_AREA_OBJECTS,  # noqa: E402,F401
+                              TEST_COAT_NORMAL_OBJECTS, TEST_EMISSION_OBJECTS, TEST_LAYER_OBJECTS, TEST_OBJECTS,
+                              build_scene, object_masks, object_means)
 
 LAYER_INPUTS = ("sheen_", "subsurface_")
 """Prefixes of the ``extra`` inputs the ``layers`` sweep's "before" drops."""
-TEST_VIEWS = {"principled": ("test_view", TEST_OBJECTS), "layers": ("test_view_layers", TEST_LAYER_OBJECTS),
-              "coat_normal": ("test_view_coat_normal", TEST_COAT_NORMAL_OBJECTS),
-              "emission": ("test_view_emission", TEST_EMISSION_OBJECTS)}
-"""Per sweep group: the stored table's key of its small test view and the view's spheres."""
+TEST_VIEWS = {"test_view": ("principled", "sun", TEST_OBJECTS),
+              "test_view_area": ("principled", "area", TEST_AREA_OBJECTS),
+              "test_view_layers": ("layers", "sun", TEST_LAYER_OBJECTS),
+              "test_view_coat_normal": ("coat_normal", "sun", TEST_COAT_NORMAL_OBJECTS),
+              "test_view_emission": ("emission", "dark", TEST_EMISSION_OBJECTS)}
+"""The small test views, by their key in the stored table: (sweep group, lighting, spheres). ``--store`` renders
+those of ``--group`` whose lighting it renders."""
+IMAGE_VIEWS = ("test_view_area", "test_view_coat_normal", "test_view_emission")
+"""Test views whose Cycles image is stored too (:data:`IMAGES`), for a pixel-by-pixel comparison."""
 BEFORE = {"principled": "mitsuba", "layers": "before", "coat_normal": "flat_coat", "emission": "unlayered_emission",
           "subsurface": "before"}
 """Per group, the model its "before" column renders: Mitsuba's ``principled``; hybridgen's BSDF without the sheen
@@ -138,8 +145,8 @@ TEST_RES, TEST_CYCLES_SPP = (64, 48), 4096
 TEST_VIEW_RES = {"coat_normal": (128, 64)}
 """Test views larger than :data:`TEST_RES` (the coat normal map's pattern is compared pixel by pixel)."""
 IMAGES = "principled_cycles_images.npz"
-"""Beside the ``--store`` table: Cycles' images (float32 H x W x 3) of the test views stored since issue 32's
-coat normal and emission groups, under the views' keys."""
+"""Beside the ``--store`` table: Cycles' images (float32 H x W x 3) of the :data:`IMAGE_VIEWS`, under the views'
+keys."""
 
 
 def test_view(bounces: int, objects: tuple[str, ...] = TEST_OBJECTS, lighting: str = "sun",
@@ -178,7 +185,7 @@ def main() -> None:
     parser.add_argument("--spp", type=int, default=256, help="hybridgen's samples per pixel")
     parser.add_argument("--cycles-spp", type=int, default=256)
     parser.add_argument("--bounces", type=int, default=4)
-    parser.add_argument("--lighting", help="default: sun,hdri (the emission group: dark)")
+    parser.add_argument("--lighting", help="default: sun,area,hdri (the emission group: dark)")
     parser.add_argument("--store", type=Path, help="write Cycles' per-object means into this JSON table")
     parser.add_argument("--reuse-cycles", action="store_true", help="Cycles' means from the --store table")
     parser.add_argument("--time-scene", help="only time a color benchmark scene (tabletop, materials, ...) per "
@@ -195,11 +202,13 @@ def main() -> None:
         return
     stored = json.loads(args.store.read_text()) if args.store and args.store.exists() else {}
     part = stored if args.group == "principled" else stored.setdefault(args.group, {})
-    if not args.reuse_cycles and not args.test_view_only:
-        part.update({"res": [width, height], "cycles_spp": args.cycles_spp, "bounces": args.bounces,
-                     "blender": None, "lightings": {}})
-    models = (BEFORE[args.group], "blender")
     lightings = args.lighting.split(",") if args.lighting else GROUP_LIGHTINGS.get(args.group, LIGHTINGS)
+    if not args.reuse_cycles and not args.test_view_only:
+        settings = {"res": [width, height], "cycles_spp": args.cycles_spp, "bounces": args.bounces}
+        same = all(part.get(key) == value for key, value in settings.items())  # other lightings still valid
+        kept = {k: v for k, v in part.get("lightings", {}).items() if same and k not in lightings}
+        part.update({**settings, "blender": None, "lightings": kept})
+    models = (BEFORE[args.group], "blender")
     for lighting in () if args.test_view_only else lightings:
         with tempfile.TemporaryDirectory() as tmp:
             workdir = Path(tmp)
@@ -226,11 +235,11 @@ def main() -> None:
             part["lightings"][lighting] = {"pixels": {n: int(m.sum()) for n, m in masks.items()},
                                            "cycles": cycles, "hybridgen": ours["blender"]}
     if args.store and not args.reuse_cycles:
-        if args.group in TEST_VIEWS:
-            key, objects = TEST_VIEWS[args.group]
-            stored[key], image = test_view(args.bounces, objects, lightings[0],
-                                           TEST_VIEW_RES.get(args.group, TEST_RES))
-            if args.group in ("coat_normal", "emission"):
+        for key, (group, lighting, objects) in TEST_VIEWS.items():
+            if group != args.group or lighting not in lightings:
+                continue
+            stored[key], image = test_view(args.bounces, objects, lighting, TEST_VIEW_RES.get(args.group, TEST_RES))
+            if key in IMAGE_VIEWS:
                 images_file = args.store.with_name(IMAGES)
                 images = dict(np.load(images_file)) if images_file.exists() else {}
                 np.savez_compressed(images_file, **{**images, key: image})
