@@ -12,13 +12,11 @@ Normal pass (the shading normal the closures saw). No lights: DiffCol does not d
 """
 from __future__ import annotations
 
-import json
 import os
 import sys
 
 import bpy
-import numpy as np
-from dust_cycles_scene import add_camera, add_mesh, render_exr  # tools/ is first on sys.path
+from dust_cycles_scene import add_camera, add_mesh, render_pixel_centres, start  # tools/ is first on sys.path
 
 
 def _material(name: str, inputs: dict) -> bpy.types.Material:
@@ -32,27 +30,13 @@ def _material(name: str, inputs: dict) -> bpy.types.Material:
 
 
 def main() -> None:
-    scene_path, spec_path, out = sys.argv[1:4]
-    data = np.load(scene_path)
-    spec = json.loads(open(spec_path).read())
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
+    data, spec, out, scene = start(sys.argv)
     for entry in spec["objects"]:
         add_mesh(entry["name"], data).data.materials.append(_material(entry["name"], entry["inputs"]))
-    world = bpy.data.worlds.new("world")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    scene.world = world
     add_camera(scene, spec["camera"])
-    cycles = scene.cycles
-    scene.render.engine, cycles.device = "CYCLES", "CPU"
-    cycles.samples = 1
-    cycles.use_adaptive_sampling = cycles.use_denoising = False
-    cycles.pixel_filter_type = "BOX"
-    cycles.filter_width = 0.01
     layer = scene.view_layers[0]
     layer.use_pass_diffuse_color = layer.use_pass_normal = True
-    render_exr(scene, spec["resolution"], out)
+    render_pixel_centres(scene, spec["resolution"], out)
 
 
 if __name__ == "__main__":

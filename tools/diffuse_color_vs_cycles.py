@@ -22,7 +22,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -103,8 +102,7 @@ def build_scene(width: int, height: int) -> Any:
 
 def render_cycles(scene: Any, work: Path) -> dict[str, np.ndarray]:
     """Cycles' DiffCol and Normal passes (H x W x 3 float) of the sweep (tools/diffuse_color_cycles.py)."""
-    import mitsuba as mi
-    from blenderproc_reference import reference_invocation
+    from blender_side import exr_passes, run_blender_side
 
     arrays: dict[str, np.ndarray] = {}
     for (name, _), centre in zip(MATERIALS, centres()):
@@ -117,18 +115,9 @@ def render_cycles(scene: Any, work: Path) -> dict[str, np.ndarray]:
             "camera": {"matrix_world": (scene.camera.keypoints[0] @ np.diag([1.0, -1, -1, 1])).tolist(),
                        "lens": float(intr.K[0, 0] * 36.0 / intr.width)}}
     (work / "spec.json").write_text(json.dumps(spec))
-    invocation = reference_invocation(str(REPO / "tools" / "diffuse_color_cycles.py"),
-                                      [str(work / "scene.npz"), str(work / "spec.json"), str(work / "out.exr")],
-                                      root=work)
-    done = subprocess.run(invocation.command, cwd=invocation.cwd, env=invocation.env, capture_output=True, text=True)
-    if done.returncode != 0:
-        raise SystemExit(f"Cycles failed: {(done.stderr or done.stdout).strip().splitlines()[-3:]}")
-    mi.set_variant("scalar_rgb")
-    bitmap = mi.Bitmap(str(work / "out.exr"))
-    values = np.asarray(bitmap, np.float64)
-    channels = {field.name.split(".", 1)[1]: values[..., i] for i, field in enumerate(bitmap.struct_())}
-    return {layer: np.stack([channels[f"{layer}.{c}"] for c in letters], -1)
-            for layer, letters in (("DiffCol", "RGB"), ("Normal", "XYZ"))}
+    run_blender_side("diffuse_color_cycles.py", [str(work / "scene.npz"), str(work / "spec.json"),
+                                                 str(work / "out.exr")], work)
+    return exr_passes(work / "out.exr")
 
 
 def pixel_rays(scene: Any) -> tuple[np.ndarray, np.ndarray]:

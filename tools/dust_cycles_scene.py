@@ -73,6 +73,16 @@ def _emissive(tree: bpy.types.NodeTree, bsdf: bpy.types.Node, value: float) -> N
         tree.links.new(emission.outputs["Emission"], socket)  # replaces the link into that input
 
 
+def start(argv: list[str]) -> tuple[np.lib.npyio.NpzFile, dict, str, bpy.types.Scene]:
+    """The Blender sides' arguments ``SCENE.npz SPEC.json OUT.exr`` read (arrays, spec, output path), and Blender
+    reset to an empty scene (returned)."""
+    scene_path, spec_path, out = argv[1:4]
+    with open(spec_path) as spec_file:
+        spec = json.load(spec_file)
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    return np.load(scene_path), spec, out, bpy.context.scene
+
+
 def add_camera(scene: bpy.types.Scene, camera_spec: dict) -> None:
     """The scene's camera: Blender ``matrix_world``, ``lens`` (mm) on a 36 mm wide sensor, clip start 1 cm."""
     camera_data = bpy.data.cameras.new("camera")
@@ -86,12 +96,8 @@ def add_camera(scene: bpy.types.Scene, camera_spec: dict) -> None:
 
 
 def main() -> None:
-    scene_path, spec_path, out = sys.argv[1:4]
-    data = np.load(scene_path)
-    spec = json.loads(open(spec_path).read())
+    data, spec, out, scene = start(sys.argv)
     weight_mode = spec["mode"] == "weight"
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
     for entry in spec["objects"]:
         obj = add_mesh(entry["name"], data)
         obj.data.materials.append(_material(entry, weight_mode))
@@ -123,6 +129,23 @@ def main() -> None:
     layer.use_pass_uv = layer.use_pass_normal = layer.use_pass_position = weight_mode
     layer.use_pass_diffuse_color = not weight_mode
     render_exr(scene, spec["resolution"], out)
+
+
+def render_pixel_centres(scene: bpy.types.Scene, resolution: list[int], out: str) -> None:
+    """Render ``scene`` in a black world on the CPU with one sample per pixel through a 0.01-pixel box filter, no
+    adaptive sampling or denoising: each pixel's passes are Cycles' values at its centre (exact for passes that
+    are no random estimate: normals, UVs, closure weights). Into the multilayer EXR ``out``."""
+    world = bpy.data.worlds.new("world")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    scene.world = world
+    cycles = scene.cycles
+    scene.render.engine, cycles.device = "CYCLES", "CPU"
+    cycles.samples = 1
+    cycles.use_adaptive_sampling = cycles.use_denoising = False
+    cycles.pixel_filter_type = "BOX"
+    cycles.filter_width = 0.01
+    render_exr(scene, resolution, out)
 
 
 def render_exr(scene: bpy.types.Scene, resolution: list[int], out: str) -> None:

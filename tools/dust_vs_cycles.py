@@ -24,7 +24,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -95,7 +94,7 @@ def hybridgen_scene(objects: list[dict[str, Any]], size: tuple[int, int], weight
 def render_cycles(objects: list[dict[str, Any]], scene: Any, mode: str, spp: int, work: Path) -> dict[str, np.ndarray]:
     """Cycles' passes (name -> H x W x C float) of the scene in ``mode`` (tools/dust_cycles_scene.py)."""
     import mitsuba as mi
-    from blenderproc_reference import reference_invocation
+    from blender_side import exr_passes, run_blender_side
 
     arrays = {f"{o['name']}.{key}": o[key] for o in objects for key in ("vertices", "faces", "uvs", "normals")}
     np.savez(work / "scene.npz", **arrays)
@@ -106,19 +105,10 @@ def render_cycles(objects: list[dict[str, Any]], scene: Any, mode: str, spp: int
             "camera": {"matrix_world": (scene.camera.keypoints[0] @ np.diag([1.0, -1, -1, 1])).tolist(),
                        "lens": float(intr.K[0, 0] * 36.0 / intr.width)}}
     (work / "spec.json").write_text(json.dumps(spec))
-    invocation = reference_invocation(str(REPO / "tools" / "dust_cycles_scene.py"),
-                                      [str(work / "scene.npz"), str(work / "spec.json"), str(work / f"{mode}.exr")],
-                                      root=work)
-    done = subprocess.run(invocation.command, cwd=invocation.cwd, env=invocation.env, capture_output=True, text=True)
-    if done.returncode != 0:
-        raise SystemExit(f"Cycles failed: {(done.stderr or done.stdout).strip().splitlines()[-3:]}")
+    run_blender_side("dust_cycles_scene.py", [str(work / "scene.npz"), str(work / "spec.json"),
+                                              str(work / f"{mode}.exr")], work)
     mi.set_variant("llvm_ad_rgb")
-    bitmap = mi.Bitmap(str(work / f"{mode}.exr"))
-    values, names = np.asarray(bitmap, np.float64), [field.name for field in bitmap.struct_()]
-    channels = {name.split(".", 1)[1]: values[..., i] for i, name in enumerate(names)}  # "Combined.R", "UV.U" ...
-    wanted = {"Combined": "RGBA", "UV": "UV", "Normal": "XYZ", "Position": "XYZ", "DiffCol": "RGB"}
-    return {layer: np.stack([channels[f"{layer}.{c}"] for c in letters], -1) for layer, letters in wanted.items()
-            if f"{layer}.{letters[0]}" in channels}
+    return exr_passes(work / f"{mode}.exr")
 
 
 def object_masks(scene: Any, margin: float = 0.85) -> tuple[dict[str, np.ndarray], np.ndarray]:

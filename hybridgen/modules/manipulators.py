@@ -68,13 +68,14 @@ class MaterialManipulator(SelectingModule):
 def linked_displacement(material: Material, factor: float, owner: str) -> Material:
     """``material`` with its base-color image as displacement map scaled by ``factor`` (BlenderProc's
     cf_color_link_to_displacement: image color x factor into the material output's displacement, which Cycles
-    renders as a bump; a constant offset changes no bump, so hybridgen's mid-level 0.5 gives the same shading).
-    A material without a base-color image is an error, as in BlenderProc."""
+    renders as a bump; a constant offset changes no bump, so hybridgen's mid-level 0.5 gives the same shading;
+    the Math node reads the color's linear luminance: ``displacement_from_color``). A material without a
+    base-color image is an error, as in BlenderProc."""
     if material.base_color_texture is None:
         raise InputError(f"object '{owner}': material '{material.name}' has no base-color image to link to "
                          "displacement (color_link_to_displacement)")
     return dataclasses.replace(material, displacement_texture=material.base_color_texture,
-                               displacement_scale=factor)
+                               displacement_scale=factor, displacement_from_color=True)
 
 
 @register_module("manipulators.EntityManipulator")

@@ -1,7 +1,8 @@
 """Decoding of a material's data maps (roughness, metallic, alpha, normal, displacement) for both renderers.
 
 A map is a file path or an HxW[xC] uint8 (or float 0..1) array. Data maps are linear values, never sRGB
-decoded; a gray map is its first channel (an RGB image of a gray map has equal channels).
+decoded; a gray map is its first channel (an RGB image of a gray map has equal channels). A color image used as
+height (:func:`color_height`) is the exception: it is read as the color Blender links to a float input.
 """
 from __future__ import annotations
 
@@ -43,6 +44,26 @@ def data_image(texture: Any, owner: str, slot: str, channels: int = 1) -> np.nda
         raise InputError(f"object '{owner}': {slot} needs {channels} channels (a tangent-space normal map is RGB), "
                          f"got {values.shape[-1]}")
     return np.ascontiguousarray(values[..., :channels])
+
+
+REC709_LUMINANCE = np.array([0.2126, 0.7152, 0.0722], np.float32)
+"""Blender 4.2's luminance weights of linear RGB (its default OpenColorIO scene-linear space, Rec.709)."""
+
+
+def color_height(texture: Any, owner: str, slot: str) -> np.ndarray:
+    """HxWx1 float32 height of an sRGB color image (a path or an HxWxC uint8 / float 0..1 array; alpha
+    ignored): the Rec.709 luminance of its linear (sRGB-decoded) RGB. What Cycles makes of an Image Texture's
+    Color linked to a float input (BlenderProc's ``set_displacement_from_principled_shader_value`` and v1's
+    ``cf_color_link_to_displacement`` link Base Color's image through a Math node into the displacement):
+    fitted on Cycles' bumped normals in bpy 4.2, the weights of the linear channels came out 0.2121, 0.7150,
+    0.0718 (tests/render/test_bump_from_color.py checks the bump against Cycles' normals, tools/bump_vs_cycles.py).
+    Cycles interpolates the 8-bit sRGB texels before decoding them; this decodes first (a bilinear height)."""
+    from .tonemap import srgb_decode
+
+    array = _decoded(texture, owner, slot)
+    values = array.astype(np.float32) / 255.0 if array.dtype == np.uint8 else array.astype(np.float32)
+    rgb = values[..., :3] if values.shape[-1] >= 3 else np.repeat(values[..., :1], 3, axis=-1)
+    return np.ascontiguousarray((srgb_decode(rgb) @ REC709_LUMINANCE)[..., None], dtype=np.float32)
 
 
 def alpha_coverage(texture: Any, owner: str) -> np.ndarray:

@@ -46,6 +46,9 @@ class Material:
       ``cycles.displacement_method``, so ambientCG / Poly Haven ``_Displacement`` maps are bumps in its
       renders too. True geometric displacement is the Displace modifier's job
       (:mod:`hybridgen.scene.displacement`, EntityManipulator ``displace``).
+    - ``displacement_from_color``: ``displacement_texture`` is a color image (sRGB, a base color's) whose height is
+      the Rec.709 luminance of its linear color, as Blender reads an image's Color linked to the displacement
+      (:func:`hybridgen.render.material_textures.color_height`); otherwise its first channel, as data.
     - ``emission_hidden_from_camera``: the emission lights the scene but the camera does not see it - camera
       rays see the surface's BSDF without emission, every other ray sees the emission alone (a black
       emitter). What BlenderProc's ``make_emissive`` builds (a Light Path "Is Camera Ray" mix), used for
@@ -84,6 +87,7 @@ class Material:
     normal_y_down: bool = False
     displacement_texture: Any = None
     displacement_scale: float = 0.15  # metres per unit of height (Blender's Displacement node default in BlenderProc)
+    displacement_from_color: bool = False  # displacement_texture's height is its color's luminance
     specular_texture: Any = None
     emission_texture: Any = None  # path or HxWx{3,4} uint8 array, sRGB encoded, like base_color_texture
     coat_normal_texture: Any = None  # tangent-space normal map of the coat (Coat Normal), as normal_texture

@@ -44,6 +44,7 @@ def test_color_link_to_displacement_bumps_with_the_base_color_image(tmp_path):
     material, _ = _run(tmp_path, "color.png", {"cf_color_link_to_displacement": 0.2})
     assert material.base_color_texture is not None  # the OBJ's map_Kd image
     assert material.displacement_texture is material.base_color_texture and material.displacement_scale == 0.2
+    assert material.displacement_from_color  # the height is the color's luminance, as Blender links it
     with pytest.raises(InputError, match="no base-color image to link"):  # BlenderProc fails there too
         _run(tmp_path, None, {"cf_color_link_to_displacement": 0.2})
 

@@ -194,8 +194,9 @@ class Material(Struct):
 
     def set_displacement_from_principled_shader_value(self, input_name: str, multiply_factor: float) -> None:
         """The image linked to ``input_name`` times ``multiply_factor`` (m) becomes the displacement (Blender's
-        default "Bump Only": shading normals change, geometry and labels do not). hybridgen reads the image's
-        first channel as height where Blender's math node takes the color's luminance."""
+        default "Bump Only": shading normals change, geometry and labels do not). The height is what Blender's
+        Math node takes from a linked color: the luminance of the image's linear color (``displacement_from_color``);
+        the image linked now, as in BlenderProc, whatever is linked to ``input_name`` later."""
         _, texture = _input(input_name)
         linked = getattr(self.blender_obj, texture) if texture is not None else None
         if linked is None:
@@ -203,6 +204,7 @@ class Material(Struct):
                              "not have any incoming connection (as in BlenderProc)")
         self.blender_obj.displacement_texture = linked
         self.blender_obj.displacement_scale = float(multiply_factor)
+        self.blender_obj.displacement_from_color = True
 
     def map_vertex_color(self, layer_name: str = "Col", active_shading: bool = True) -> None:
         """The mesh's vertex colors become the base color (Blender's color attribute linked to Base Color)."""

@@ -15,7 +15,8 @@ The BSDF is built inside out:
   with the base's map, and Cycles lifts and tests mapped normals differently (:mod:`.principled_frames`);
 - ``bumpmap`` for a displacement map: shading normals of the surface displaced by h x scale metres (the
   texture's gradient with respect to UV times ``displacement_scale``; the 0.5 mid level of Blender's node
-  does not change a gradient);
+  does not change a gradient; a color image linked as height, ``displacement_from_color``, is its linear
+  luminance, :func:`~hybridgen.render.material_textures.color_height`);
 - both without Mitsuba's default bump-terminator shadowing (Estevez et al. 2019), so a mapped normal shades
   exactly as the analytic tilted normal (Cycles softens diffuse closures with Chiang et al. 2019's term
   instead: the two differ only where light grazes the geometric surface);
@@ -42,7 +43,7 @@ from ...io.image_check import check_image_file
 from ...scene.material import ALPHA_MODES, Material
 from .glossy_filter import filtered_roughness
 from .lobe_sampling import principled_sampling_rates
-from ..material_textures import data_image
+from ..material_textures import color_height, data_image
 
 
 def rgb(value: Any) -> dict[str, Any]:
@@ -229,9 +230,11 @@ def bsdf_dict(material: Material, owner: str, *, vertex_colors: bool = False, uv
                 "normalmap": data_texture(material.normal_texture, owner, "normal_texture", channels=3,
                                           invert_green=material.normal_y_down)}
     if material.displacement_texture is not None and material.displacement_scale != 0:
+        height = material.displacement_texture
+        if material.displacement_from_color:
+            height = color_height(height, owner, "displacement_texture")
         bsdf = {"type": "bumpmap", "bsdf": bsdf, "scale": float(material.displacement_scale),
-                "use_shadowing_function": False,
-                "arbitrary": data_texture(material.displacement_texture, owner, "displacement_texture")}
+                "use_shadowing_function": False, "arbitrary": data_texture(height, owner, "displacement_texture")}
     if material.transmission == 0 and not (blender and bsdf_is_plugin(bsdf)):
         # Mitsuba's opaque BSDFs are one-sided; Blender (and real meshes with mixed windings) need both sides.
         bsdf = {"type": "twosided", "material": bsdf}
