@@ -135,6 +135,12 @@ TEST_AREA_OBJECTS = ("grey_s1_r01", "white_s05_r05", "gold_m1_r03", "red_coat")
 0.1) and broadly (roughness 0.3 metal, 0.5 dielectric), compared with Cycles' image pixel by pixel too."""
 
 
+TEST_GLASS_OBJECTS = ("green_glass_r05", "glass_r02")
+"""The spheres of the glass test view (under the HDRI): rough refraction lit by the HDRI's small sun, where Cycles
+values direction pairs no microfacet connects (docs/principled_bsdf.md, "Refraction pairs"; 0.95 of Cycles without)
+and a less rough clear glass."""
+
+
 TEST_COAT_NORMAL_OBJECTS = ("cn_base_map", "cn_coat_map", "cn_red_base_map", "cn_sheen_coat_map")
 """The spheres of the coat-normal test view: the base's map alone, the coat's alone, a red base under a coat, and
 sheen over a half coat (the sheen's mixed normal)."""
