@@ -18,10 +18,7 @@ rad). ``--compare`` also runs hybridgen on the same operations and prints the la
 """
 from __future__ import annotations
 
-import argparse
 import json
-import os
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -144,22 +141,6 @@ def inner(engine: str, out: str) -> None:
     Path(out).write_text(json.dumps(table, indent=1) + "\n")
 
 
-def _run(engine: str, out: Path) -> dict[str, Any]:
-    sys.path.insert(0, str(TOOLS))
-    from blenderproc_reference import reference_invocation
-
-    if engine == "blenderproc":
-        invocation = reference_invocation("x", [], root=REPO)
-        command, env = [invocation.command[0]], invocation.env
-    else:
-        command, env = [sys.executable], dict(os.environ)
-    done = subprocess.run([*command, str(Path(__file__).resolve()), "--inner", engine, str(out)], env=env,
-                          capture_output=True, text=True, check=False)
-    if not out.is_file():
-        sys.exit(f"{engine} made no table (exit {done.returncode}): {(done.stdout + done.stderr)[-2000:]}")
-    return json.loads(out.read_text())
-
-
 def differences(reference: dict[str, Any], ours: dict[str, Any]) -> list[str]:
     """Per frame the largest joint-pose difference (m and rad) and joint-rotation difference (rad)."""
     import numpy as np
@@ -176,20 +157,10 @@ def differences(reference: dict[str, Any], ours: dict[str, Any]) -> list[str]:
 
 
 def main() -> None:
-    if len(sys.argv) > 1 and sys.argv[1] == "--inner":
-        inner(sys.argv[2], sys.argv[3])
-        return
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--store", default=str(STORE))
-    parser.add_argument("--compare", action="store_true", help="also run hybridgen and print the differences")
-    ns = parser.parse_args()
-    with tempfile.TemporaryDirectory() as folder:
-        reference = _run("blenderproc", Path(folder) / "blenderproc.json")
-        Path(ns.store).parent.mkdir(parents=True, exist_ok=True)
-        Path(ns.store).write_text(json.dumps(reference, indent=1) + "\n")
-        print(f"stored {ns.store}")
-        if ns.compare:
-            print("\n".join(differences(reference, _run("hybridgen", Path(folder) / "hybridgen.json"))))
+    sys.path.insert(0, str(TOOLS))
+    from bproc_table_tool import table_tool
+
+    table_tool(Path(__file__).resolve(), __doc__, STORE, inner, differences)
 
 
 if __name__ == "__main__":

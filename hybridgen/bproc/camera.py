@@ -14,7 +14,7 @@ from ..errors import InputError
 from ..scene.frames import blender_to_opencv, forward_to_rotation_blender
 from .session import SESSION, current_intrinsics
 from .types.entity import matrix4
-from .types.unsupported import fail, module_getattr
+from .types.unsupported import fail
 
 
 def add_camera_pose(cam2world_matrix: Any, frame: int | None = None) -> int:
@@ -215,4 +215,5 @@ from .camera_validation import (decrease_interest_score, perform_obstacle_in_vie
 from .camera_projection import (depth_at_points_via_raytracing, depth_via_raytracing,  # noqa: E402
                                 pointcloud_from_depth, project_points, unproject_points)
 
-__getattr__ = module_getattr("camera", ["check_novel_pose", "set_camera_parameters_from_config_file"])
+from .camera_novelty import check_novel_pose  # noqa: E402
+from .dlr_calibration import set_camera_parameters_from_config_file  # noqa: E402

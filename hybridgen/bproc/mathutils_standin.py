@@ -163,9 +163,11 @@ class Matrix(_Array):
         return Matrix(self._values.T)
 
     def to_euler(self, order: str = "XYZ") -> "Euler":
+        """Blender's choice of the two XYZ triples (:func:`hybridgen.bproc.math.blender_euler_from_matrix`)."""
+        from .math import blender_euler_from_matrix
+
         _xyz_only(order)
-        linear = self._values[:3, :3]
-        return Euler(matrix_to_euler_xyz(linear / np.linalg.norm(linear, axis=0)))
+        return Euler(blender_euler_from_matrix(self._values[:3, :3]))
 
     def to_quaternion(self) -> "Quaternion":
         from scipy.spatial.transform import Rotation

@@ -8,8 +8,8 @@ from types import TracebackType
 
 from ..logs import LOGGER
 from .label_id_mapping import LabelIdMapping, resolve_resource  # noqa: F401 - bproc.utility names
+from .pattern import generate_random_pattern_img  # noqa: F401 - a bproc.utility name
 from .session import SESSION
-from .types.unsupported import module_getattr
 from .undo import UndoAfterExecution  # noqa: F401 - a bproc.utility name
 
 
@@ -62,5 +62,3 @@ class BlockStopWatch:
                  traceback: TracebackType | None) -> None:
         LOGGER.info("#### Finished - %s (took %.3f seconds) ####", self.block_name, time.perf_counter() - self.start)
 
-
-__getattr__ = module_getattr("utility", ["generate_random_pattern_img"])
