@@ -216,4 +216,19 @@ from .camera_projection import (depth_at_points_via_raytracing, depth_via_raytra
                                 pointcloud_from_depth, project_points, unproject_points)
 
 from .camera_novelty import check_novel_pose  # noqa: E402
-from .dlr_calibration import set_camera_parameters_from_config_file  # noqa: E402
+
+
+def set_camera_parameters_from_config_file(camera_intrinsics_file_path: str, read_the_extrinsics: bool = False,
+                                           camera_index: int = 0) -> tuple[int, int, np.ndarray]:
+    """Intrinsics, lens distortion and (with ``read_the_extrinsics``) a new camera pose from camera
+    ``camera_index`` of a DLR-RMC calibration file (:mod:`.dlr_calibration`). Returns ``(width, height, mapping)``:
+    the file's image size (px, the size ``apply_lens_distortion`` makes) and the (2, height * width) mapping of
+    :func:`set_lens_distortion`."""
+    from .dlr_calibration import read_camera_calibration
+
+    calibration = read_camera_calibration(camera_intrinsics_file_path, read_the_extrinsics, camera_index)
+    set_intrinsics_from_K_matrix(calibration.K, calibration.width, calibration.height)
+    mapping = set_lens_distortion(*calibration.distortion)
+    if calibration.cam2world is not None:
+        add_camera_pose(calibration.cam2world)
+    return calibration.width, calibration.height, mapping

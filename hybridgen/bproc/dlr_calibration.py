@@ -135,13 +135,23 @@ def check_version_and_origin(entries: dict[str, Any], path: str) -> None:
                          f"(got {entries.get('origin')!r})")
 
 
-def set_camera_parameters_from_config_file(camera_intrinsics_file_path: str, read_the_extrinsics: bool = False,
-                                           camera_index: int = 0) -> tuple[int, int, np.ndarray]:
-    """Intrinsics, lens distortion and (with ``read_the_extrinsics``) a new camera pose from camera
-    ``camera_index`` of a DLR-RMC calibration file (module docstring). Returns ``(width, height, mapping)``: the
-    file's image size (px, the size ``apply_lens_distortion`` makes) and the (2, height * width) mapping of
-    ``set_lens_distortion``."""
-    from .camera import add_camera_pose, set_intrinsics_from_K_matrix, set_lens_distortion
+@dataclass
+class CameraCalibration:
+    """What BlenderProc takes from one camera of a calibration file: the image size (px), K (px), the distortion
+    coefficients (k1, k2, k3, p1, p2) and, when the extrinsics were asked for, the cam2world in Blender's camera
+    axes (m; None otherwise)."""
+
+    width: int
+    height: int
+    K: np.ndarray
+    distortion: tuple[float, float, float, float, float]
+    cam2world: np.ndarray | None
+
+
+def read_camera_calibration(camera_intrinsics_file_path: str, read_the_extrinsics: bool = False,
+                            camera_index: int = 0) -> CameraCalibration:
+    """Camera ``camera_index`` of a DLR-RMC calibration file (module docstring), checked as BlenderProc checks it;
+    ``bproc.camera.set_camera_parameters_from_config_file`` applies it."""
     from .math import change_source_coordinate_frame_of_transformation_matrix
 
     path = str(camera_intrinsics_file_path)
@@ -152,13 +162,13 @@ def set_camera_parameters_from_config_file(camera_intrinsics_file_path: str, rea
     LOGGER.debug("DLR-RMC camera calibration %s, camera %d: %s", path, camera_index, entries)
     check_version_and_origin(entries, path)
     width, height = _pixels(entries, "width", path), _pixels(entries, "height", path)
-    set_intrinsics_from_K_matrix(_array(entries, "A", path, (3, 3)), width, height)
-    coefficients = [_number(entries, "k1", path)] + [_number(entries, key, path, 0.0)
-                                                     for key in ("k2", "k3", "p1", "p2")]
-    mapping = set_lens_distortion(*coefficients)
+    K = _array(entries, "A", path, (3, 3))
+    k1 = _number(entries, "k1", path)
+    k2, k3, p1, p2 = (_number(entries, key, path, 0.0) for key in ("k2", "k3", "p1", "p2"))
+    cam2world = None
     if read_the_extrinsics:
-        cam2world = np.eye(4)
-        cam2world[:3, :3] = _array(entries, "R", path, (3, 3))
-        cam2world[:3, 3] = _array(entries, "T", path, (3,))
-        add_camera_pose(change_source_coordinate_frame_of_transformation_matrix(cam2world, ["X", "-Y", "-Z"]))
-    return width, height, mapping
+        opencv = np.eye(4)
+        opencv[:3, :3] = _array(entries, "R", path, (3, 3))
+        opencv[:3, 3] = _array(entries, "T", path, (3,))
+        cam2world = change_source_coordinate_frame_of_transformation_matrix(opencv, ["X", "-Y", "-Z"])
+    return CameraCalibration(width, height, K, (k1, k2, k3, p1, p2), cam2world)
