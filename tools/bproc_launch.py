@@ -14,7 +14,9 @@ PYTHONPATH, ``USE_EXTERNAL_BPY_MODULE=1``) and needs nothing of hybridgen; ``hyb
 - ``--add-labels``: the outputs the script did not enable among depth (``activate_antialiasing=False``, unless
   it asked for distance), normals and instance segmentation mapped by ``instance`` and ``name``
   (``instance_segmaps`` and ``instance_attribute_maps``), for pixel and per-object comparisons;
-- ``--frames N``: only the first N frames are rendered (``set_keyframe_render_interval``).
+- ``--frames N``: only the first N frames are rendered (``set_keyframe_render_interval``);
+- ``--seed N``: the path tracer's seed (Cycles' ``scene.cycles.seed``, 0 unless set; hybridgen's render seed, 0):
+  another independent noise pattern, e.g. a second reference to measure a reference's own noise.
 
 ``--scene-dump PATH`` writes, at each render, what the camera and objects are: a JSON list with one object per
 render, ``{"K": 3x3, "cam2world": [4x4 per frame, Blender camera axes], "objects": {name: 4x4 local2world}}``
@@ -55,6 +57,7 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     parser.add_argument("--view-transform")
     parser.add_argument("--add-labels", action="store_true")
     parser.add_argument("--frames", type=int)
+    parser.add_argument("--seed", type=int)
     parser.add_argument("--profile")
     parser.add_argument("--scene-dump")
     parser.add_argument("script")
@@ -81,6 +84,11 @@ class BlenderProcEngine:
         import bpy
 
         return int(bpy.context.scene.frame_start)
+
+    def set_seed(self, seed: int) -> None:
+        import bpy
+
+        bpy.context.scene.cycles.seed = seed
 
     def run(self, script: str, args: list[str]) -> int:
         import runpy
@@ -109,6 +117,17 @@ class HybridgenEngine:
         from hybridgen.bproc.session import SESSION
 
         return int(SESSION.frame_start)
+
+    def set_seed(self, seed: int) -> None:
+        import hybridgen
+
+        render_color = getattr(hybridgen.render_color, "unseeded", hybridgen.render_color)
+
+        def seeded(*args: Any, **kwargs: Any) -> Any:
+            return render_color(*args, **{**kwargs, "seed": seed})
+
+        seeded.unseeded = render_color  # type: ignore[attr-defined]
+        hybridgen.render_color = seeded
 
     def run(self, script: str, args: list[str]) -> int:
         from hybridgen.cli import main
@@ -204,6 +223,8 @@ def apply_overrides(engine: Any, ns: argparse.Namespace, spent: dict[str, float]
             renderer.set_output_format(view_transform=ns.view_transform)
         if ns.add_labels:
             add_labels(renderer, engine.enabled_outputs())
+        if ns.seed is not None:
+            engine.set_seed(ns.seed)
         if ns.frames is not None:
             start = engine.frame_start()
             engine.bproc.utility.set_keyframe_render_interval(start, start + ns.frames)

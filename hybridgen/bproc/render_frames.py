@@ -51,14 +51,35 @@ uses it on a slow machine); unset: the script's settings."""
 DEFAULT_LOAD_KEYS = {"colors", "distance", "normals", "diffuse", "depth", "segmap"}
 EDGE_SAMPLES = 4
 """Denoised adaptive renders give the pixels on edges of the denoising guides (silhouettes, creases, albedo edges:
-:mod:`hybridgen.render.guide_edges`) this many times the minimum samples (256 at BlenderProc's default threshold
-0.01), so that the colors are as clean as BlenderProc's against each engine's own converged reference. Measured
-with tools/bench_blenderproc.py's score (frame 0 against a 1024-spp reference of the same engine, see
-docs/blenderproc.md "Speed"): without it hybridgen's basics/basic was 53.47 dB and camera_sampling 53.50 dB
-against BlenderProc's 54.34 and 54.00 - the edge pixels stopped at the minimum like flat ones, but the denoiser
-cannot average them with their neighbours; with it 54.53 and 54.06 dB for 20-35 % more sampling time. Raising
-the minimum everywhere to 80 (Cycles' first check) gave 53.74 and 53.69 dB for as much time; 2 and 3 times the
-minimum, or a lower minimum with this floor, were below BlenderProc's in one of the two."""
+:mod:`hybridgen.render.guide_edges`) at least this many times Cycles' automatic minimum samples (256 at BlenderProc's
+default threshold 0.01): the denoiser cannot average them with their neighbours, so they keep their own noise,
+while adaptive sampling would stop them like flat pixels. See :data:`DENOISED_MIN_SHARE` for the measurements."""
+DENOISED_MIN_SHARE = 0.5
+"""Denoised adaptive renders start every pixel at this share of Cycles' automatic minimum (32 instead of 64 spp at
+threshold 0.01; then adaptive sampling as Cycles', and :data:`EDGE_SAMPLES` on edges): Open Image Denoise with
+hybridgen's exact guides leaves flat pixels at 32 spp nearly as clean as at 64, while edge pixels need samples.
+Measured with tools/bench_blenderproc.py's score (frame 0 against the engine's converged image: two 1024-spp
+references, their own noise taken out; docs/blenderproc.md "Speed"), basics/basic and camera_sampling, hybridgen /
+BlenderProc 55.84 and 56.23 dB, sampling CPU s of the frame (loaded machine, +-5 %):
+
+| minimum, edge floor | basics/basic | camera_sampling |
+|---|---|---|
+| 64, 256 (before) | 56.47 dB, 5.8 s | 56.68 dB, 6.4 s |
+| 32, 256 | 56.01 dB, 4.7 s | 55.96 dB, 5.1 s |
+| **32, 256 and :data:`EDGE_RAW_WEIGHT` (now)** | **56.46 dB** | **56.57 dB** |
+| 32, 128 and the mix | 55.46 dB, 3.9 s | 56.00 dB, 4.6 s |
+| 48, 192 and the mix | 56.19 dB, 5.0 s | 56.58 dB, 5.9 s |
+| 24, 192 and the mix | 55.86 dB, 4.3 s | 56.10 dB, 4.7 s |
+| 16, 256 and the mix | 55.91 dB, 4.4 s | 55.92 dB, 4.5 s |
+| 16, 512 and the mix | 56.62 dB, 6.4 s | 56.26 dB, 6.0 s |
+
+("the mix" rows other than "now" mixed the 8-bit colors after the fact; the mix as rendered, in linear light before
+encoding, scores ~0.1 dB higher.) Before the mix, the edge floor alone (64, 256) had taken basics/basic from
+53.47 to 54.53 dB and camera_sampling from 53.50 to 54.06 dB against a single 1024-spp reference (BlenderProc
+54.34 and 54.00), for 20-35 % more sampling time."""
+EDGE_RAW_WEIGHT = 0.5
+"""Denoised renders mix this share of the raw samples into the colors on strong guide edges
+(:mod:`hybridgen.render.edge_blend`)."""
 
 
 def _light_state(frame: int) -> tuple[Any, ...]:
@@ -177,8 +198,11 @@ def _render_group(frames: list[int], meshes: list[MeshObject], color: bool,
                                      max_bounces=settings.max_bounces, diffuse_bounces=settings.diffuse_bounces,
                                      glossy_bounces=settings.glossy_bounces,
                                      transmission_bounces=settings.transmission_bounces)
-        if settings.denoiser is not None and trace.plan().adaptive:  # the denoiser's edges: see EDGE_SAMPLES
-            trace = replace(trace, edge_min_samples=min(EDGE_SAMPLES * trace.plan().min_samples, samples))
+        if settings.denoiser is not None and trace.plan().adaptive:  # see DENOISED_MIN_SHARE and EDGE_SAMPLES
+            automatic = trace.plan().min_samples  # Cycles' automatic minimum for the threshold
+            least = max(2, int(automatic * DENOISED_MIN_SHARE) // 2 * 2)
+            trace = replace(trace, min_samples=min(least, samples),
+                            edge_min_samples=min(EDGE_SAMPLES * automatic, samples), edge_raw_weight=EDGE_RAW_WEIGHT)
         scene.camera.depth_of_field = _depth_of_field(frames[0])
         hg.render_color(scene, [sink], trace, labels=request, seed=0, denoise=settings.denoiser is not None,
                         hdr=settings.color_depth == 16, stereo_baseline=_stereo_baseline())

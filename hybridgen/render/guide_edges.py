@@ -40,9 +40,16 @@ def _largest_step(image: np.ndarray) -> np.ndarray:
     return largest
 
 
+def edge_strength(albedo: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """Float32 H x W: each pixel's largest guide step to a neighbour in units of the edge thresholds,
+    ``max(albedo step / ALBEDO_STEP, normal step / NORMAL_STEP)`` (guides H x W x 3 each, see the module
+    docstring); above 1 is an edge pixel."""
+    albedo = np.nan_to_num(np.asarray(albedo, dtype=np.float32))
+    normals = np.nan_to_num(np.asarray(normals, dtype=np.float32))
+    return np.maximum(_largest_step(albedo) / ALBEDO_STEP, _largest_step(normals) / NORMAL_STEP)
+
+
 def guide_edges(albedo: np.ndarray, normals: np.ndarray) -> np.ndarray:
     """Bool H x W: the pixels whose albedo or normal guide (H x W x 3 each, see the module docstring) steps to a
     neighbour's."""
-    albedo = np.nan_to_num(np.asarray(albedo, dtype=np.float32))
-    normals = np.nan_to_num(np.asarray(normals, dtype=np.float32))
-    return (_largest_step(albedo) > ALBEDO_STEP) | (_largest_step(normals) > NORMAL_STEP)
+    return edge_strength(albedo, normals) > 1.0

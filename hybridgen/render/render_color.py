@@ -12,8 +12,9 @@ from ..io.texture_needs import require_base_colors
 from ..scene.scene import Scene
 from . import denoise_guides
 from .denoise_guides import DenoiseGuides
-from .guide_edges import guide_edges
+from .edge_blend import mix_raw_on_edges
 from .guide_worker import GuideWorker
+from .keypoint_guides import KeypointGuides
 from .keypoint_loop import Producer, ProgressFactory, StereoProducer, run_keypoints
 from .passes import color_keys, layout
 from .pathtrace.denoise import denoise as oidn_denoise
@@ -49,6 +50,7 @@ class ColorProducer:
         self._guides: DenoiseGuides | None = None
         self._worker: GuideWorker | None = None
         self._denoiser: ThreadPoolExecutor | None = None  # denoising and encoding, one keypoint at a time
+        self._filtering: ThreadPoolExecutor | None = None  # the shared raster's guides filtered while sampling
         if denoise and raster is None and not denoise_guides.FOLLOW_SPECULAR:
             # guides of their own: drawn on a thread of their own, its GL context made while Mitsuba starts
             self._worker = GuideWorker(scene)
@@ -82,6 +84,7 @@ class ColorProducer:
                 "clamp_indirect": s.clamp_indirect if self.view.clamped else 0.0,
                 "filter_glossy": s.filter_glossy if self.view.own_integrator else 0.0,
                 **({"edge_min_samples": plan.edge_min_samples} if plan.edge_floor and self.denoise else {}),
+                **({"edge_raw_weight": s.edge_raw_weight} if s.edge_raw_weight > 0 and self.denoise else {}),
                 "pixel_filter": (f"Blackman-Harris, filter_width {self.view.filter_width} px" if self.view.filter_width
                                  else "box, 1 px"),
                 "min_bounces": s.min_bounces, "max_bounces": s.max_bounces, "mitsuba_max_depth": s.max_bounces + 2,
@@ -101,40 +104,39 @@ class ColorProducer:
         next keypoint while Open Image Denoise works on this one (:func:`hybridgen.render.keypoint_loop.run_keypoints`;
         the same values as in order)."""
         worker = self._worker  # guides drawn on their own thread while the samples are traced
-        drawing = worker.submit(cam2world, self.view.filter_width) if worker is not None else None
         plan = self.settings.plan()
-        guides = None
-        edges = None
-        if self.denoise and plan.edge_floor:  # the guides' edges get more samples
-            if drawing is None and self._guides is not None:  # the shared raster: guides drawn first
-                guides = self._guides.render(cam2world, self.view)
-            edges = partial(_edges_of, worker, drawing, guides)
+        guides: KeypointGuides | None = None
+        if worker is not None:
+            guides = KeypointGuides(partial(worker.result, worker.submit(cam2world, self.view.filter_width)))
+        elif self._guides is not None and plan.edge_floor:  # the shared raster: drawn here, filtered meanwhile
+            fine = self._guides.draw(cam2world, self.view)
+            if self._filtering is None:
+                self._filtering = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hybridgen-guide-filter")
+            guides = KeypointGuides(self._filtering.submit(self._guides.filtered, fine).result)
+        edges = guides.edges if guides is not None and self.denoise and plan.edge_floor else None
         linear, counts = self.view.render_with_counts(cam2world, keypoint_seed(self.seed, index, eye), edges=edges)
         values: dict[str, Any] = {}
         if self.keep_raw:
             values["colors_raw"] = to_srgb8(linear)
         if self.sample_counts:
             values["sample_counts"] = counts
-        fine = None  # drawn here, on the GL context's thread, and filtered on the denoising thread
-        if drawing is None and guides is None and self._guides is not None:
-            fine = self._guides.draw(cam2world, self.view)
-        finish = partial(self._finish, values, linear, worker if drawing is not None else None, drawing, guides, fine)
+        if guides is None and self._guides is not None:  # drawn here, on the GL context's thread, and filtered
+            guides = KeypointGuides(partial(self._guides.filtered, self._guides.draw(cam2world, self.view)))
+        finish = partial(self._finish, values, linear, guides)
         if not self.denoise:
             return finish
         if self._denoiser is None:
             self._denoiser = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hybridgen-denoise")
         return self._denoiser.submit(finish).result
 
-    def _finish(self, values: dict[str, Any], linear: np.ndarray, worker: GuideWorker | None, drawing: Any,
-                guides: tuple[np.ndarray, np.ndarray] | None,
-                fine: tuple[np.ndarray, np.ndarray] | None) -> dict[str, Any]:
-        """``values`` completed with the keypoint's colors: ``linear`` denoised with the guides (``guides``, the
-        supersampled ``fine`` ones filtered here, or ``worker``'s ``drawing``) when denoising, then encoded."""
-        if worker is not None:
-            linear = oidn_denoise(linear, *worker.result(drawing))
-        elif guides is not None or fine is not None:
-            assert self._guides is not None
-            linear = oidn_denoise(linear, *(guides if guides is not None else self._guides.filtered(fine)))
+    def _finish(self, values: dict[str, Any], linear: np.ndarray, guides: KeypointGuides | None) -> dict[str, Any]:
+        """``values`` completed with the keypoint's colors: ``linear`` denoised with the keypoint's ``guides`` when
+        denoising (and the raw samples mixed back on strong edges, :mod:`hybridgen.render.edge_blend`), then
+        encoded."""
+        if guides is not None:
+            denoised = oidn_denoise(linear, *guides.get())
+            linear = mix_raw_on_edges(denoised, linear, guides.strength(), self.settings.edge_raw_weight) \
+                if self.settings.edge_raw_weight > 0 else denoised
         values["colors"] = to_srgb8(linear)
         if self.hdr:
             values["colors_hdr"] = linear.astype(np.float16)
@@ -148,22 +150,16 @@ class ColorProducer:
     def close(self) -> None:
         """Release the denoising guides' GL resources and thread and the denoising thread (the Mitsuba scene goes
         with this producer)."""
-        if self._denoiser is not None:
-            denoiser, self._denoiser = self._denoiser, None
-            denoiser.shutdown(wait=True)
+        for pool in (self._denoiser, self._filtering):
+            if pool is not None:
+                pool.shutdown(wait=True)
+        self._denoiser = self._filtering = None
         if self._guides is not None:
             self._guides.release()
             self._guides = None
         if self._worker is not None:
             worker, self._worker = self._worker, None
             worker.release()
-
-
-def _edges_of(worker: GuideWorker | None, drawing: Any, guides: tuple[np.ndarray, np.ndarray] | None) -> np.ndarray:
-    """The edge pixels (:func:`hybridgen.render.guide_edges.guide_edges`) of a keypoint's denoising guides: drawn
-    already (``guides``) or by ``worker`` (waits for its ``drawing``)."""
-    albedo, normals = guides if guides is not None else worker.result(drawing)  # type: ignore[union-attr]
-    return guide_edges(albedo, normals)
 
 
 def render_color(scene: Scene, sinks: Iterable[FrameSink], settings: PathTraceSettings | None = None, *,

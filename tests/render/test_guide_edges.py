@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
-from hybridgen.render.guide_edges import ALBEDO_STEP, NORMAL_STEP, guide_edges
+from hybridgen.render.guide_edges import ALBEDO_STEP, NORMAL_STEP, edge_strength, guide_edges
 from hybridgen.render.pathtrace.adaptive_sampling import SamplingPlan, render_adaptive
 from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
 
@@ -31,6 +31,18 @@ def test_an_albedo_step_marks_the_two_columns_beside_it() -> None:
     assert np.array_equal(guide_edges(albedo, normals), expected)
     albedo[:, 5:] = 0.5 + ALBEDO_STEP / 4  # 0.75 x ALBEDO_STEP summed: no edge
     assert not guide_edges(albedo, normals).any()
+
+
+def test_edge_strength_is_the_largest_step_in_units_of_the_thresholds() -> None:
+    albedo, normals = _flat()
+    albedo[:, 5:, 0] += 0.3  # an albedo step of 0.3 = 6 x ALBEDO_STEP
+    normals[3:, :] = [0.0, 0.6, 0.8]  # a normal step of |0.6| + |0.2| = 0.8 = 8 x NORMAL_STEP
+    strength = edge_strength(albedo, normals)
+    assert strength.dtype == np.float32
+    assert strength[0, 4] == pytest.approx(0.3 / ALBEDO_STEP) and strength[0, 5] == pytest.approx(6.0)
+    assert strength[2, 0] == pytest.approx(8.0) and strength[3, 9] == pytest.approx(8.0)
+    assert strength[0, 0] == 0.0 and strength[5, 8] == 0.0
+    assert np.array_equal(guide_edges(albedo, normals), strength > 1.0)
 
 
 def test_a_crease_marks_pixels_when_the_normals_turn_more_than_the_step() -> None:
@@ -145,7 +157,7 @@ def test_the_color_producer_gives_its_guides_edges_the_floor(gl_context) -> None
         assert (counts[far_sky] == 4).all()
 
 
-def test_blenderproc_scripts_denoise_with_four_times_the_minimum_on_edges(monkeypatch) -> None:
+def test_blenderproc_scripts_denoise_from_half_the_minimum_with_four_times_it_on_edges(monkeypatch) -> None:
     from hybridgen.bproc import render_frames
 
     seen: list[hg.PathTraceSettings] = []
@@ -164,7 +176,14 @@ def test_blenderproc_scripts_denoise_with_four_times_the_minimum_on_edges(monkey
         render_frames._render_group([0], [], True, False)
         return seen[-1]
 
-    assert render("INTEL").edge_min_samples == 256  # 4 x Cycles' automatic minimum 64 at threshold 0.01
+    denoised = render("INTEL")
+    assert denoised.edge_min_samples == 256  # 4 x Cycles' automatic minimum 64 at threshold 0.01
+    assert denoised.plan().min_samples == 32 and denoised.plan().rounds()[:2] == [32, 32]  # half of it
+    assert denoised.edge_raw_weight == 0.5
+    assert render("INTEL", threshold=0.001).plan().min_samples == 64  # Cycles' 128 at 0.001, halved
     assert render("INTEL", samples=100).edge_min_samples == 100
-    assert render(None).edge_min_samples == 0
-    assert render("INTEL", threshold=0.0).edge_min_samples == 0
+    capped = render("INTEL", samples=20)  # the minimum is capped at the maximum first, then halved
+    assert capped.plan().min_samples == 10 and capped.edge_min_samples == 20
+    for plain in (render(None), render("INTEL", threshold=0.0)):
+        assert plain.edge_min_samples == 0 and plain.edge_raw_weight == 0.0
+    assert render(None).plan().min_samples == 64  # without the denoiser: Cycles' minimum

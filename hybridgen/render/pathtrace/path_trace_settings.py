@@ -87,7 +87,11 @@ class PathTraceSettings:
 
     ``edge_min_samples`` (hybridgen's; default 0 = off): with adaptive sampling and denoising, the samples per pixel
     the pixels on edges of the denoising guides get at least (:mod:`hybridgen.render.guide_edges`; at most the
-    maximum). BlenderProc scripts render with four times the minimum (:mod:`hybridgen.bproc.render_frames`).
+    maximum). BlenderProc scripts render with four times Cycles' automatic minimum (:mod:`hybridgen.bproc.render_frames`).
+
+    ``edge_raw_weight`` (hybridgen's; default 0 = off): with denoising, the share of the raw (not denoised) value in
+    the colors of pixels on strong edges of the denoising guides (:mod:`hybridgen.render.edge_blend`), 0..1.
+    BlenderProc scripts render with 0.5.
     """
 
     samples: int | None = None
@@ -103,6 +107,7 @@ class PathTraceSettings:
     filter_glossy: float = glossy_filter.DEFAULT_FILTER_GLOSSY
     caustics_refractive: bool = True
     edge_min_samples: int = 0
+    edge_raw_weight: float = 0.0
 
     def __post_init__(self) -> None:
         if self.samples is not None and self.samples < 1:
@@ -120,6 +125,8 @@ class PathTraceSettings:
             raise InputError(f"filter_glossy must be >= 0 (0 = off), got {self.filter_glossy}")
         if self.edge_min_samples < 0:
             raise InputError(f"edge_min_samples must be >= 0 (0 = off), got {self.edge_min_samples}")
+        if not (math.isfinite(self.edge_raw_weight) and 0 <= self.edge_raw_weight <= 1):
+            raise InputError(f"edge_raw_weight must be in 0..1 (0 = off), got {self.edge_raw_weight}")
         if not (math.isfinite(self.filter_width) and 0 <= self.filter_width <= 10):
             raise InputError(f"filter_width must be in 0..10 px (0 = one-pixel box), got {self.filter_width}")
         self.plan()  # validates the sampling knobs
