@@ -112,7 +112,8 @@ class ColorProducer:
             fine = self._guides.draw(cam2world, self.view)
             if self._filtering is None:
                 self._filtering = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hybridgen-guide-filter")
-            guides = KeypointGuides(self._filtering.submit(self._guides.filtered, fine).result)
+            guides = KeypointGuides(partial(self._guides.filtered, fine))
+            self._filtering.submit(guides.strength)  # filtered and their edges found while the first round samples
         edges = guides.edges if guides is not None and self.denoise and plan.edge_floor else None
         linear, counts = self.view.render_with_counts(cam2world, keypoint_seed(self.seed, index, eye), edges=edges)
         values: dict[str, Any] = {}

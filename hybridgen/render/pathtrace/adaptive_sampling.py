@@ -181,7 +181,8 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
     floor: np.ndarray | None = None  # the edge pixels (flat bool), once asked for
     for round_index, spp in enumerate(plan.rounds()):
         if round_index > 0:
-            error = pixel_error(sum_a[active], sum_b[active], count[active])
+            rows = slice(None) if len(active) == h * w else active  # all: views, not copies
+            error = pixel_error(sum_a[rows], sum_b[rows], count[rows])
             unconverged = np.zeros(h * w, dtype=bool)
             unconverged[active] = error >= plan.noise_threshold * CYCLES_THRESHOLD_SCALE
             keep = dilate(unconverged.reshape(h, w)).ravel()

@@ -24,6 +24,7 @@ from functools import lru_cache
 
 from ...errors import SystemSetupError
 from ...io.cache_folder import cache_path
+from .huge_pages import decline_huge_pages
 
 AUTO_ORDER = ("cuda_ad_rgb", "llvm_ad_rgb", "scalar_rgb")
 ENV_VARIABLE = "HYBRIDGEN_MITSUBA_VARIANT"
@@ -137,9 +138,12 @@ def choose_variant(requested: str | None = None) -> str:
 def activate(variant: str) -> None:
     """Make ``variant`` the current Mitsuba variant of this process, with the threads it was given. Mitsuba's
     Python AD integrators, which the first switch to a JIT variant would execute, run on first use instead
-    (:mod:`hybridgen.render.pathtrace.deferred_ad_integrators`)."""
+    (:mod:`hybridgen.render.pathtrace.deferred_ad_integrators`). The LLVM variants run with 4 KiB pages
+    (:mod:`hybridgen.render.pathtrace.huge_pages`)."""
     import mitsuba as mi
 
+    if variant.startswith("llvm_"):
+        decline_huge_pages()  # before Dr.Jit's first allocation: see huge_pages.py
     if mi.variant() != variant:
         from . import deferred_ad_integrators
 
