@@ -77,9 +77,17 @@ BlenderProc 55.84 and 56.23 dB, sampling CPU s of the frame (loaded machine, +-5
 encoding, scores ~0.1 dB higher.) Before the mix, the edge floor alone (64, 256) had taken basics/basic from
 53.47 to 54.53 dB and camera_sampling from 53.50 to 54.06 dB against a single 1024-spp reference (BlenderProc
 54.34 and 54.00), for 20-35 % more sampling time."""
-EDGE_RAW_WEIGHT = 0.5
-"""Denoised renders mix this share of the raw samples into the colors on strong guide edges
-(:mod:`hybridgen.render.edge_blend`)."""
+EDGE_RAW_WEIGHT = 0.6
+"""Denoised renders mix this share of the raw samples, pooled with the neighbours'
+(:mod:`hybridgen.render.pathtrace.pooled_edges`), into the colors on guide edges (:mod:`hybridgen.render.edge_blend`)."""
+DENOISED_MAX_SHARE = 0.25
+"""Denoised adaptive renders stop every pixel at this share of the script's maximum samples (256 of Cycles' 1024),
+but not below the edge floor."""
+FLAT_NOISE_SCALE = 1.5
+"""Denoised adaptive renders stop pixels off the guide edges at this many times the noise threshold
+(:attr:`hybridgen.render.pathtrace.path_trace_settings.PathTraceSettings.flat_noise_scale`)."""
+GUIDE_FACTOR = 2
+"""Denoised renders rasterize the denoising guides at twice the resolution (hybridgen's default: 3)."""
 
 
 def _light_state(frame: int) -> tuple[Any, ...]:
@@ -201,8 +209,10 @@ def _render_group(frames: list[int], meshes: list[MeshObject], color: bool,
         if settings.denoiser is not None and trace.plan().adaptive:  # see DENOISED_MIN_SHARE and EDGE_SAMPLES
             automatic = trace.plan().min_samples  # Cycles' automatic minimum for the threshold
             least = max(2, int(automatic * DENOISED_MIN_SHARE) // 2 * 2)
-            trace = replace(trace, min_samples=min(least, samples),
-                            edge_min_samples=min(EDGE_SAMPLES * automatic, samples), edge_raw_weight=EDGE_RAW_WEIGHT)
+            edge = min(EDGE_SAMPLES * automatic, samples)
+            trace = replace(trace, samples=max(edge, int(samples * DENOISED_MAX_SHARE)), min_samples=min(least, samples),
+                            edge_min_samples=edge, edge_raw_weight=EDGE_RAW_WEIGHT, flat_noise_scale=FLAT_NOISE_SCALE,
+                            guide_factor=GUIDE_FACTOR)
         scene.camera.depth_of_field = _depth_of_field(frames[0])
         hg.render_color(scene, [sink], trace, labels=request, seed=0, denoise=settings.denoiser is not None,
                         hdr=settings.color_depth == 16, stereo_baseline=_stereo_baseline())

@@ -26,7 +26,7 @@ from concurrent.futures import Future
 import numpy as np
 
 from ..scene.scene import Scene
-from .denoise_guides import DenoiseGuides
+from .denoise_guides import DEFAULT_FACTOR, DenoiseGuides
 from .pathtrace import denoise
 from .raster.gl_worker import DEFAULT_TIMEOUT_S, GLWorker
 from .raster.raster_view import RasterView
@@ -38,8 +38,9 @@ class GuideWorker:
     construction, in the background) and draws :class:`~hybridgen.render.denoise_guides.DenoiseGuides` of the
     keypoints handed to :meth:`submit`, in order."""
 
-    def __init__(self, scene: Scene, timeout: float = DEFAULT_TIMEOUT_S) -> None:
+    def __init__(self, scene: Scene, timeout: float = DEFAULT_TIMEOUT_S, factor: int = DEFAULT_FACTOR) -> None:
         self._guides: DenoiseGuides | None = None  # made on the worker by the first submit (its filter width)
+        self._factor = int(factor)  # the guides' supersampling (denoise_guides.py)
 
         def build(ctx: object) -> SceneRaster:
             return SceneRaster(scene, view=RasterView(scene, ctx=ctx))
@@ -64,7 +65,8 @@ class GuideWorker:
 
         def draw(raster: SceneRaster) -> tuple[np.ndarray, np.ndarray]:
             if self._guides is None or self._guides.filter_width != width:
-                self._guides = DenoiseGuides(raster.scene, raster=raster, filter_width=width, follow_specular=False)
+                self._guides = DenoiseGuides(raster.scene, self._factor, raster=raster, filter_width=width,
+                                             follow_specular=False)
             return self._guides.render(pose)
 
         return self._worker.submit(draw)

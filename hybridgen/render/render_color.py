@@ -20,6 +20,7 @@ from .passes import color_keys, layout
 from .pathtrace.denoise import denoise as oidn_denoise
 from .pathtrace.denoise import require_oidn
 from .pathtrace.path_trace import PathTraceSettings, PathTraceView
+from .pathtrace.pooled_edges import PooledEdges
 from .raster.label_producer import LabelProducer
 from .raster.label_request import LabelRequest
 from .raster.scene_raster import SceneRaster
@@ -51,9 +52,10 @@ class ColorProducer:
         self._worker: GuideWorker | None = None
         self._denoiser: ThreadPoolExecutor | None = None  # denoising and encoding, one keypoint at a time
         self._filtering: ThreadPoolExecutor | None = None  # the shared raster's guides filtered while sampling
+        self._pool: PooledEdges | None | bool = None  # edge pixels' pooled samples (False: the view cannot pool)
         if denoise and raster is None and not denoise_guides.FOLLOW_SPECULAR:
             # guides of their own: drawn on a thread of their own, its GL context made while Mitsuba starts
-            self._worker = GuideWorker(scene)
+            self._worker = GuideWorker(scene, factor=settings.guide_factor)
         try:
             if denoise:
                 require_oidn()
@@ -64,7 +66,7 @@ class ColorProducer:
             self.close()
             raise
         if denoise and self._worker is None:  # raster: the labels' view, shared; guides filtered like the pixels
-            self._guides = DenoiseGuides(scene, raster=raster, filter_width=self.view.filter_width)
+            self._guides = DenoiseGuides(scene, settings.guide_factor, raster=raster, filter_width=self.view.filter_width)
 
     @property
     def guides(self) -> DenoiseGuides | None:
@@ -115,7 +117,10 @@ class ColorProducer:
             guides = KeypointGuides(partial(self._guides.filtered, fine))
             self._filtering.submit(guides.strength)  # filtered and their edges found while the first round samples
         edges = guides.edges if guides is not None and self.denoise and plan.edge_floor else None
-        linear, counts = self.view.render_with_counts(cam2world, keypoint_seed(self.seed, index, eye), edges=edges)
+        pool = self._edge_pool() if edges is not None else None
+        linear, counts = self.view.render_with_counts(cam2world, keypoint_seed(self.seed, index, eye), edges=edges,
+                                                      pool=pool)
+        pooled = pool.image() if pool is not None and pool.started else None
         values: dict[str, Any] = {}
         if self.keep_raw:
             values["colors_raw"] = to_srgb8(linear)
@@ -123,20 +128,29 @@ class ColorProducer:
             values["sample_counts"] = counts
         if guides is None and self._guides is not None:  # drawn here, on the GL context's thread, and filtered
             guides = KeypointGuides(partial(self._guides.filtered, self._guides.draw(cam2world, self.view)))
-        finish = partial(self._finish, values, linear, guides)
+        finish = partial(self._finish, values, linear, guides, pooled)
         if not self.denoise:
             return finish
         if self._denoiser is None:
             self._denoiser = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hybridgen-denoise")
         return self._denoiser.submit(finish).result
 
-    def _finish(self, values: dict[str, Any], linear: np.ndarray, guides: KeypointGuides | None) -> dict[str, Any]:
+    def _edge_pool(self) -> PooledEdges | None:
+        """The view's pool of edge pixels' samples when raw samples are mixed back on edges (made once per view)."""
+        if self.settings.edge_raw_weight <= 0 or not self.denoise:
+            return None
+        if self._pool is None:
+            self._pool = self.view.pooled_edges() or False
+        return self._pool or None
+
+    def _finish(self, values: dict[str, Any], linear: np.ndarray, guides: KeypointGuides | None,
+                pooled: np.ndarray | None = None) -> dict[str, Any]:
         """``values`` completed with the keypoint's colors: ``linear`` denoised with the keypoint's ``guides`` when
-        denoising (and the raw samples mixed back on strong edges, :mod:`hybridgen.render.edge_blend`), then
-        encoded."""
+        denoising (and the raw samples - ``pooled`` where given - mixed back on edges, :mod:`hybridgen.render.edge_blend`),
+        then encoded."""
         if guides is not None:
             denoised = oidn_denoise(linear, *guides.get())
-            linear = mix_raw_on_edges(denoised, linear, guides.strength(), self.settings.edge_raw_weight) \
+            linear = mix_raw_on_edges(denoised, linear, guides.strength(), self.settings.edge_raw_weight, pooled) \
                 if self.settings.edge_raw_weight > 0 else denoised
         values["colors"] = to_srgb8(linear)
         if self.hdr:
@@ -147,6 +161,7 @@ class ColorProducer:
         """The scene's objects moved or the intrinsics changed between keypoints: Mitsuba's scene is built anew
         (its meshes are stored in world coordinates, its sensor holds the intrinsics)."""
         self.view = PathTraceView(self.scene, self.settings, variant=self.view.variant)
+        self._pool = None
 
     def close(self) -> None:
         """Release the denoising guides' GL resources and thread and the denoising thread (the Mitsuba scene goes

@@ -1,6 +1,7 @@
-"""Raw samples mixed back into denoised colors on strong guide edges (hybridgen.render.edge_blend): the arithmetic on
-its own, then the color producer's output - with the whole raw share, strong-edge pixels carry the raw colors and
-every other pixel the denoised ones, whichever way the guides are made."""
+"""Raw samples mixed back into denoised colors on guide edges (hybridgen.render.edge_blend): the arithmetic on its own
+(the raw samples on strong edges, or the pooled estimate where there is one), then the color producer's output - with
+the whole raw share, edge pixels carry the pooled estimate (hybridgen.render.pathtrace.pooled_edges) and every other
+pixel the denoised colors, whichever way the guides are made."""
 from __future__ import annotations
 
 import numpy as np
@@ -52,13 +53,24 @@ def _scene() -> hg.Scene:
 
 
 @pytest.mark.parametrize("shared_raster", [False, True])
-def test_the_producer_keeps_the_raw_colors_on_strong_edges(gl_context, shared_raster: bool) -> None:
+def test_the_producer_mixes_the_pooled_estimate_on_edges(gl_context, monkeypatch, shared_raster: bool) -> None:
+    from hybridgen.render import render_color
     from hybridgen.render.denoise_guides import DenoiseGuides
     from hybridgen.render.raster.scene_raster import SceneRaster
     from hybridgen.render.render_color import ColorProducer
+    from hybridgen.render.tonemap import to_srgb8
 
+    if choose_variant() == "scalar_rgb":
+        pytest.skip("pooling needs a JIT Mitsuba variant")
     scene = _scene()
     pose = scene.camera.keypoints[0]
+    mixes: list[dict] = []
+
+    def recording(denoised, raw, strength, weight, pooled=None):
+        mixes.append({"raw": raw, "pooled": pooled})
+        return mix_raw_on_edges(denoised, raw, strength, weight, pooled)
+
+    monkeypatch.setattr(render_color, "mix_raw_on_edges", recording)
     outputs = {}
     for weight in (0.0, 1.0):
         settings = hg.PathTraceSettings(samples=16, noise_threshold=0.01, min_samples=4, edge_min_samples=16,
@@ -74,12 +86,34 @@ def test_the_producer_keeps_the_raw_colors_on_strong_edges(gl_context, shared_ra
                 raster.release()
     guides = DenoiseGuides(scene)
     try:
-        strong = edge_strength(*guides.render(pose)) >= STRONG_EDGE
+        edges = edge_strength(*guides.render(pose)) > 1.0
     finally:
         guides.release()
-    assert 20 < strong.sum() < strong.size / 3
+    assert 20 < edges.sum() < edges.size / 2
+    assert len(mixes) == 1  # weight 0: no mix at all
+    pooled, raw = mixes[0]["pooled"], mixes[0]["raw"]
+    assert np.array_equal(np.isfinite(pooled).all(axis=2), edges)  # pooled exactly on the edge pixels
     mixed, plain = outputs[1.0], outputs[0.0]
     assert np.array_equal(mixed["colors_raw"], plain["colors_raw"])  # the same samples
-    assert np.array_equal(mixed["colors"][strong], mixed["colors_raw"][strong])
-    assert np.array_equal(mixed["colors"][~strong], plain["colors"][~strong])
-    assert not np.array_equal(plain["colors"][strong], plain["colors_raw"][strong])  # the denoiser did change them
+    assert np.array_equal(mixed["colors"][edges], to_srgb8(pooled)[edges])
+    assert np.array_equal(mixed["colors"][~edges], plain["colors"][~edges])
+    assert not np.array_equal(plain["colors"][edges], plain["colors_raw"][edges])  # the denoiser did change them
+    # the pooled estimate has the raw samples' expectation: their means over the edge pixels agree closely
+    assert abs(pooled[edges].mean() - raw[edges].mean()) < 0.03 * raw[edges].mean()
+    assert not np.array_equal(pooled[edges], raw[edges])
+
+
+def test_without_a_pool_the_raw_samples_are_mixed_on_strong_edges() -> None:
+    rng = np.random.default_rng(5)
+    denoised, raw, pooled = (rng.random((3, 4, 3), dtype=np.float32) for _ in range(3))
+    strength = np.zeros((3, 4), np.float32)
+    strength[1, 1] = STRONG_EDGE
+    strength[2, 2] = 2.0  # an edge, not a strong one
+    pooled[:] = np.nan
+    pooled[2, 2] = 0.5
+    with_pool = mix_raw_on_edges(denoised, raw, strength, 0.5, pooled)
+    np.testing.assert_allclose(with_pool[2, 2], 0.5 * 0.5 + 0.5 * denoised[2, 2], rtol=1e-6)
+    assert np.array_equal(with_pool[1, 1], denoised[1, 1])  # where the pool has no value: denoised
+    without = mix_raw_on_edges(denoised, raw, strength, 0.5)
+    np.testing.assert_allclose(without[1, 1], 0.5 * raw[1, 1] + 0.5 * denoised[1, 1], rtol=1e-6)
+    assert np.array_equal(without[2, 2], denoised[2, 2])

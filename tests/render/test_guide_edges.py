@@ -115,6 +115,40 @@ def test_edge_pixels_get_edge_min_samples_and_the_others_stop_at_the_minimum() -
         SamplingPlan(64, 4, 0.01, edge_min_samples=128)
 
 
+class _NoisyTracer(_ExactTracer):
+    """Pixel i's two halves differ by 2 x ``spread[i]`` of its value 0.25 in every round: its error estimate is
+    0.866 x spread (Cycles' estimate, adaptive_sampling.pixel_error), whatever its samples."""
+
+    def __init__(self, width: int, height: int, spread: np.ndarray) -> None:
+        super().__init__(width, height)
+        self.spread = spread.ravel()
+
+    def trace(self, pixels: np.ndarray, spp: int, seed: int, first: np.ndarray | None = None):
+        self.rounds.append(np.array(pixels))
+        half = np.full((len(pixels), 3), 0.25 * spp / 2)
+        e = self.spread[pixels][:, None]
+        return half * (1 + e), half * (1 - e)
+
+
+def test_flat_noise_scale_stops_pixels_off_the_edges_at_a_looser_threshold() -> None:
+    spread = np.zeros((7, 9))
+    spread[3, 4] = 0.07  # error 0.061: above Cycles' 5 x 0.01, below 1.5 times that
+    spread[1, 1] = 0.07  # the same noise on an edge pixel
+    edges = np.zeros((7, 9), bool)
+    edges[1, 1] = True
+    plan = SamplingPlan(64, 4, 0.01, edge_min_samples=16)
+    _, counts = render_adaptive(_NoisyTracer(9, 7, spread), plan, 1, lambda: edges)
+    assert counts[3, 4] == 64 and (counts[2:5, 3:6] == 64).all()  # unconverged, and its neighbours with it
+    assert counts[1, 1] == 64
+    loose = SamplingPlan(64, 4, 0.01, edge_min_samples=16, flat_noise_scale=1.5)
+    _, counts = render_adaptive(_NoisyTracer(9, 7, spread), loose, 1, lambda: edges)
+    assert counts[3, 4] == 4 and (counts[2:5, 3:6] == 4).all()  # off the edges: converged at 1.5 x
+    assert counts[1, 1] == 64  # on an edge: the threshold as given
+    assert counts[6, 8] == 4 and counts[0, 8] == 4  # quiet pixels stop at the minimum
+    with pytest.raises(hg.InputError, match="flat_noise_scale"):
+        SamplingPlan(64, 4, 0.01, flat_noise_scale=0.5)
+
+
 def _silhouette_scene() -> hg.Scene:
     """A white cube lit by a sun against a black sky (sky pixels: every sample 0)."""
     scene = hg.Scene()
@@ -158,6 +192,8 @@ def test_the_color_producer_gives_its_guides_edges_the_floor(gl_context) -> None
 
 
 def test_blenderproc_scripts_denoise_from_half_the_minimum_with_four_times_it_on_edges(monkeypatch) -> None:
+    """And stop at a quarter of the maximum, 1.5 times the threshold off the edges, with guides at twice the
+    resolution (hybridgen.bproc.render_frames)."""
     from hybridgen.bproc import render_frames
 
     seen: list[hg.PathTraceSettings] = []
@@ -179,11 +215,16 @@ def test_blenderproc_scripts_denoise_from_half_the_minimum_with_four_times_it_on
     denoised = render("INTEL")
     assert denoised.edge_min_samples == 256  # 4 x Cycles' automatic minimum 64 at threshold 0.01
     assert denoised.plan().min_samples == 32 and denoised.plan().rounds()[:2] == [32, 32]  # half of it
-    assert denoised.edge_raw_weight == 0.5
+    assert denoised.plan().max_samples == 256  # a quarter of Cycles' 1024, not below the edge floor
+    assert denoised.edge_raw_weight == 0.6 and denoised.flat_noise_scale == 1.5 and denoised.guide_factor == 2
+    assert render("INTEL", samples=4096).plan().max_samples == 1024
     assert render("INTEL", threshold=0.001).plan().min_samples == 64  # Cycles' 128 at 0.001, halved
-    assert render("INTEL", samples=100).edge_min_samples == 100
+    hundred = render("INTEL", samples=100)
+    assert hundred.edge_min_samples == 100 and hundred.plan().max_samples == 100
     capped = render("INTEL", samples=20)  # the minimum is capped at the maximum first, then halved
     assert capped.plan().min_samples == 10 and capped.edge_min_samples == 20
     for plain in (render(None), render("INTEL", threshold=0.0)):
         assert plain.edge_min_samples == 0 and plain.edge_raw_weight == 0.0
+        assert plain.flat_noise_scale == 1.0 and plain.guide_factor == 3
     assert render(None).plan().min_samples == 64  # without the denoiser: Cycles' minimum
+    assert render(None).plan().max_samples == 1024

@@ -13,6 +13,8 @@ Knobs (Cycles' and BlenderProc's names and meaning):
 - ``edge_min_samples`` (hybridgen's, 0 = off): samples a pixel the denoiser cannot smooth (an edge of the denoising
   guides, :mod:`hybridgen.render.guide_edges`) gets at least, whatever its error estimate; the render's caller
   hands the edge pixels to :func:`render_adaptive`, which asks for them after the first round.
+- ``flat_noise_scale`` (hybridgen's, default 1): with ``edge_min_samples``, the pixels off the edges (which the
+  denoiser smooths) stop at this many times the threshold.
 
 The error estimate is Cycles' (after Dammertz et al. 2010, "A hierarchical automatic stopping condition
 for Monte Carlo global illumination"; ``film_adaptive_sampling_convergence_check`` in Cycles'
@@ -76,6 +78,7 @@ import numpy as np
 
 from ...errors import InputError
 from .pixel_tracer import PixelTracer, launch_counts, pattern_size, round_seed
+from .pooled_edges import PooledEdges
 
 __all__ = ["CYCLES_THRESHOLD_SCALE", "MAX_WAVEFRONT", "PixelTracer", "SamplingPlan", "automatic_min_samples", "dilate",
            "launch_counts", "pattern_size", "pixel_error", "render_adaptive", "round_seed"]
@@ -98,6 +101,8 @@ class SamplingPlan:
     min_samples: int = 16
     noise_threshold: float = 0.01
     edge_min_samples: int = 0
+    flat_noise_scale: float = 1.0
+    """With ``edge_min_samples``: pixels off the edges stop at this many times the threshold (>= 1)."""
 
     def __post_init__(self) -> None:
         if self.max_samples < 1:
@@ -109,6 +114,8 @@ class SamplingPlan:
                              f"pixel's samples: samples must be >= 2, got {self.max_samples}")
         if self.adaptive and not 2 <= self.min_samples <= self.max_samples:
             raise InputError(f"min_samples must be in 2..samples ({self.max_samples}), got {self.min_samples}")
+        if not (math.isfinite(self.flat_noise_scale) and self.flat_noise_scale >= 1):
+            raise InputError(f"flat_noise_scale must be >= 1, got {self.flat_noise_scale}")
         if not 0 <= self.edge_min_samples <= self.max_samples:
             raise InputError(f"edge_min_samples must be in 0..samples ({self.max_samples}), "
                              f"got {self.edge_min_samples}")
@@ -168,10 +175,14 @@ def dilate(mask: np.ndarray) -> np.ndarray:
 
 
 def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
-                    edges: Callable[[], np.ndarray | None] | None = None) -> tuple[np.ndarray, np.ndarray]:
+                    edges: Callable[[], np.ndarray | None] | None = None,
+                    pool: PooledEdges | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Linear RGB (float32 H x W x 3) and samples per pixel (uint32 H x W) of one keypoint. With the plan's
     ``edge_min_samples``, ``edges`` is called once, after the first round (so that the caller can find them
-    meanwhile), for the pixels (bool H x W, or None: none) that get at least that many samples."""
+    meanwhile), for the pixels (bool H x W, or None: none) that get at least that many samples. With ``pool`` as
+    well (a tracer with hybridgen's Owen-Sobol sampler), those pixels' samples from the second round on are also
+    pooled with their neighbours' (:mod:`hybridgen.render.pathtrace.pooled_edges`; ``pool.started`` tells whether
+    there were any)."""
     h, w = tracer.height, tracer.width
     if isinstance(tracer, PixelTracer):
         tracer.guide_world()
@@ -179,25 +190,44 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
     count = np.zeros(h * w, dtype=np.uint32)
     active = np.arange(h * w)
     floor: np.ndarray | None = None  # the edge pixels (flat bool), once asked for
+    if pool is not None:
+        pool.reset()
+        if not getattr(tracer, "owen_sobol", False):
+            pool = None
     for round_index, spp in enumerate(plan.rounds()):
         if round_index > 0:
             rows = slice(None) if len(active) == h * w else active  # all: views, not copies
             error = pixel_error(sum_a[rows], sum_b[rows], count[rows])
+            if plan.edge_floor and edges is not None and floor is None:
+                found = edges()
+                floor = np.zeros(h * w, dtype=bool) if found is None else np.asarray(found, dtype=bool).ravel()
+            threshold = plan.noise_threshold * CYCLES_THRESHOLD_SCALE
+            if floor is not None and plan.flat_noise_scale != 1:  # the denoiser smooths the pixels off the edges
+                threshold = np.where(floor[active], threshold, threshold * plan.flat_noise_scale)
             unconverged = np.zeros(h * w, dtype=bool)
-            unconverged[active] = error >= plan.noise_threshold * CYCLES_THRESHOLD_SCALE
+            unconverged[active] = error >= threshold
             keep = dilate(unconverged.reshape(h, w)).ravel()
-            if plan.edge_floor and edges is not None:
-                if floor is None:
-                    found = edges()
-                    floor = np.zeros(h * w, dtype=bool) if found is None else np.asarray(found, dtype=bool).ravel()
+            if floor is not None:
                 keep |= floor & (count < plan.edge_min_samples)
             active = active[keep[active]]
             if len(active) == 0:
                 break
+            if pool is not None and floor is not None and floor.any():
+                if not pool.started:  # the edges are known from the second round on
+                    pool.start(floor, sum_a + sum_b, count)
+                pool.round(active)
         # a whole-frame tracer (scalar_rgb's) renders every pixel per call: one call per round
         per_chunk = len(active) if tracer.whole_frames else max(1, MAX_WAVEFRONT // spp)
         for chunk, start in enumerate(range(0, len(active), per_chunk)):
             pixels = active[start:start + per_chunk]
+            if pool is not None and pool.started:  # pooled pixels in a launch of their own
+                pooled = pool.contributing(pixels)
+                for part, part_pool in ((pixels[pooled], pool), (pixels[~pooled], None)):
+                    if len(part):
+                        a, b = tracer.trace(part, spp, seed, first=count[part], pool=part_pool)
+                        sum_a[part] += a
+                        sum_b[part] += b
+                continue
             if tracer.owen_sobol:  # one pattern per pixel, continued from round to round
                 a, b = tracer.trace(pixels, spp, seed, first=count[pixels])
             else:

@@ -25,6 +25,7 @@ from .mitsuba_variant import activate, choose_variant, is_jit
 from .path_trace_settings import (CYCLES_MAX_SAMPLES, DEFAULT_MAX_SAMPLES, DEFAULT_MIN_SAMPLES, DEFAULT_NOISE_THRESHOLD,
                                   PathTraceSettings)
 from .pixel_tracer import PixelTracer, launch_counts
+from .pooled_edges import PooledEdges
 
 __all__ = ["CYCLES_MAX_SAMPLES", "DEFAULT_MAX_SAMPLES", "DEFAULT_MIN_SAMPLES", "DEFAULT_NOISE_THRESHOLD",
            "FullFrameTracer", "PathTraceSettings", "PathTraceView", "SAMPLER", "mitsuba_pixel_centre_depth",
@@ -156,16 +157,26 @@ class PathTraceView:
         """The pixel filter's width (px) this view renders with (0: one-pixel box)."""
         return self.settings.filter_width if isinstance(self._tracer, PixelTracer) and not self._own_film else 0.0
 
+    def pooled_edges(self) -> PooledEdges | None:
+        """A pool for :meth:`render_with_counts` when this view's tracer can pool edge pixels (JIT variants with
+        hybridgen's Owen-Sobol sampler and a pixel filter wider than the pixel), else None."""
+        tracer = self._tracer
+        if not isinstance(tracer, PixelTracer) or not tracer.owen_sobol or self._own_film or self.filter_width <= 0:
+            return None
+        return PooledEdges(tracer.width, tracer.height, self.filter_width)
+
     def render(self, cam2world: np.ndarray, seed: int, spp: int | None = None) -> np.ndarray:
         """Linear RGB of one keypoint; ``seed`` fixes the sample pattern (same seed -> same bytes). ``spp``
         forces a plain fixed-count estimate."""
         return self.render_with_counts(cam2world, seed, spp)[0]
 
     def render_with_counts(self, cam2world: np.ndarray, seed: int, spp: int | None = None,
-                           edges: Callable[[], np.ndarray | None] | None = None) -> tuple[np.ndarray, np.ndarray]:
+                           edges: Callable[[], np.ndarray | None] | None = None,
+                           pool: PooledEdges | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Linear RGB (float32 H x W x 3) and samples per pixel (uint32 H x W) of one keypoint, sampled by
         the settings' plan (adaptive or fixed; ``spp`` forces a fixed count); ``edges``: the pixels the plan's
-        ``edge_min_samples`` applies to (:func:`~hybridgen.render.pathtrace.adaptive_sampling.render_adaptive`)."""
+        ``edge_min_samples`` applies to, ``pool`` their pooled estimate
+        (:func:`~hybridgen.render.pathtrace.adaptive_sampling.render_adaptive`)."""
         import mitsuba as mi
 
         self.set_pose(cam2world)
@@ -174,7 +185,7 @@ class PathTraceView:
             image = mi.render(self.mi_scene, sensor=self.sensor, spp=plan.max_samples, seed=int(seed))
             counts = np.full((self.intrinsics.height, self.intrinsics.width), plan.max_samples, np.uint32)
             return np.array(image, dtype=np.float32)[..., :3], counts
-        return render_adaptive(self._tracer, plan, int(seed), edges)
+        return render_adaptive(self._tracer, plan, int(seed), edges, pool)
 
 
 class FullFrameTracer:

@@ -91,7 +91,16 @@ class PathTraceSettings:
 
     ``edge_raw_weight`` (hybridgen's; default 0 = off): with denoising, the share of the raw (not denoised) value in
     the colors of pixels on strong edges of the denoising guides (:mod:`hybridgen.render.edge_blend`), 0..1.
-    BlenderProc scripts render with 0.5.
+    BlenderProc scripts render with 0.6, and on every edge pixel with the pooled estimate of
+    :mod:`hybridgen.render.pathtrace.pooled_edges`.
+
+    ``flat_noise_scale`` (hybridgen's; default 1): with ``edge_min_samples``, pixels off the guide edges stop at this
+    many times the noise threshold (the denoiser smooths them; :mod:`hybridgen.render.pathtrace.adaptive_sampling`).
+    BlenderProc scripts render with 1.5.
+
+    ``guide_factor`` (hybridgen's; default 3, 1..4): the denoising guides are rasterized at this many times the
+    resolution and averaged with the pixel filter (:mod:`hybridgen.render.denoise_guides`). BlenderProc scripts
+    render with 2.
     """
 
     samples: int | None = None
@@ -108,6 +117,8 @@ class PathTraceSettings:
     caustics_refractive: bool = True
     edge_min_samples: int = 0
     edge_raw_weight: float = 0.0
+    flat_noise_scale: float = 1.0
+    guide_factor: int = 3  # denoise_guides.DEFAULT_FACTOR
 
     def __post_init__(self) -> None:
         if self.samples is not None and self.samples < 1:
@@ -127,6 +138,8 @@ class PathTraceSettings:
             raise InputError(f"edge_min_samples must be >= 0 (0 = off), got {self.edge_min_samples}")
         if not (math.isfinite(self.edge_raw_weight) and 0 <= self.edge_raw_weight <= 1):
             raise InputError(f"edge_raw_weight must be in 0..1 (0 = off), got {self.edge_raw_weight}")
+        if not 1 <= self.guide_factor <= 4:
+            raise InputError(f"guide_factor must be in 1..4, got {self.guide_factor}")
         if not (math.isfinite(self.filter_width) and 0 <= self.filter_width <= 10):
             raise InputError(f"filter_width must be in 0..10 px (0 = one-pixel box), got {self.filter_width}")
         self.plan()  # validates the sampling knobs
@@ -142,7 +155,7 @@ class PathTraceSettings:
             if threshold == 0:  # adaptivity off: the maximum in every pixel
                 return SamplingPlan(most, most, 0.0)
             least = self._min_samples(threshold)
-        return SamplingPlan(most, min(least, most), threshold, min(self.edge_min_samples, most))
+        return SamplingPlan(most, min(least, most), threshold, min(self.edge_min_samples, most), self.flat_noise_scale)
 
     def _min_samples(self, threshold: float) -> int:
         """``min_samples``, or Cycles' automatic minimum for ``threshold`` (> 0) when it is 0."""

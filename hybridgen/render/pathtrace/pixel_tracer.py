@@ -10,6 +10,7 @@ import numpy as np
 
 from .. import pixel_filter
 from .owen_sobol import OwenSobol, mix
+from .pooled_edges import PooledEdges
 
 LAUNCH_STREAM = 1 << 20
 """Round index (never reached by adaptive rounds) whose seeds the second and later launches of one trace use."""
@@ -83,8 +84,8 @@ class PixelTracer:
         self.world_guide = guide
         self.integrator.world_guide = None if guide is None else world_guide.JitGuide.of(guide, self._world_radiance)
 
-    def trace(self, pixels: np.ndarray, spp: int, seed: int,
-              first: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    def trace(self, pixels: np.ndarray, spp: int, seed: int, first: np.ndarray | None = None,
+              pool: PooledEdges | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Sums of linear RGB over the first and the second half of ``spp`` samples of every pixel in
         ``pixels`` (flat indices ``v * width + u``): two float64 arrays of shape (len(pixels), 3).
 
@@ -95,9 +96,14 @@ class PixelTracer:
         (stratified patterns: powers of two for ``ldsampler``), so ``spp`` is split into counts it accepts
         (:func:`launch_counts`); equal counts are one launch (a pattern per count and pixel), each launch with its
         own seed derived from ``seed``; each pattern's first half of samples goes to the first sum.
-        An odd ``spp`` (fixed-count rendering only) leaves the odd sample in the first sum."""
+        An odd ``spp`` (fixed-count rendering only) leaves the odd sample in the first sum. With ``pool`` (Owen-Sobol
+        only; every pixel a contributing source of it) the samples are also pooled into its edge pixels
+        (:mod:`hybridgen.render.pathtrace.pooled_edges`)."""
         if self.owen_sobol:
-            return self._launch(pixels, spp, 1, seed, np.zeros(len(pixels), np.uint32) if first is None else first)
+            return self._launch(pixels, spp, 1, seed, np.zeros(len(pixels), np.uint32) if first is None else first,
+                                pool)
+        if pool is not None:
+            raise ValueError("pooled edges need hybridgen's Owen-Sobol sampler")
         sum_a, sum_b = np.zeros((len(pixels), 3)), np.zeros((len(pixels), 3))
         counts = launch_counts(spp, self.sensor.sampler().class_name())
         launches = [(count, len(list(same))) for count, same in itertools.groupby(counts)]
@@ -109,7 +115,7 @@ class PixelTracer:
         return sum_a, sum_b
 
     def _launch(self, pixels: np.ndarray, spp: int, copies: int, seed: int,
-                first: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+                first: np.ndarray | None = None, pool: PooledEdges | None = None) -> tuple[np.ndarray, np.ndarray]:
         """One wavefront of ``len(pixels) x copies x spp`` samples, pixel-major: ``copies`` patterns of ``spp``
         samples per pixel (each copy of a pixel is its own sequence for the sampler: its own scramble); the
         halves' sums as :meth:`trace`, each half the sum of the copies' halves. With the Owen-Sobol sampler
@@ -138,9 +144,11 @@ class PixelTracer:
         ray, weight = self.sensor.sample_ray(0.0, sampler.next_1d(), position, sampler.next_2d())
         value, _, _ = self.integrator.sample(self.mi_scene, sampler, ray, None, True)
         rgb = mi.Color3f(value) * weight
+        if pool is not None:
+            pool.add(pixels, local, u, v, offset, rgb)
         # Deterministic block sums (evaluated mode: no atomics) over each half of each pixel's samples.
         block = spp // 2 if spp % 2 == 0 else spp
-        dr.eval(rgb)  # one kernel for all three channels
+        dr.eval(rgb, *([] if pool is None else [pool.sums]))  # one kernel for all three channels (and the pool)
         sums = dr.block_sum(rgb, block, mode="evaluated")
         sums = np.stack([np.asarray(sums.x), np.asarray(sums.y), np.asarray(sums.z)], axis=-1).astype(np.float64)
         if block == spp:  # an odd count: one launch of one pattern
