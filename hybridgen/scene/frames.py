@@ -7,7 +7,8 @@ by a rotation of pi about the camera x axis: ``cam2world_cv = cam2world_blender 
 from __future__ import annotations
 
 import math
-from typing import Any, Sequence
+from functools import lru_cache
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
@@ -110,8 +111,73 @@ def _quaternion_matrix(quaternion: list[float]) -> np.ndarray:
 
 
 def matrix_to_euler_xyz(rotation: np.ndarray) -> np.ndarray:
-    """Blender ``XYZ`` Euler angles (radians) of a 3x3 rotation; the inverse of :func:`euler_xyz_to_matrix`."""
-    return _rotation().from_matrix(np.asarray(rotation, dtype=np.float64)).as_euler("xyz")
+    """Blender ``XYZ`` Euler angles (radians) of a 3x3 rotation; the inverse of :func:`euler_xyz_to_matrix`.
+
+    SciPy's ``Rotation.from_matrix(rotation).as_euler("xyz")`` bit for bit (its quaternion from the matrix, then
+    Bernardes and Viollet's angles from the quaternion, in SciPy's operation order; held against SciPy in
+    tests/scene/test_rotations_scipy.py) without importing SciPy, whose ``scipy.spatial`` costs ~0.17 s of every
+    BlenderProc script's start (each new object's pose is decomposed). A matrix that is not orthogonal to SciPy's
+    tolerance (which SciPy first projects onto the rotations), a gimbal lock (SciPy warns) and a non-positive
+    determinant (SciPy's error) go to SciPy itself."""
+    matrix = np.asarray(rotation, dtype=np.float64)
+    if matrix.shape != (3, 3) or not _orthogonal(matrix):
+        return _rotation().from_matrix(matrix).as_euler("xyz")
+    m = matrix.tolist()
+    trace = m[0][0] + m[1][1] + m[2][2]
+    decision = [m[0][0], m[1][1], m[2][2], trace]
+    choice = decision.index(max(decision))  # the first maximum, as argmax
+    if choice == 3:
+        quat = [m[2][1] - m[1][2], m[0][2] - m[2][0], m[1][0] - m[0][1], 1 + trace]
+    else:
+        i, j, k = choice, (choice + 1) % 3, (choice + 2) % 3
+        quat = [0.0] * 4
+        quat[i] = 1 - trace + 2 * m[i][i]
+        quat[j] = m[j][i] + m[i][j]
+        quat[k] = m[k][i] + m[i][k]
+        quat[3] = m[k][j] - m[j][k]
+    norm = math.sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3])
+    if not norm > 0:
+        return _rotation().from_matrix(matrix).as_euler("xyz")
+    x, y, z, w = (q / norm for q in quat)
+    a, b, c, d = w - y, x + z, y + w, z - x  # extrinsic xyz: i, j, k = 0, 1, 2, sign +1
+    # the C library's atan2 (math's) and hypot, as SciPy's compiled code calls them - not NumPy's vectorised ones,
+    # nor math.hypot (Python's own, which differs from the C library's in the last bit now and then)
+    hypot = _c_hypot()
+    if hypot is None:
+        return _rotation().from_matrix(matrix).as_euler("xyz")
+    half_sum, half_diff = math.atan2(b, a), math.atan2(d, c)
+    second = 2 * math.atan2(hypot(c, d), hypot(a, b))
+    if abs(second) <= 1e-7 or abs(second - math.pi) <= 1e-7:  # gimbal lock
+        return _rotation().from_matrix(matrix).as_euler("xyz")
+    angles = [half_sum - half_diff, second - math.pi / 2, half_sum + half_diff]
+    for index, angle in enumerate(angles):  # into [-pi, pi], as SciPy's compiled backend does
+        if angle < -math.pi:
+            angles[index] = angle + 2 * math.pi
+        elif angle > math.pi:
+            angles[index] = angle - 2 * math.pi
+    return np.array(angles, dtype=np.float64)
+
+
+@lru_cache(maxsize=1)
+def _c_hypot() -> Callable[[float, float], float] | None:
+    """The C math library's ``hypot``, or None where it cannot be loaded."""
+    import ctypes
+    import ctypes.util
+
+    try:
+        library = ctypes.CDLL(ctypes.util.find_library("m") or "libm.so.6")
+        function = library.hypot
+    except (OSError, AttributeError):
+        return None
+    function.restype, function.argtypes = ctypes.c_double, [ctypes.c_double, ctypes.c_double]
+    return function
+
+
+def _orthogonal(matrix: np.ndarray) -> bool:
+    """SciPy's test before ``from_matrix``: positive determinant, ``M M^T`` within (rtol 1e-5, atol 1e-12) of I."""
+    if not np.linalg.det(matrix) > 0:
+        return False
+    return bool(np.all(np.abs(matrix @ matrix.T - np.eye(3)) <= 1e-12 + 1e-5 * np.ones((3, 3))))
 
 
 def rotation_about_axis(axis: np.ndarray, angle: float) -> np.ndarray:

@@ -59,3 +59,35 @@ def test_posing_objects_imports_no_scipy():
               "print('scipy' in sys.modules)")
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
     assert done.stdout.strip() == "False"
+
+
+def test_matrix_to_euler_is_scipys_bit_for_bit() -> None:
+    """hybridgen's own decomposition (no SciPy import) gives SciPy's angles to the last bit: random rotations,
+    Euler-built ones, quarter turns, slightly non-unit ones, and the gimbal locks SciPy handles itself."""
+    import warnings
+
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(11)
+    matrices = [np.eye(3), np.diag([1.0, -1, -1]), np.diag([-1.0, 1, -1]), np.diag([-1.0, -1, 1])]
+    for _ in range(1500):
+        matrices.append(Rotation.random(random_state=rng).as_matrix())
+        matrices.append(euler_xyz_to_matrix(rng.uniform(-np.pi, np.pi, 3)))
+        matrices.append(euler_xyz_to_matrix(rng.integers(-2, 3, 3) * np.pi / 2))
+        matrices.append(euler_xyz_to_matrix(rng.uniform(-np.pi, np.pi, 3)) * (1 + 1e-9))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # SciPy's gimbal-lock warning
+        for matrix in matrices:
+            ours, scipys = matrix_to_euler_xyz(matrix), Rotation.from_matrix(matrix).as_euler("xyz")
+            assert ours.tobytes() == scipys.tobytes(), matrix.tolist()
+
+
+def test_matrix_to_euler_does_not_import_scipy() -> None:
+    import subprocess
+    import sys
+
+    probe = ("import sys; from hybridgen.scene.frames import matrix_to_euler_xyz, euler_xyz_to_matrix; "
+             "print(matrix_to_euler_xyz(euler_xyz_to_matrix([0.3, -0.2, 1.1])).round(12).tolist(), "
+             "'scipy.spatial' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[0.3, -0.2, 1.1] False"

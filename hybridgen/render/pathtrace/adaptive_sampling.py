@@ -220,16 +220,9 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
         per_chunk = len(active) if tracer.whole_frames else max(1, MAX_WAVEFRONT // spp)
         for chunk, start in enumerate(range(0, len(active), per_chunk)):
             pixels = active[start:start + per_chunk]
-            if pool is not None and pool.started:  # pooled pixels in a launch of their own
-                pooled = pool.contributing(pixels)
-                for part, part_pool in ((pixels[pooled], pool), (pixels[~pooled], None)):
-                    if len(part):
-                        a, b = tracer.trace(part, spp, seed, first=count[part], pool=part_pool)
-                        sum_a[part] += a
-                        sum_b[part] += b
-                continue
             if tracer.owen_sobol:  # one pattern per pixel, continued from round to round
-                a, b = tracer.trace(pixels, spp, seed, first=count[pixels])
+                pooling = {"pool": pool} if pool is not None and pool.started else {}
+                a, b = tracer.trace(pixels, spp, seed, first=count[pixels], **pooling)
             else:
                 a, b = tracer.trace(pixels, spp, round_seed(seed, round_index, chunk))
             rows = slice(start, start + len(pixels)) if len(active) == h * w else pixels  # all: no index lists

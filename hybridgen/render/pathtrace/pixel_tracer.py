@@ -97,7 +97,7 @@ class PixelTracer:
         (:func:`launch_counts`); equal counts are one launch (a pattern per count and pixel), each launch with its
         own seed derived from ``seed``; each pattern's first half of samples goes to the first sum.
         An odd ``spp`` (fixed-count rendering only) leaves the odd sample in the first sum. With ``pool`` (Owen-Sobol
-        only; every pixel a contributing source of it) the samples are also pooled into its edge pixels
+        only) the samples of its contributing pixels are also pooled into its edge pixels
         (:mod:`hybridgen.render.pathtrace.pooled_edges`)."""
         if self.owen_sobol:
             return self._launch(pixels, spp, 1, seed, np.zeros(len(pixels), np.uint32) if first is None else first,

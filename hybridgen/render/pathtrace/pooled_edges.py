@@ -133,7 +133,8 @@ class PooledEdges:
 
     def add(self, pixels: np.ndarray, local: Any, u: Any, v: Any, offset: Any, rgb: Any) -> None:
         """Records, in the launch's kernel, the pooled contributions of its samples: ``pixels`` (flat indices, the
-        launch's, all contributing), ``local`` each sample's index into them, ``u``/``v`` its pixel (UInt32),
+        launch's; those that do not contribute this round add nothing), ``local`` each sample's index into them,
+        ``u``/``v`` its pixel (UInt32),
         ``offset`` its offset from the pixel's corner (Point2f, px), ``rgb`` its value (Color3f, linear)."""
         import drjit as dr
         import mitsuba as mi
@@ -151,7 +152,7 @@ class PooledEdges:
             denominator = mi.Float(0.0)
             for du, dv in SHAPE:
                 denominator = dr.fma(contributes[(tu + du, tv + dv)] * px[tu + du], py[tv + dv], denominator)
-            weight = contributes[(tu, tv)] * px[tu] * py[tv] / dr.maximum(denominator, 1e-30)
+            weight = contributes[(0, 0)] * contributes[(tu, tv)] * px[tu] * py[tv] / dr.maximum(denominator, 1e-30)
             live = valid & (weight > 0)
             target = mi.UInt32(base + tv * self._stride + tu) * CHANNELS
             for channel, value in enumerate((rgb.x, rgb.y, rgb.z, 1.0)):
