@@ -76,7 +76,10 @@ BlenderProc 55.84 and 56.23 dB, sampling CPU s of the frame (loaded machine, +-5
 ("the mix" rows other than "now" mixed the 8-bit colors after the fact; the mix as rendered, in linear light before
 encoding, scores ~0.1 dB higher.) Before the mix, the edge floor alone (64, 256) had taken basics/basic from
 53.47 to 54.53 dB and camera_sampling from 53.50 to 54.06 dB against a single 1024-spp reference (BlenderProc
-54.34 and 54.00), for 20-35 % more sampling time."""
+54.34 and 54.00), for 20-35 % more sampling time. With the pooled edge estimate mixed at 0.6
+(:mod:`hybridgen.render.pathtrace.pooled_edges`) the "now" row scores 56.94 / 56.81 dB; that margin is spent on
+:data:`DENOISED_MAX_SHARE`, :data:`FLAT_NOISE_SCALE` and :data:`GUIDE_FACTOR` (56.40 / 56.40 dB; the grid is in
+docs/blenderproc.md "Speed")."""
 EDGE_RAW_WEIGHT = 0.6
 """Denoised renders mix this share of the raw samples, pooled with the neighbours'
 (:mod:`hybridgen.render.pathtrace.pooled_edges`), into the colors on guide edges (:mod:`hybridgen.render.edge_blend`)."""
