@@ -9,13 +9,11 @@ its authors) and Replica's segmented meshes raise one line naming the call.
 from __future__ import annotations
 
 from .loader_blend import load_blend
-from .loader_bop import load_bop_intrinsics, load_bop_objs, load_bop_scene
 from .loader_datasets import (load_AMASS, load_front3d, load_ikea, load_matterport3d, load_pix3d, load_replica,
                               load_scenenet, load_shapenet)
 from .loader_materials import (get_random_world_background_hdr_img_path_from_haven, load_ccmaterials, load_haven_mat,
                                load_texture)
 from .loader_object import load_obj
-from .loader_urdf import load_urdf
 from .types.unsupported import module_getattr
 
 __all__ = ["get_random_world_background_hdr_img_path_from_haven", "load_AMASS", "load_blend", "load_bop_intrinsics",
@@ -23,4 +21,7 @@ __all__ = ["get_random_world_background_hdr_img_path_from_haven", "load_AMASS", 
            "load_matterport3d", "load_obj", "load_pix3d", "load_replica", "load_scenenet", "load_shapenet",
            "load_texture", "load_urdf"]
 
-__getattr__ = module_getattr("loader", ["load_replica_segmented_mesh", "load_suncg"])
+# BOP's and URDF's loaders pull in hybridgen's BOP module and the URDF stack (~70 ms): imported when first used
+__getattr__ = module_getattr("loader", ["load_replica_segmented_mesh", "load_suncg"],
+                             lazy={"load_bop_intrinsics": "loader_bop", "load_bop_objs": "loader_bop",
+                                   "load_bop_scene": "loader_bop", "load_urdf": "loader_urdf"}, namespace=globals())

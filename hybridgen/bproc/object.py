@@ -22,7 +22,6 @@ from ..scene.primitives import make_primitive
 from .bvh_tree import create_bvh_tree_multi_objects, scene_ray_cast
 from .face_slicer import extract_floor, slice_faces_with_normals
 from .object_replacer import replace_objects
-from .physics import simulate_physics, simulate_physics_and_fix_final_poses
 from .placement import sample_poses, sample_poses_on_surface
 from .types import Entity, MeshObject
 from .types.mesh_object import get_all_mesh_objects
@@ -161,4 +160,7 @@ def create_from_point_cloud(points: Any, object_name: str, add_geometry_nodes_vi
     return obj
 
 
-__getattr__ = module_getattr("object", ["create_from_blender_mesh"])
+# the physics stack (~20 ms of imports) is imported when a script first simulates
+__getattr__ = module_getattr("object", ["create_from_blender_mesh"],
+                             lazy={"simulate_physics": "physics", "simulate_physics_and_fix_final_poses": "physics"},
+                             namespace=globals())

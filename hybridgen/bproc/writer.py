@@ -61,5 +61,6 @@ def write_hdf5(output_dir_path: str, output_data_dict: dict[str, Any], append_to
         raise
 
 
-__getattr__ = module_getattr("writer", ["write_bop", "write_coco_annotations", "write_gif_animation"])
-from .file_writers import write_bop, write_coco_annotations, write_gif_animation  # noqa: E402,F401
+# the file writers (BOP, COCO, GIF: ~25 ms of imports) are imported when first used
+__getattr__ = module_getattr("writer", [], lazy={"write_bop": "bop_writer", "write_coco_annotations": "coco_writer",
+                                                 "write_gif_animation": "gif_writer"}, namespace=globals())

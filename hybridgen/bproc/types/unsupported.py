@@ -3,7 +3,8 @@ yet``. Never a silent no-op: such a call would change BlenderProc's output, so i
 under ``hybridgen run``)."""
 from __future__ import annotations
 
-from typing import Any, Callable, Iterable, NoReturn
+import importlib
+from typing import Any, Callable, Iterable, Mapping, NoReturn
 
 from ...errors import InputError
 
@@ -33,12 +34,20 @@ def unsupported_method(class_name: str, name: str, why: str = "") -> Callable[..
     return unsupported_function(f"bproc.types.{class_name}.{name}", why)
 
 
-def module_getattr(area: str, names: Iterable[str]) -> Callable[[str], Any]:
+def module_getattr(area: str, names: Iterable[str], lazy: Mapping[str, str] | None = None,
+                   namespace: dict[str, Any] | None = None) -> Callable[[str], Any]:
     """A module ``__getattr__`` for ``bproc.<area>``: BlenderProc's ``names`` this module lacks become stand-ins
-    that raise one line when called; any other name is an AttributeError as usual."""
-    known = frozenset(names)
+    that raise one line when called; a name in ``lazy`` is imported, on first use, from the ``hybridgen.bproc``
+    module it maps to and kept in ``namespace`` (the module's globals), so that a script that never calls it does
+    not pay for its imports at start; any other name is an AttributeError as usual."""
+    known, deferred = frozenset(names), dict(lazy or {})
 
     def __getattr__(name: str) -> Any:  # noqa: N807 - a module's __getattr__
+        if name in deferred:
+            value = getattr(importlib.import_module(f"hybridgen.bproc.{deferred[name]}"), name)
+            if namespace is not None:
+                namespace[name] = value
+            return value
         if name in known:
             return unsupported_function(f"bproc.{area}.{name}")
         raise AttributeError(f"module 'bproc.{area}' has no attribute {name!r}")
