@@ -58,6 +58,8 @@ STAGES = ("imports", "scene_load", "mitsuba_scene", "kernel_compile", "sampling"
 """The stages of the render loop's thread, in order (``denoise`` runs on a thread of its own beside them)."""
 
 
+BLENDERPROC_DONE = "Cleaning temporary directory"
+"""BlenderProc's last line once a script's files are written (a crash after it is counted as finished)."""
 HYBRIDGEN_TREE: list[Path | None] = [None]
 """``--hybridgen-tree``: the hybridgen source tree the runs use (None: the installed checkout)."""
 
@@ -73,7 +75,9 @@ def timed(engine: str, script: str, work: Path, label: str, launch: list[str] | 
     output = work / label
     args = example_args(script, examples_tree(), output, work / "inputs")
     run = invocation(engine, script, args, launch)
-    return run_process(run.command, env=run.env, cwd=run.cwd), output
+    # bpy 4.2 may segfault on its way out after BlenderProc has written everything (basics/material_manipulation)
+    crash_after = BLENDERPROC_DONE if engine == "blenderproc" else None
+    return run_process(run.command, env=run.env, cwd=run.cwd, crash_after=crash_after), output
 
 
 def first_colors(output: Path) -> np.ndarray:

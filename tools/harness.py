@@ -14,6 +14,7 @@ import re
 import resource
 import statistics
 import subprocess
+import sys
 import tempfile
 import time
 from collections.abc import Callable, Iterable, Sequence
@@ -86,8 +87,11 @@ class Finished:
         return next((json.loads(line) for line in reversed(self.lines) if line.startswith("{")), None)
 
 
-def run_process(command: Sequence[str], env: dict[str, str] | None = None, cwd: Path | str | None = None) -> Finished:
-    """Runs ``command`` to its end and times it; raises RuntimeError with its output's tail if it fails."""
+def run_process(command: Sequence[str], env: dict[str, str] | None = None, cwd: Path | str | None = None,
+                crash_after: str | None = None) -> Finished:
+    """Runs ``command`` to its end and times it; raises RuntimeError with its output's tail if it fails - unless it
+    was killed by a signal after printing a line containing ``crash_after`` (a process that crashes on its way out,
+    its work done: it is counted, with a notice)."""
     with tempfile.TemporaryFile() as output:
         start = time.perf_counter()
         child = subprocess.Popen(list(command), stdout=output, stderr=subprocess.STDOUT, env=env, cwd=cwd)
@@ -96,7 +100,10 @@ def run_process(command: Sequence[str], env: dict[str, str] | None = None, cwd: 
         code = os.waitstatus_to_exitcode(status)
         output.seek(0)
         lines = output.read().decode(errors="replace").strip().splitlines()
-    if code != 0:
+    if code < 0 and crash_after is not None and any(crash_after in line for line in lines):
+        print(f"notice: `{Path(str(command[-1])).name}`'s process died of signal {-code} after {crash_after!r}; "
+              f"counted as finished", file=sys.stderr)
+    elif code != 0:
         raise RuntimeError(f"`{' '.join(map(str, command))}` failed (exit {code}):\n  " + "\n  ".join(lines[-8:]))
     return Finished(lines, wall, usage.ru_utime + usage.ru_stime)
 

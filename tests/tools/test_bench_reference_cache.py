@@ -173,3 +173,20 @@ def test_default_color_process_renders_what_render_color_renders(tmp_path: Path)
                     denoise=True, sample_counts=True)
     assert np.array_equal(np.asarray(Image.open(png).convert("RGB")), sink.frames[0]["colors"])
     assert report["mean_spp"] == pytest.approx(float(sink.frames[0]["sample_counts"].mean()))
+
+
+def test_a_process_that_crashes_after_its_work_is_counted_only_when_told_so() -> None:
+    """harness.run_process(crash_after=...): BlenderProc's bpy may segfault on its way out after writing every file
+    (basics/material_manipulation); such a run counts, any other crash or failure still raises."""
+    import harness
+
+    done = ["bash", "-c", "echo Cleaning temporary directory; kill -SEGV $$"]
+    finished = harness.run_process(done, crash_after="Cleaning temporary directory")
+    assert finished.lines == ["Cleaning temporary directory"] and finished.wall > 0
+    with pytest.raises(RuntimeError, match="exit -11"):
+        harness.run_process(["bash", "-c", "echo halfway; kill -SEGV $$"], crash_after="Cleaning temporary directory")
+    with pytest.raises(RuntimeError, match="exit -11"):
+        harness.run_process(done)
+    with pytest.raises(RuntimeError, match="exit 3"):
+        harness.run_process(["bash", "-c", "echo Cleaning temporary directory; exit 3"],
+                            crash_after="Cleaning temporary directory")
