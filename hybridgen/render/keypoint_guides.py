@@ -13,7 +13,7 @@ from typing import Callable
 
 import numpy as np
 
-from .guide_edges import edge_strength
+from .guide_edges import edge_strength, textured_pixels
 
 
 class KeypointGuides:
@@ -25,6 +25,7 @@ class KeypointGuides:
         self._lock = threading.Lock()
         self._guides: tuple[np.ndarray, np.ndarray] | None = None
         self._strength: np.ndarray | None = None
+        self._textured: np.ndarray | None = None
 
     def get(self) -> tuple[np.ndarray, np.ndarray]:
         """(albedo, normals), made on the first call."""
@@ -40,6 +41,19 @@ class KeypointGuides:
             if self._strength is None:
                 self._strength = edge_strength(*guides)
             return self._strength
+
+    def textured(self) -> np.ndarray:
+        """Bool H x W: :func:`~hybridgen.render.guide_edges.textured_pixels` of the albedo guide (computed once)."""
+        guides = self.get()
+        with self._lock:
+            if self._textured is None:
+                self._textured = textured_pixels(guides[0])
+            return self._textured
+
+    def prepare(self) -> None:
+        """Makes the guides and everything derived from them (for a thread that works ahead)."""
+        self.strength()
+        self.textured()
 
     def edges(self) -> np.ndarray:
         """Bool H x W: the edge pixels (:func:`~hybridgen.render.guide_edges.guide_edges`: strength above 1)."""

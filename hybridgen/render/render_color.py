@@ -115,11 +115,12 @@ class ColorProducer:
             if self._filtering is None:
                 self._filtering = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hybridgen-guide-filter")
             guides = KeypointGuides(partial(self._guides.filtered, fine))
-            self._filtering.submit(guides.strength)  # filtered and their edges found while the first round samples
+            self._filtering.submit(guides.prepare)  # filtered, edges and textures found while the first round samples
         edges = guides.edges if guides is not None and self.denoise and plan.edge_floor else None
+        textured = guides.textured if guides is not None and self.denoise and plan.texture_floor else None
         pool = self._edge_pool() if edges is not None else None
         linear, counts = self.view.render_with_counts(cam2world, keypoint_seed(self.seed, index, eye), edges=edges,
-                                                      pool=pool)
+                                                      pool=pool, textured=textured)
         pooled = pool.image() if pool is not None and pool.started else None
         values: dict[str, Any] = {}
         if self.keep_raw:

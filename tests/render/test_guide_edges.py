@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
-from hybridgen.render.guide_edges import ALBEDO_STEP, NORMAL_STEP, edge_strength, guide_edges
+from hybridgen.render.guide_edges import ALBEDO_STEP, NORMAL_STEP, TEXTURE_STEP, edge_strength, guide_edges, textured_pixels
 from hybridgen.render.pathtrace.adaptive_sampling import SamplingPlan, render_adaptive
 from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
 
@@ -72,6 +72,38 @@ def test_a_diagonal_neighbour_counts_and_smooth_ramps_do_not() -> None:
     albedo[2, 2] = np.nan  # a non-finite guide value counts as 0
     edges = guide_edges(albedo, normals)
     assert edges[1:4, 1:4].all() and edges.sum() == 9
+
+
+def test_textured_pixels_are_albedo_steps_above_the_texture_step_grown_by_one_pixel() -> None:
+    albedo, _ = _flat(8, 12)
+    assert not textured_pixels(albedo).any()
+    albedo[:] = (np.arange(12, dtype=np.float32) * TEXTURE_STEP / 4)[None, :, None]  # 0.75 x the step per pixel
+    assert not textured_pixels(albedo).any()
+    albedo, _ = _flat(8, 12)
+    albedo[3, 6, 0] += 1.5 * TEXTURE_STEP  # one texel, below an edge's step
+    assert not guide_edges(albedo, _flat(8, 12)[1]).any()
+    expected = np.zeros((8, 12), bool)
+    expected[1:6, 4:9] = True  # the texel and its neighbours step; one more pixel around them
+    assert np.array_equal(textured_pixels(albedo), expected)
+    albedo[0, 0] = np.nan  # a non-finite guide value counts as 0: a step
+    assert textured_pixels(albedo)[0:3, 0:3].all()
+
+
+def test_textured_pixels_get_texture_min_samples() -> None:
+    tracer = _ExactTracer(8, 5)
+    textured = np.zeros((5, 8), bool)
+    textured[2, 3] = True
+    plan = SamplingPlan(64, 4, 0.01, texture_min_samples=16)
+    assert plan.texture_floor and not SamplingPlan(64, 16, 0.01, texture_min_samples=16).texture_floor
+    _, counts = render_adaptive(tracer, plan, 1, None, None, lambda: textured)
+    assert counts[2, 3] == 16 and (counts[~textured] == 4).all()
+    _, counts = render_adaptive(_ExactTracer(8, 5), SamplingPlan(64, 4, 0.01), 1, None, None,
+                                lambda: pytest.fail("asked"))
+    assert (counts == 4).all()
+    with pytest.raises(hg.InputError, match="texture_min_samples"):
+        SamplingPlan(64, 4, 0.01, texture_min_samples=128)
+    with pytest.raises(hg.InputError, match="texture_min_samples"):
+        hg.PathTraceSettings(texture_min_samples=-1)
 
 
 class _ExactTracer:
@@ -217,6 +249,7 @@ def test_blenderproc_scripts_denoise_from_half_the_minimum_with_four_times_it_on
     assert denoised.plan().min_samples == 32 and denoised.plan().rounds()[:2] == [32, 32]  # half of it
     assert denoised.plan().max_samples == 256  # a quarter of Cycles' 1024, not below the edge floor
     assert denoised.edge_raw_weight == 0.6 and denoised.flat_noise_scale == 1.5 and denoised.guide_factor == 2
+    assert denoised.texture_min_samples == 64 and denoised.plan().texture_floor  # Cycles' minimum on textures
     assert render("INTEL", samples=4096).plan().max_samples == 1024
     assert render("INTEL", threshold=0.001).plan().min_samples == 64  # Cycles' 128 at 0.001, halved
     hundred = render("INTEL", samples=100)
@@ -225,6 +258,6 @@ def test_blenderproc_scripts_denoise_from_half_the_minimum_with_four_times_it_on
     assert capped.plan().min_samples == 10 and capped.edge_min_samples == 20
     for plain in (render(None), render("INTEL", threshold=0.0)):
         assert plain.edge_min_samples == 0 and plain.edge_raw_weight == 0.0
-        assert plain.flat_noise_scale == 1.0 and plain.guide_factor == 3
+        assert plain.flat_noise_scale == 1.0 and plain.guide_factor == 3 and plain.texture_min_samples == 0
     assert render(None).plan().min_samples == 64  # without the denoiser: Cycles' minimum
     assert render(None).plan().max_samples == 1024

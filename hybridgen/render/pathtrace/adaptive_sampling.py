@@ -15,6 +15,8 @@ Knobs (Cycles' and BlenderProc's names and meaning):
   hands the edge pixels to :func:`render_adaptive`, which asks for them after the first round.
 - ``flat_noise_scale`` (hybridgen's, default 1): with ``edge_min_samples``, the pixels off the edges (which the
   denoiser smooths) stop at this many times the threshold.
+- ``texture_min_samples`` (hybridgen's, 0 = off): samples the pixels of textured surfaces
+  (:func:`hybridgen.render.guide_edges.textured_pixels`) get at least; asked for after the first round, as the edges.
 
 The error estimate is Cycles' (after Dammertz et al. 2010, "A hierarchical automatic stopping condition
 for Monte Carlo global illumination"; ``film_adaptive_sampling_convergence_check`` in Cycles'
@@ -103,6 +105,8 @@ class SamplingPlan:
     edge_min_samples: int = 0
     flat_noise_scale: float = 1.0
     """With ``edge_min_samples``: pixels off the edges stop at this many times the threshold (>= 1)."""
+    texture_min_samples: int = 0
+    """Samples the pixels of textured surfaces get at least (0 = off)."""
 
     def __post_init__(self) -> None:
         if self.max_samples < 1:
@@ -116,6 +120,9 @@ class SamplingPlan:
             raise InputError(f"min_samples must be in 2..samples ({self.max_samples}), got {self.min_samples}")
         if not (math.isfinite(self.flat_noise_scale) and self.flat_noise_scale >= 1):
             raise InputError(f"flat_noise_scale must be >= 1, got {self.flat_noise_scale}")
+        if not 0 <= self.texture_min_samples <= self.max_samples:
+            raise InputError(f"texture_min_samples must be in 0..samples ({self.max_samples}), "
+                             f"got {self.texture_min_samples}")
         if not 0 <= self.edge_min_samples <= self.max_samples:
             raise InputError(f"edge_min_samples must be in 0..samples ({self.max_samples}), "
                              f"got {self.edge_min_samples}")
@@ -123,6 +130,11 @@ class SamplingPlan:
     @property
     def adaptive(self) -> bool:
         return self.noise_threshold > 0
+
+    @property
+    def texture_floor(self) -> bool:
+        """Whether ``texture_min_samples`` gives some pixels more samples than the first round."""
+        return self.adaptive and self.texture_min_samples > self.rounds()[0]
 
     @property
     def edge_floor(self) -> bool:
@@ -176,13 +188,15 @@ def dilate(mask: np.ndarray) -> np.ndarray:
 
 def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
                     edges: Callable[[], np.ndarray | None] | None = None,
-                    pool: PooledEdges | None = None) -> tuple[np.ndarray, np.ndarray]:
+                    pool: PooledEdges | None = None,
+                    textured: Callable[[], np.ndarray | None] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Linear RGB (float32 H x W x 3) and samples per pixel (uint32 H x W) of one keypoint. With the plan's
     ``edge_min_samples``, ``edges`` is called once, after the first round (so that the caller can find them
     meanwhile), for the pixels (bool H x W, or None: none) that get at least that many samples. With ``pool`` as
     well (a tracer with hybridgen's Owen-Sobol sampler), those pixels' samples from the second round on are also
     pooled with their neighbours' (:mod:`hybridgen.render.pathtrace.pooled_edges`; ``pool.started`` tells whether
-    there were any)."""
+    there were any). With the plan's ``texture_min_samples``, ``textured`` is called once, after the first round,
+    for the pixels of textured surfaces (bool H x W, or None) that get at least that many."""
     h, w = tracer.height, tracer.width
     if isinstance(tracer, PixelTracer):
         tracer.guide_world()
@@ -190,6 +204,7 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
     count = np.zeros(h * w, dtype=np.uint32)
     active = np.arange(h * w)
     floor: np.ndarray | None = None  # the edge pixels (flat bool), once asked for
+    texture: np.ndarray | None = None  # the textured pixels (flat bool), once asked for
     if pool is not None:
         pool.reset()
         if not getattr(tracer, "owen_sobol", False):
@@ -209,6 +224,11 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
             keep = dilate(unconverged.reshape(h, w)).ravel()
             if floor is not None:
                 keep |= floor & (count < plan.edge_min_samples)
+            if plan.texture_floor and textured is not None:
+                if texture is None:
+                    found = textured()
+                    texture = np.zeros(h * w, dtype=bool) if found is None else np.asarray(found, dtype=bool).ravel()
+                keep |= texture & (count < plan.texture_min_samples)
             active = active[keep[active]]
             if len(active) == 0:
                 break

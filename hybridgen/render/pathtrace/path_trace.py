@@ -172,11 +172,12 @@ class PathTraceView:
 
     def render_with_counts(self, cam2world: np.ndarray, seed: int, spp: int | None = None,
                            edges: Callable[[], np.ndarray | None] | None = None,
-                           pool: PooledEdges | None = None) -> tuple[np.ndarray, np.ndarray]:
+                           pool: PooledEdges | None = None,
+                           textured: Callable[[], np.ndarray | None] | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Linear RGB (float32 H x W x 3) and samples per pixel (uint32 H x W) of one keypoint, sampled by
         the settings' plan (adaptive or fixed; ``spp`` forces a fixed count); ``edges``: the pixels the plan's
-        ``edge_min_samples`` applies to, ``pool`` their pooled estimate
-        (:func:`~hybridgen.render.pathtrace.adaptive_sampling.render_adaptive`)."""
+        ``edge_min_samples`` applies to, ``pool`` their pooled estimate, ``textured`` the pixels its
+        ``texture_min_samples`` applies to (:func:`~hybridgen.render.pathtrace.adaptive_sampling.render_adaptive`)."""
         import mitsuba as mi
 
         self.set_pose(cam2world)
@@ -185,7 +186,7 @@ class PathTraceView:
             image = mi.render(self.mi_scene, sensor=self.sensor, spp=plan.max_samples, seed=int(seed))
             counts = np.full((self.intrinsics.height, self.intrinsics.width), plan.max_samples, np.uint32)
             return np.array(image, dtype=np.float32)[..., :3], counts
-        return render_adaptive(self._tracer, plan, int(seed), edges, pool)
+        return render_adaptive(self._tracer, plan, int(seed), edges, pool, textured)
 
 
 class FullFrameTracer:

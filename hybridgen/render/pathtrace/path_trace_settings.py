@@ -98,6 +98,10 @@ class PathTraceSettings:
     many times the noise threshold (the denoiser smooths them; :mod:`hybridgen.render.pathtrace.adaptive_sampling`).
     BlenderProc scripts render with 1.5.
 
+    ``texture_min_samples`` (hybridgen's; default 0 = off): with adaptive sampling and denoising, the samples per
+    pixel the pixels of textured surfaces get at least (:func:`hybridgen.render.guide_edges.textured_pixels`; at most
+    the maximum). BlenderProc scripts render with Cycles' automatic minimum there.
+
     ``guide_factor`` (hybridgen's; default 3, 1..4): the denoising guides are rasterized at this many times the
     resolution and averaged with the pixel filter (:mod:`hybridgen.render.denoise_guides`). BlenderProc scripts
     render with 2.
@@ -119,6 +123,7 @@ class PathTraceSettings:
     edge_raw_weight: float = 0.0
     flat_noise_scale: float = 1.0
     guide_factor: int = 3  # denoise_guides.DEFAULT_FACTOR
+    texture_min_samples: int = 0
 
     def __post_init__(self) -> None:
         if self.samples is not None and self.samples < 1:
@@ -134,6 +139,8 @@ class PathTraceSettings:
             raise InputError(f"clamp_indirect must be >= 0 (0 = off), got {self.clamp_indirect}")
         if not (math.isfinite(self.filter_glossy) and self.filter_glossy >= 0):
             raise InputError(f"filter_glossy must be >= 0 (0 = off), got {self.filter_glossy}")
+        if self.texture_min_samples < 0:
+            raise InputError(f"texture_min_samples must be >= 0 (0 = off), got {self.texture_min_samples}")
         if self.edge_min_samples < 0:
             raise InputError(f"edge_min_samples must be >= 0 (0 = off), got {self.edge_min_samples}")
         if not (math.isfinite(self.edge_raw_weight) and 0 <= self.edge_raw_weight <= 1):
@@ -155,7 +162,8 @@ class PathTraceSettings:
             if threshold == 0:  # adaptivity off: the maximum in every pixel
                 return SamplingPlan(most, most, 0.0)
             least = self._min_samples(threshold)
-        return SamplingPlan(most, min(least, most), threshold, min(self.edge_min_samples, most), self.flat_noise_scale)
+        return SamplingPlan(most, min(least, most), threshold, min(self.edge_min_samples, most), self.flat_noise_scale,
+                            min(self.texture_min_samples, most))
 
     def _min_samples(self, threshold: float) -> int:
         """``min_samples``, or Cycles' automatic minimum for ``threshold`` (> 0) when it is 0."""
