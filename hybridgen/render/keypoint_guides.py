@@ -13,7 +13,7 @@ from typing import Callable
 
 import numpy as np
 
-from .guide_edges import edge_strength, textured_pixels
+from .guide_edges import edge_strength_and_texture
 
 
 class KeypointGuides:
@@ -36,24 +36,22 @@ class KeypointGuides:
 
     def strength(self) -> np.ndarray:
         """Float32 H x W: :func:`~hybridgen.render.guide_edges.edge_strength` of the guides (computed once)."""
-        guides = self.get()
-        with self._lock:
-            if self._strength is None:
-                self._strength = edge_strength(*guides)
-            return self._strength
+        return self._derived()[0]
 
     def textured(self) -> np.ndarray:
         """Bool H x W: :func:`~hybridgen.render.guide_edges.textured_pixels` of the albedo guide (computed once)."""
-        guides = self.get()
-        with self._lock:
-            if self._textured is None:
-                self._textured = textured_pixels(guides[0])
-            return self._textured
+        return self._derived()[1]
 
     def prepare(self) -> None:
         """Makes the guides and everything derived from them (for a thread that works ahead)."""
-        self.strength()
-        self.textured()
+        self._derived()
+
+    def _derived(self) -> tuple[np.ndarray, np.ndarray]:
+        guides = self.get()
+        with self._lock:
+            if self._strength is None or self._textured is None:
+                self._strength, self._textured = edge_strength_and_texture(*guides)
+            return self._strength, self._textured
 
     def edges(self) -> np.ndarray:
         """Bool H x W: the edge pixels (:func:`~hybridgen.render.guide_edges.guide_edges`: strength above 1)."""
