@@ -48,14 +48,13 @@ def edge_strength(albedo: np.ndarray, normals: np.ndarray) -> np.ndarray:
     """Float32 H x W: each pixel's largest guide step to a neighbour in units of the edge thresholds,
     ``max(albedo step / ALBEDO_STEP, normal step / NORMAL_STEP)`` (guides H x W x 3 each, see the module
     docstring); above 1 is an edge pixel."""
-    return edge_strength_and_texture(albedo, normals)[0]
+    return _strength(_steps(albedo), _steps(normals))
 
 
 def edge_strength_and_texture(albedo: np.ndarray, normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(:func:`edge_strength`, :func:`textured_pixels`) of the guides, the albedo's steps computed once."""
-    albedo_steps = _largest_step(np.nan_to_num(np.asarray(albedo, dtype=np.float32)))
-    normal_steps = _largest_step(np.nan_to_num(np.asarray(normals, dtype=np.float32)))
-    return np.maximum(albedo_steps / ALBEDO_STEP, normal_steps / NORMAL_STEP), dilate(albedo_steps > TEXTURE_STEP)
+    albedo_steps = _steps(albedo)
+    return _strength(albedo_steps, _steps(normals)), _textured(albedo_steps)
 
 
 def textured_pixels(albedo: np.ndarray) -> np.ndarray:
@@ -63,7 +62,20 @@ def textured_pixels(albedo: np.ndarray) -> np.ndarray:
     :data:`TEXTURE_STEP`, grown by one pixel. Open Image Denoise needs more samples there than on a uniform surface to
     keep the texture (BlenderProc's ``basics/material_manipulation``: 52.9 -> 55.3 dB against the converged image with
     these pixels at 64 spp instead of 32, for 11 % more samples; untextured ``basics/basic`` +0.04 dB for 1 %)."""
-    return dilate(_largest_step(np.nan_to_num(np.asarray(albedo, dtype=np.float32))) > TEXTURE_STEP)
+    return _textured(_steps(albedo))
+
+
+def _steps(guide: np.ndarray) -> np.ndarray:
+    """:func:`_largest_step` of a guide, a non-finite value counting as 0."""
+    return _largest_step(np.nan_to_num(np.asarray(guide, dtype=np.float32)))
+
+
+def _strength(albedo_steps: np.ndarray, normal_steps: np.ndarray) -> np.ndarray:
+    return np.maximum(albedo_steps / ALBEDO_STEP, normal_steps / NORMAL_STEP)
+
+
+def _textured(albedo_steps: np.ndarray) -> np.ndarray:
+    return dilate(albedo_steps > TEXTURE_STEP)
 
 
 def guide_edges(albedo: np.ndarray, normals: np.ndarray) -> np.ndarray:

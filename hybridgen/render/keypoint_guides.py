@@ -24,8 +24,7 @@ class KeypointGuides:
         self._make = make
         self._lock = threading.Lock()
         self._guides: tuple[np.ndarray, np.ndarray] | None = None
-        self._strength: np.ndarray | None = None
-        self._textured: np.ndarray | None = None
+        self._derived_values: tuple[np.ndarray, np.ndarray] | None = None  # (edge strength, textured pixels)
 
     def get(self) -> tuple[np.ndarray, np.ndarray]:
         """(albedo, normals), made on the first call."""
@@ -49,9 +48,9 @@ class KeypointGuides:
     def _derived(self) -> tuple[np.ndarray, np.ndarray]:
         guides = self.get()
         with self._lock:
-            if self._strength is None or self._textured is None:
-                self._strength, self._textured = edge_strength_and_texture(*guides)
-            return self._strength, self._textured
+            if self._derived_values is None:
+                self._derived_values = edge_strength_and_texture(*guides)
+            return self._derived_values
 
     def edges(self) -> np.ndarray:
         """Bool H x W: the edge pixels (:func:`~hybridgen.render.guide_edges.guide_edges`: strength above 1)."""

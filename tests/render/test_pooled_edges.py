@@ -15,6 +15,7 @@ from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
 from hybridgen.render.pathtrace.path_trace import PathTraceSettings, PathTraceView
 from hybridgen.render.pathtrace.pooled_edges import REACH, SHAPE, filter_density
 from hybridgen.render.pixel_filter import blackman_harris
+from tests.render.test_edge_blend import _scene as edge_blend_scene
 
 L = 1.5  # the panel's radiance
 LOOK_UP = np.array([[1.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 1.0], [0, 0, 0, 1]])  # at z = 1 looking up (+z)
@@ -96,15 +97,8 @@ def test_pooled_estimate_lowers_the_noise_of_lit_edges() -> None:
     variant = choose_variant()
     if variant == "scalar_rgb":
         pytest.skip("needs a JIT Mitsuba variant")
-    scene = hg.Scene()
-    scene.add(hg.make_primitive("cube", 1.0, name="cube", category_id=1, color=(0.9, 0.9, 0.9)))
-    floor = hg.make_primitive("plane", 6.0, name="floor", category_id=2, color=(0.2, 0.3, 0.5))
-    floor.local2world = hg.object_pose([0, 0, -0.5], [0, 0, 0])
-    scene.add(floor)
-    scene.world.strength = 0.3
-    scene.lights.append(hg.Light("sun", "SUN", energy=3.0, local2world=hg.object_pose([0, 0, 3], [0.4, 0.3, 0])))
-    scene.camera.intrinsics = hg.Intrinsics.from_fov(0.9, 40, 30)
-    pose = hg.look_at([2.2, -2.6, 1.8], [0, 0, 0])
+    scene = edge_blend_scene()  # the producer test's scene: a cube on a floor, a sun, a dim sky
+    pose = scene.camera.keypoints[0]
     guides = DenoiseGuides(scene)
     try:
         edges = edge_strength(*guides.render(pose)) > 1.0

@@ -186,6 +186,11 @@ def dilate(mask: np.ndarray) -> np.ndarray:
     return out
 
 
+def _pixel_mask(found: np.ndarray | None, size: int) -> np.ndarray:
+    """A caller's pixels (bool H x W, or None: none) as a flat bool mask of ``size``."""
+    return np.zeros(size, dtype=bool) if found is None else np.asarray(found, dtype=bool).ravel()
+
+
 def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
                     edges: Callable[[], np.ndarray | None] | None = None,
                     pool: PooledEdges | None = None,
@@ -214,8 +219,7 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
             rows = slice(None) if len(active) == h * w else active  # all: views, not copies
             error = pixel_error(sum_a[rows], sum_b[rows], count[rows])
             if plan.edge_floor and edges is not None and floor is None:
-                found = edges()
-                floor = np.zeros(h * w, dtype=bool) if found is None else np.asarray(found, dtype=bool).ravel()
+                floor = _pixel_mask(edges(), h * w)
             threshold = plan.noise_threshold * CYCLES_THRESHOLD_SCALE
             if floor is not None and plan.flat_noise_scale != 1:  # the denoiser smooths the pixels off the edges
                 threshold = np.where(floor[active], threshold, threshold * plan.flat_noise_scale)
@@ -226,8 +230,7 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
                 keep |= floor & (count < plan.edge_min_samples)
             if plan.texture_floor and textured is not None:
                 if texture is None:
-                    found = textured()
-                    texture = np.zeros(h * w, dtype=bool) if found is None else np.asarray(found, dtype=bool).ravel()
+                    texture = _pixel_mask(textured(), h * w)
                 keep |= texture & (count < plan.texture_min_samples)
             active = active[keep[active]]
             if len(active) == 0:

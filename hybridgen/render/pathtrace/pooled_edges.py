@@ -114,11 +114,6 @@ class PooledEdges:
     def started(self) -> bool:
         return self._targets is not None
 
-    def contributing(self, pixels: np.ndarray) -> np.ndarray:
-        """Bool mask over ``pixels`` (flat indices): the ones whose samples are pooled."""
-        assert self._sources is not None
-        return self._sources[pixels]
-
     def round(self, active: np.ndarray) -> None:
         """The next round traces ``active`` (flat indices): each contributing source learns which of the sources
         within its reach contribute too."""
