@@ -27,6 +27,9 @@ NORMAL_STEP = 0.1
 """Largest normal difference (sum over xyz) between neighbours that is not an edge (about 6 degrees)."""
 TEXTURE_STEP = ALBEDO_STEP / 4
 """Smallest albedo difference (sum over RGB) between neighbours that marks a textured surface (:func:`textured_pixels`)."""
+GEOMETRIC_EDGE_STEP = NORMAL_STEP
+"""Normal difference (sum over xyz) between neighbours above which a pixel lies on a silhouette or crease: never a
+textured pixel (:func:`textured_pixels`), whatever its albedo does."""
 
 
 def _largest_step(image: np.ndarray) -> np.ndarray:
@@ -52,17 +55,25 @@ def edge_strength(albedo: np.ndarray, normals: np.ndarray) -> np.ndarray:
 
 
 def edge_strength_and_texture(albedo: np.ndarray, normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(:func:`edge_strength`, :func:`textured_pixels`) of the guides, the albedo's steps computed once."""
-    albedo_steps = _steps(albedo)
-    return _strength(albedo_steps, _steps(normals)), _textured(albedo_steps)
+    """(:func:`edge_strength`, :func:`textured_pixels`) of the guides, each guide's steps computed once."""
+    albedo_steps, normal_steps = _steps(albedo), _steps(normals)
+    return _strength(albedo_steps, normal_steps), _textured(albedo_steps, normal_steps)
 
 
-def textured_pixels(albedo: np.ndarray) -> np.ndarray:
+def textured_pixels(albedo: np.ndarray, normals: np.ndarray) -> np.ndarray:
     """Bool H x W: the pixels on or beside a textured surface - an albedo step to a neighbour above
-    :data:`TEXTURE_STEP`, grown by one pixel. Open Image Denoise needs more samples there than on a uniform surface to
-    keep the texture (BlenderProc's ``basics/material_manipulation``: 52.9 -> 55.3 dB against the converged image with
-    these pixels at 64 spp instead of 32, for 11 % more samples; untextured ``basics/basic`` +0.04 dB for 1 %)."""
-    return _textured(_steps(albedo))
+    :data:`TEXTURE_STEP`, grown by one pixel - that are not on a silhouette or crease (a normal step above
+    :data:`GEOMETRIC_EDGE_STEP`).
+
+    Open Image Denoise needs more samples there than on a uniform surface to keep the texture (BlenderProc's
+    ``basics/material_manipulation``: 52.9 -> 55.3 dB against the converged image with these pixels at 64 spp instead
+    of 32, for 11 % more samples; untextured ``basics/basic`` +0.04 dB for 1 %), but no more on the texture's own
+    albedo edges than between them: adaptive sampling gives these pixels the texture's minimum in place of the edge
+    minimum (:func:`hybridgen.render.pathtrace.adaptive_sampling.render_adaptive`). There the wood of
+    material_manipulation has as much noise per sample on its grain's edges as between them; with the grain's edges at
+    the edge minimum (256 spp) they held 52 % of the samples for 13 % of the error. At 64 spp: 55.34 -> 54.14 dB
+    (BlenderProc 53.36) for 62 % of the frame's sampling time; basics/basic 56.44 -> 56.43 dB, the same samples."""
+    return _textured(_steps(albedo), _steps(normals))
 
 
 def _steps(guide: np.ndarray) -> np.ndarray:
@@ -74,8 +85,8 @@ def _strength(albedo_steps: np.ndarray, normal_steps: np.ndarray) -> np.ndarray:
     return np.maximum(albedo_steps / ALBEDO_STEP, normal_steps / NORMAL_STEP)
 
 
-def _textured(albedo_steps: np.ndarray) -> np.ndarray:
-    return dilate(albedo_steps > TEXTURE_STEP)
+def _textured(albedo_steps: np.ndarray, normal_steps: np.ndarray) -> np.ndarray:
+    return dilate(albedo_steps > TEXTURE_STEP) & ~(normal_steps > GEOMETRIC_EDGE_STEP)
 
 
 def guide_edges(albedo: np.ndarray, normals: np.ndarray) -> np.ndarray:

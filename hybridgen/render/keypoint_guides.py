@@ -38,7 +38,7 @@ class KeypointGuides:
         return self._derived()[0]
 
     def textured(self) -> np.ndarray:
-        """Bool H x W: :func:`~hybridgen.render.guide_edges.textured_pixels` of the albedo guide (computed once)."""
+        """Bool H x W: :func:`~hybridgen.render.guide_edges.textured_pixels` of the guides (computed once)."""
         return self._derived()[1]
 
     def prepare(self) -> None:

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 import hybridgen as hg
-from hybridgen.render.guide_edges import ALBEDO_STEP, NORMAL_STEP, TEXTURE_STEP, edge_strength, guide_edges, textured_pixels
+from hybridgen.render.guide_edges import (ALBEDO_STEP, GEOMETRIC_EDGE_STEP, NORMAL_STEP, TEXTURE_STEP, edge_strength,
+                                         edge_strength_and_texture, guide_edges, textured_pixels)
 from hybridgen.render.pathtrace.adaptive_sampling import SamplingPlan, render_adaptive
 from hybridgen.render.pathtrace.mitsuba_variant import choose_variant
 
@@ -75,18 +76,36 @@ def test_a_diagonal_neighbour_counts_and_smooth_ramps_do_not() -> None:
 
 
 def test_textured_pixels_are_albedo_steps_above_the_texture_step_grown_by_one_pixel() -> None:
-    albedo, _ = _flat(8, 12)
-    assert not textured_pixels(albedo).any()
+    albedo, normals = _flat(8, 12)
+    assert not textured_pixels(albedo, normals).any()
     albedo[:] = (np.arange(12, dtype=np.float32) * TEXTURE_STEP / 4)[None, :, None]  # 0.75 x the step per pixel
-    assert not textured_pixels(albedo).any()
+    assert not textured_pixels(albedo, normals).any()
     albedo, _ = _flat(8, 12)
     albedo[3, 6, 0] += 1.5 * TEXTURE_STEP  # one texel, below an edge's step
-    assert not guide_edges(albedo, _flat(8, 12)[1]).any()
+    assert not guide_edges(albedo, normals).any()
     expected = np.zeros((8, 12), bool)
     expected[1:6, 4:9] = True  # the texel and its neighbours step; one more pixel around them
-    assert np.array_equal(textured_pixels(albedo), expected)
+    assert np.array_equal(textured_pixels(albedo, normals), expected)
     albedo[0, 0] = np.nan  # a non-finite guide value counts as 0: a step
-    assert textured_pixels(albedo)[0:3, 0:3].all()
+    assert textured_pixels(albedo, normals)[0:3, 0:3].all()
+
+
+def test_silhouettes_and_creases_are_never_textured_pixels() -> None:
+    """A texture of strong albedo steps (every pixel an edge of the guides) over a crease: the crease's two columns
+    are edge pixels but not textured ones, every other pixel is both; an albedo edge alone is textured."""
+    albedo, normals = _flat(6, 10)
+    albedo[:, ::2, 1] += 4 * ALBEDO_STEP  # stripes: every pixel steps by 4 x ALBEDO_STEP
+    normals[:, 5:] = [0.0, 0.6, 0.8]  # a crease between columns 4 and 5: a step of 0.8 = 8 x NORMAL_STEP
+    assert 0.8 > GEOMETRIC_EDGE_STEP
+    crease = np.zeros((6, 10), bool)
+    crease[:, 4:6] = True
+    assert guide_edges(albedo, normals).all()
+    assert np.array_equal(textured_pixels(albedo, normals), ~crease)
+    strength, textured = edge_strength_and_texture(albedo, normals)
+    assert np.array_equal(strength, edge_strength(albedo, normals))
+    assert np.array_equal(textured, textured_pixels(albedo, normals))
+    normals[:, 5:] = [0.0, 0.05, 0.99875]  # a turn below the step (0.05 + 0.00125): the whole texture
+    assert textured_pixels(albedo, normals).all()
 
 
 def test_textured_pixels_get_texture_min_samples() -> None:
@@ -104,6 +123,20 @@ def test_textured_pixels_get_texture_min_samples() -> None:
         SamplingPlan(64, 4, 0.01, texture_min_samples=128)
     with pytest.raises(hg.InputError, match="texture_min_samples"):
         hg.PathTraceSettings(texture_min_samples=-1)
+
+
+def test_edge_pixels_of_a_texture_get_the_texture_minimum_instead_of_the_edge_minimum() -> None:
+    edges, textured = np.zeros((5, 8), bool), np.zeros((5, 8), bool)
+    edges[1, 1] = edges[1, 2] = True  # (1, 1): a silhouette; (1, 2): an albedo edge of the texture
+    textured[1, 2:5] = True
+    plan = SamplingPlan(64, 4, 0.01, edge_min_samples=32, texture_min_samples=8)
+    _, counts = render_adaptive(_ExactTracer(8, 5), plan, 1, lambda: edges, None, lambda: textured)
+    assert counts[1, 1] == 32 and counts[1, 2] == 8 and counts[1, 3] == counts[1, 4] == 8
+    assert (counts[~(edges | textured)] == 4).all()
+    # without a texture floor every edge keeps the edge minimum, and the textured pixels are not asked for
+    _, counts = render_adaptive(_ExactTracer(8, 5), SamplingPlan(64, 4, 0.01, edge_min_samples=32), 1,
+                                lambda: edges, None, lambda: pytest.fail("asked"))
+    assert counts[1, 1] == counts[1, 2] == 32 and (counts[~edges] == 4).all()
 
 
 class _ExactTracer:

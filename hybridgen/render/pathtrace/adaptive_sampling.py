@@ -16,7 +16,8 @@ Knobs (Cycles' and BlenderProc's names and meaning):
 - ``flat_noise_scale`` (hybridgen's, default 1): with ``edge_min_samples``, the pixels off the edges (which the
   denoiser smooths) stop at this many times the threshold.
 - ``texture_min_samples`` (hybridgen's, 0 = off): samples the pixels of textured surfaces
-  (:func:`hybridgen.render.guide_edges.textured_pixels`) get at least; asked for after the first round, as the edges.
+  (:func:`hybridgen.render.guide_edges.textured_pixels`) get at least, in place of ``edge_min_samples`` on the texture's
+  own edges; asked for after the first round, as the edges.
 
 The error estimate is Cycles' (after Dammertz et al. 2010, "A hierarchical automatic stopping condition
 for Monte Carlo global illumination"; ``film_adaptive_sampling_convergence_check`` in Cycles'
@@ -106,7 +107,8 @@ class SamplingPlan:
     flat_noise_scale: float = 1.0
     """With ``edge_min_samples``: pixels off the edges stop at this many times the threshold (>= 1)."""
     texture_min_samples: int = 0
-    """Samples the pixels of textured surfaces get at least (0 = off)."""
+    """Samples the pixels of textured surfaces get at least (0 = off), in place of ``edge_min_samples`` on the
+    texture's own albedo edges."""
 
     def __post_init__(self) -> None:
         if self.max_samples < 1:
@@ -201,7 +203,8 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
     well (a tracer with hybridgen's Owen-Sobol sampler), those pixels' samples from the second round on are also
     pooled with their neighbours' (:mod:`hybridgen.render.pathtrace.pooled_edges`; ``pool.started`` tells whether
     there were any). With the plan's ``texture_min_samples``, ``textured`` is called once, after the first round,
-    for the pixels of textured surfaces (bool H x W, or None) that get at least that many."""
+    for the pixels of textured surfaces (bool H x W, or None) that get at least that many - edge pixels among them
+    that instead of ``edge_min_samples``."""
     h, w = tracer.height, tracer.width
     if isinstance(tracer, PixelTracer):
         tracer.guide_world()
@@ -226,11 +229,11 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
             unconverged = np.zeros(h * w, dtype=bool)
             unconverged[active] = error >= threshold
             keep = dilate(unconverged.reshape(h, w)).ravel()
-            if floor is not None:
-                keep |= floor & (count < plan.edge_min_samples)
-            if plan.texture_floor and textured is not None:
-                if texture is None:
-                    texture = _pixel_mask(textured(), h * w)
+            if plan.texture_floor and textured is not None and texture is None:
+                texture = _pixel_mask(textured(), h * w)
+            if floor is not None:  # an edge of a texture gets the texture's minimum (guide_edges.textured_pixels)
+                keep |= (floor if texture is None else floor & ~texture) & (count < plan.edge_min_samples)
+            if texture is not None:
                 keep |= texture & (count < plan.texture_min_samples)
             active = active[keep[active]]
             if len(active) == 0:

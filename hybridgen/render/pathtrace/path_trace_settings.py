@@ -100,7 +100,8 @@ class PathTraceSettings:
 
     ``texture_min_samples`` (hybridgen's; default 0 = off): with adaptive sampling and denoising, the samples per
     pixel the pixels of textured surfaces get at least (:func:`hybridgen.render.guide_edges.textured_pixels`; at most
-    the maximum). BlenderProc scripts render with Cycles' automatic minimum there.
+    the maximum), the texture's own albedo edges included (instead of ``edge_min_samples``). BlenderProc scripts render
+    with Cycles' automatic minimum there.
 
     ``guide_factor`` (hybridgen's; default 3, 1..4): the denoising guides are rasterized at this many times the
     resolution and averaged with the pixel filter (:mod:`hybridgen.render.denoise_guides`). BlenderProc scripts
