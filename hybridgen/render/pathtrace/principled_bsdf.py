@@ -201,7 +201,7 @@ def register(variant: str) -> None:
 
                 return sample(self._layered(si, active), sample1, sample2, active)
             inp, lay, wi, flip, rot = self._setup(si, active)
-            choice = sampling.choose(lay, sample1, inp.has_sheen)
+            choice, sample2 = sampling.split(lay, sample1, sample2, inp.has_sheen)
             alpha_x = dr.select(choice.pick_coat, lay.alpha_coat, dr.select(choice.pick_glass, lay.alpha_glass, lay.ax))
             alpha_y = dr.select(choice.pick_coat, lay.alpha_coat, dr.select(choice.pick_glass, lay.alpha_glass, lay.ay))
             wo, refract = sampling.draw(lay, wi, choice, sample2, alpha_x, alpha_y, inp.has_transmission)

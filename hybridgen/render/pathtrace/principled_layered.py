@@ -76,10 +76,10 @@ def eval_pdf(state: Layered, wo: Any, active: Any) -> tuple[Any, Any]:
 
 
 def sample(state: Layered, sample1: Any, sample2: Any, active: Any) -> tuple[Any, Any]:
-    """(BSDFSample3f, weight) as :meth:`~.principled_bsdf.PrincipledBSDF.sample`: the lobe picked by ``sample1``
-    drawn in its layer's frame with ``sample2``."""
+    """(BSDFSample3f, weight) as :meth:`~.principled_bsdf.PrincipledBSDF.sample`: the lobe picked and drawn in its
+    layer's frame with ``sample2`` (:func:`~.principled_sampling.split`; ``sample1``: the glass's choice)."""
     inp, lay, wi = state.inp, state.lay, state.wi
-    choice = sampling.choose(lay, sample1, inp.has_sheen)
+    choice, sample2 = sampling.split(lay, sample1, sample2, inp.has_sheen)
     alpha_x = dr.select(choice.pick_glass, lay.alpha_glass, lay.ax)
     alpha_y = dr.select(choice.pick_glass, lay.alpha_glass, lay.ay)
     wo, refract = sampling.draw(lay, wi, choice, sample2, alpha_x, alpha_y, inp.has_transmission)
