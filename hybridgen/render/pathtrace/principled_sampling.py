@@ -33,27 +33,23 @@ from . import principled_lobes as lobes
 
 @dataclass
 class Choice:
-    """The lobe ``sample1`` picks: cumulative shares and one mask per lobe (sheen's is ``pick_sheen``, within
-    ``pick_diffuse``: both are sampled as diffuse bounces, Cycles' label)."""
+    """The picked lobe: one mask per lobe (sheen's is ``pick_sheen``, within ``pick_diffuse``: both are sampled as
+    diffuse bounces, Cycles' label) and the uniform number ``glass_u`` the glass reflects or refracts by."""
 
-    sample1: Any
-    c_metal: Any
-    c_spec: Any
+    glass_u: Any
     pick_coat: Any
     pick_glass: Any
     pick_diffuse: Any
     pick_sheen: Any
 
 
-def choose(lay: Any, sample1: Any, has_sheen: bool) -> Choice:
-    """The lobe of ``lay`` (:class:`~.principled_layers.Layers`) that ``sample1`` in [0, 1) picks."""
+def choose(lay: Any, u: Any, has_sheen: bool, glass_u: Any) -> Choice:
+    """The lobe of ``lay`` (:class:`~.principled_layers.Layers`) that ``u`` in [0, 1) picks by the cumulative shares."""
     s = lay.shares
     c_coat, c_metal = s[0], s[0] + s[1]
     c_glass, c_spec = c_metal + s[2], c_metal + s[2] + s[3]
-    pick_coat, pick_glass, pick_diffuse = sample1 < c_coat, (sample1 >= c_metal) & (sample1 < c_glass), \
-        sample1 >= c_spec
-    pick_sheen = sample1 >= c_spec + s[4] if has_sheen else None
-    return Choice(sample1, c_metal, c_spec, pick_coat, pick_glass, pick_diffuse, pick_sheen)
+    pick_sheen = u >= c_spec + s[4] if has_sheen else None
+    return Choice(glass_u, u < c_coat, (u >= c_metal) & (u < c_glass), u >= c_spec, pick_sheen)
 
 
 def split(lay: Any, sample1: Any, sample2: Any, has_sheen: bool) -> tuple[Choice, Any]:
@@ -63,22 +59,20 @@ def split(lay: Any, sample1: Any, sample2: Any, has_sheen: bool) -> tuple[Choice
     refraction."""
     s = lay.shares
     x = sample2.x
-    choice = choose(lay, x, has_sheen)
-    bounds = [s[0]]
+    bounds = [s[0]]  # the upper ends of the lobes' intervals, as choose() sums them
     for share in s[1:5]:
         bounds.append(bounds[-1] + share)
     if not has_sheen:
         bounds[-1] = mi.Float(1.0)
     lo, hi = mi.Float(0.0), bounds[0]
-    for low, high in zip(bounds[:-1], bounds[1:]):
+    for low, high in zip(bounds[:-1], bounds[1:]):  # the last interval starting at or below x (empty ones skipped)
         inside = x >= low
         lo, hi = dr.select(inside, low, lo), dr.select(inside, high, hi)
     if has_sheen:
         inside = x >= bounds[-1]
         lo, hi = dr.select(inside, bounds[-1], lo), dr.select(inside, 1.0, hi)
     rescaled = dr.clip((x - lo) / dr.maximum(hi - lo, 1e-20), 0.0, 1.0 - 2.0 ** -24)
-    choice.sample1 = choice.c_metal + sample1 * s[2]  # the glass's own uniform number: sample1
-    return choice, mi.Point2f(rescaled, sample2.y)
+    return choose(lay, x, has_sheen, sample1), mi.Point2f(rescaled, sample2.y)
 
 
 def draw(lay: Any, wi: Any, choice: Choice, sample2: Any, alpha_x: Any, alpha_y: Any,
@@ -91,7 +85,7 @@ def draw(lay: Any, wi: Any, choice: Choice, sample2: Any, alpha_x: Any, alpha_y:
     refract = mi.Bool(False)
     if has_transmission:
         p_reflect, _, _ = layers_mod.glass_reflect_probability(lay, cos_hi)
-        u = (choice.sample1 - choice.c_metal) / dr.maximum(lay.shares[2], 1e-20)
+        u = choice.glass_u
         _, cos_t = lobes.fresnel_dielectric(cos_hi, lay.eta_glass)
         refract = choice.pick_glass & (u >= p_reflect) & (cos_t > 0.0)
         wo = dr.select(refract, lobes.refract(wi, h, cos_t, lay.eta_glass), wo)
