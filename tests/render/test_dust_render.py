@@ -162,18 +162,19 @@ def test_strength_zero_is_bit_identical(jit_variant: str) -> None:
 
 def test_white_furnace(jit_variant: str) -> None:
     """A white Lambertian square in a uniform white world (a furnace: it reflects all it gets, mean radiance 1):
-    white dust over it changes nothing, sample for sample (both lobes draw the same cosine direction); gray dust
-    of albedo 0.5 scales each path by 1 - 0.5 w exactly, so each pixel by 1 - 0.5 x its mean weight."""
+    white dust over it changes nothing (the mix of two white cosine lobes is one; per sample the two sides draw
+    different directions, so the images agree within their noise: at 64 spp the means differ by 4e-5, the pixels
+    by 0.006 on average); gray dust of albedo 0.5 scales each pixel by 1 - 0.5 x its mean weight."""
     def furnace(dust: tuple[Dust, ...]) -> tuple[np.ndarray, object]:
         scene = _square(Material(base_color=(1, 1, 1, 1), specular=0.0, dust=dust), (24, 24))
         scene.lights.clear()
         scene.world.color, scene.world.strength = (1.0, 1.0, 1.0), 1.0
-        return _render(scene, jit_variant, spp=16), scene
+        return _render(scene, jit_variant, spp=64), scene
 
     plain, _ = furnace(())
     assert abs(plain.mean() - 1.0) < 0.01
     white, _ = furnace((Dust(1.0, 20.0, color=(1.0, 1.0, 1.0)),))
-    np.testing.assert_allclose(white, plain, rtol=1e-5, atol=1e-6)
+    assert abs(white.mean() - plain.mean()) < 1e-3 and np.abs(white - plain).mean() < 0.015
     gray_layer = Dust(1.0, 20.0, color=(0.5, 0.5, 0.5))
     gray, scene = furnace((gray_layer,))
     expected = 1.0 - 0.5 * _pixel_weights(scene, gray_layer)

@@ -15,7 +15,12 @@ reproduced) and emission stays the mesh emitter's, undimmed by dust.
 
 Sampling picks the dust lobe with probability W = 1 - m (a cosine lobe) and the material's otherwise, then
 returns the whole mix's value over the whole mix's pdf (a nested delta lobe keeps its own weight, with pdf
-m x its pdf), so ``sample``, ``eval``, ``pdf`` and ``eval_pdf`` agree. JIT variants only (a Python BSDF).
+m x its pdf), so ``sample``, ``eval``, ``pdf`` and ``eval_pdf`` agree. The pick is the x of the 2D direction sample,
+rescaled to the picked side's interval before that side draws its direction with it, as the Principled BSDF picks its
+lobes (:func:`~.principled_sampling.split`): each side's directions keep the stratification of the pattern. A dusty
+specular square (base 0.3 / 0.1 / 0.02, specular 0.5, roughness 0.3, dust 0.8) under a dim sun and a gray world,
+96 x 96, 64 spp: variance between seeds 0.167 -> 0.142 (8-bit sRGB), the same mean. JIT variants only (a Python
+BSDF).
 """
 from __future__ import annotations
 
@@ -197,10 +202,13 @@ def register(variant: str) -> None:
         def sample(self, ctx: Any, si: Any, sample1: Any, sample2: Any, active: Any = True) -> tuple[Any, Any]:
             mix = self._mix(si, active)
             share, _, dust = mix
-            pick_dust = sample1 < dust
-            rescaled = dr.minimum((sample1 - dust) / dr.maximum(share, 1e-20), 0.99999994)
-            bs, weight = self.nested.sample(ctx, si, dr.select(pick_dust, 0.0, rescaled), sample2,
-                                            active & ~pick_dust)
+            # dust or material picked by sample2's x, rescaled to the pick's interval for its direction: each side's
+            # directions stay a stratified part of the pattern (principled_sampling.split); sample1 goes on inside
+            x = sample2.x
+            pick_dust = x < dust
+            rescaled = dr.select(pick_dust, x / dr.maximum(dust, 1e-20), (x - dust) / dr.maximum(share, 1e-20))
+            sample2 = mi.Point2f(dr.clip(rescaled, 0.0, 0.99999994), sample2.y)
+            bs, weight = self.nested.sample(ctx, si, sample1, sample2, active & ~pick_dust)
             wo_dust = mi.warp.square_to_cosine_hemisphere(sample2)
             wo_dust.z = dr.select(mi.Frame3f.cos_theta(si.wi) < 0.0, -wo_dust.z, wo_dust.z)
             wo = dr.select(pick_dust, wo_dust, bs.wo)
