@@ -43,36 +43,29 @@ class Choice:
     pick_sheen: Any
 
 
-def choose(lay: Any, u: Any, has_sheen: bool, glass_u: Any) -> Choice:
-    """The lobe of ``lay`` (:class:`~.principled_layers.Layers`) that ``u`` in [0, 1) picks by the cumulative shares."""
-    s = lay.shares
-    c_coat, c_metal = s[0], s[0] + s[1]
-    c_glass, c_spec = c_metal + s[2], c_metal + s[2] + s[3]
-    pick_sheen = u >= c_spec + s[4] if has_sheen else None
-    return Choice(glass_u, u < c_coat, (u >= c_metal) & (u < c_glass), u >= c_spec, pick_sheen)
-
-
 def split(lay: Any, sample1: Any, sample2: Any, has_sheen: bool) -> tuple[Choice, Any]:
-    """The lobe picked by ``sample2.x`` and the 2D sample to draw its direction with: ``sample2`` with x rescaled to
-    the picked lobe's interval of the cumulative shares. The directions of each lobe's samples then keep the 2D
-    stratification of ``sample2``'s pattern. ``sample1`` is left to the glass's choice between reflection and
-    refraction."""
+    """The lobe picked by ``sample2.x`` by the cumulative shares of ``lay`` (:class:`~.principled_layers.Layers`) and
+    the 2D sample to draw its direction with: ``sample2`` with x rescaled to the picked lobe's interval. The directions
+    of each lobe's samples then keep the 2D stratification of ``sample2``'s pattern. ``sample1`` is left to the
+    glass's choice between reflection and refraction."""
     s = lay.shares
     x = sample2.x
-    bounds = [s[0]]  # the upper ends of the lobes' intervals, as choose() sums them
+    ends = [s[0]]  # the upper ends of the intervals of coat, metal, glass, specular and diffuse
     for share in s[1:5]:
-        bounds.append(bounds[-1] + share)
+        ends.append(ends[-1] + share)
+    pick_sheen = x >= ends[4] if has_sheen else None
+    choice = Choice(sample1, x < ends[0], (x >= ends[1]) & (x < ends[2]), x >= ends[3], pick_sheen)
     if not has_sheen:
-        bounds[-1] = mi.Float(1.0)
-    lo, hi = mi.Float(0.0), bounds[0]
-    for low, high in zip(bounds[:-1], bounds[1:]):  # the last interval starting at or below x (empty ones skipped)
+        ends[-1] = mi.Float(1.0)
+    lo, hi = mi.Float(0.0), ends[0]
+    for low, high in zip(ends[:-1], ends[1:]):  # the last interval starting at or below x (empty ones skipped)
         inside = x >= low
         lo, hi = dr.select(inside, low, lo), dr.select(inside, high, hi)
     if has_sheen:
-        inside = x >= bounds[-1]
-        lo, hi = dr.select(inside, bounds[-1], lo), dr.select(inside, 1.0, hi)
+        inside = x >= ends[-1]
+        lo, hi = dr.select(inside, ends[-1], lo), dr.select(inside, 1.0, hi)
     rescaled = dr.clip((x - lo) / dr.maximum(hi - lo, 1e-20), 0.0, 1.0 - 2.0 ** -24)
-    return choose(lay, x, has_sheen, sample1), mi.Point2f(rescaled, sample2.y)
+    return choice, mi.Point2f(rescaled, sample2.y)
 
 
 def draw(lay: Any, wi: Any, choice: Choice, sample2: Any, alpha_x: Any, alpha_y: Any,
