@@ -80,6 +80,27 @@ encoding, scores ~0.1 dB higher.) Before the mix, the edge floor alone (64, 256)
 (:mod:`hybridgen.render.pathtrace.pooled_edges`) the "now" row scores 56.94 / 56.81 dB; that margin is spent on
 :data:`DENOISED_MAX_SHARE`, :data:`FLAT_NOISE_SCALE` and :data:`GUIDE_FACTOR` (56.40 / 56.40 dB; the grid is in
 docs/blenderproc.md "Speed")."""
+EDGE_NOISE_SCALE = 4.0
+"""Denoised adaptive renders give the edge pixels (off textures) :data:`EDGE_SAMPLES` times the automatic minimum at
+most, and only as many as bring the root mean square of their error estimates to the noise threshold divided by this
+(:attr:`hybridgen.render.pathtrace.adaptive_sampling.SamplingPlan.edge_noise_scale`): one count for all of a frame's
+edge pixels, from their first round. The denoiser leaves those pixels as they are, so they are held to a stricter
+threshold than Cycles' per-pixel one; 4 keeps the full 256 spp on the edges of basics/basic and camera_sampling,
+where hybridgen is within 0.1-0.5 dB of BlenderProc (the root mean square after 32 spp: 0.037-0.052 on their frames
+0-1, which asks 277-556 spp, capped), and gives fewer where edges are quieter. Frame 0 (the exp harness; PSNR against the converged
+image, sampling CPU of the frame; BlenderProc 53.36 / 56.80 dB):
+
+| | basics/basic, camera_sampling | material_manipulation | light_sampling |
+|---|---|---|---|
+| fixed 256 (before) | 56.33 / 56.36 dB | 54.46 dB, 5.67 s | 58.80 dB, 4.10 s |
+| scale 4 (now) | the same bytes | 54.10 dB, 3.91 s (edges 64 spp: 0.012 after 32) | 57.87 dB, 2.99 s (118 spp: 0.024) |
+| scale 4, at least 32 (not 64) | | 53.55 dB, 3.65 s | 57.99 dB, 2.98 s |
+
+camera_sampling's later frames get 256 but frame 3 (0.030: 184 spp); entity_manipulation's 256 and 162. Measured and
+dropped: each edge pixel stopped on its own error estimate at a 4-16x stricter threshold (camera_sampling under
+BlenderProc: a single pixel's estimate after 32 spp is too noisy to stop on), and each given samples in proportion to
+its estimated noise (the allocation that minimises the squared error for a budget; no better than the same mean count
+everywhere: basics/basic 6 % less edge error, light_sampling none)."""
 EDGE_RAW_WEIGHT = 0.6
 """Denoised renders mix this share of the raw samples, pooled with the neighbours'
 (:mod:`hybridgen.render.pathtrace.pooled_edges`), into the colors on guide edges (:mod:`hybridgen.render.edge_blend`)."""
@@ -220,7 +241,8 @@ def _render_group(frames: list[int], meshes: list[MeshObject], color: bool,
             least = max(2, int(automatic * DENOISED_MIN_SHARE) // 2 * 2)
             edge = min(EDGE_SAMPLES * automatic, samples)
             trace = replace(trace, samples=max(edge, int(samples * DENOISED_MAX_SHARE)), min_samples=min(least, samples),
-                            edge_min_samples=edge, edge_raw_weight=EDGE_RAW_WEIGHT, flat_noise_scale=FLAT_NOISE_SCALE,
+                            edge_min_samples=edge, edge_noise_scale=EDGE_NOISE_SCALE, edge_raw_weight=EDGE_RAW_WEIGHT,
+                            flat_noise_scale=FLAT_NOISE_SCALE,
                             guide_factor=GUIDE_FACTOR, texture_min_samples=min(TEXTURE_SAMPLES * automatic, samples))
         scene.camera.depth_of_field = _depth_of_field(frames[0])
         hg.render_color(scene, [sink], trace, labels=request, seed=0, denoise=settings.denoiser is not None,

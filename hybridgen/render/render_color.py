@@ -86,6 +86,8 @@ class ColorProducer:
                 "clamp_indirect": s.clamp_indirect if self.view.clamped else 0.0,
                 "filter_glossy": s.filter_glossy if self.view.own_integrator else 0.0,
                 **({"edge_min_samples": plan.edge_min_samples} if plan.edge_floor and self.denoise else {}),
+                **({"edge_noise_scale": plan.edge_noise_scale}
+                   if plan.edge_floor and self.denoise and plan.edge_noise_scale else {}),
                 **({"edge_raw_weight": s.edge_raw_weight} if s.edge_raw_weight > 0 and self.denoise else {}),
                 "pixel_filter": (f"Blackman-Harris, filter_width {self.view.filter_width} px" if self.view.filter_width
                                  else "box, 1 px"),

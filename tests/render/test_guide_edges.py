@@ -214,6 +214,58 @@ def test_flat_noise_scale_stops_pixels_off_the_edges_at_a_looser_threshold() -> 
         SamplingPlan(64, 4, 0.01, flat_noise_scale=0.5)
 
 
+def test_edge_samples_bring_the_edges_rms_error_to_the_threshold_over_the_scale() -> None:
+    """SamplingPlan.edge_samples: errors fall as 1 / sqrt(samples), so the count is samples x (rms / target)^2,
+    target = threshold x 5 / edge_noise_scale, rounded up to an even count, within [2 x first round, floor]."""
+    plan = SamplingPlan(1024, 32, 0.01, edge_min_samples=256, edge_noise_scale=4)
+    target = 0.01 * 5 / 4
+    errors = np.full(1000, 0.02)
+    assert plan.edge_samples(errors, 32) == 82  # 32 x (0.02 / 0.0125)^2 = 81.92
+    mixed = np.r_[np.full(500, 0.01), np.full(500, 0.03)]  # the root mean square (0.0224), not the mean (0.02)
+    assert plan.edge_samples(mixed, 32) == 2 * math.ceil(32 * np.mean(mixed ** 2) / target ** 2 / 2) == 104
+    assert plan.edge_samples(np.full(10, 0.001), 32) == 64  # at least twice the first round
+    assert plan.edge_samples(np.full(10, 0.1), 32) == 256  # at most the floor
+    assert plan.edge_samples(np.zeros(0), 32) == 256  # no edge pixels: the floor as given
+    fixed = SamplingPlan(1024, 32, 0.01, edge_min_samples=256)
+    assert fixed.edge_samples(errors, 32) == 256  # edge_noise_scale 0: the fixed floor
+    assert SamplingPlan(1024, 32, 0.01, edge_min_samples=48, edge_noise_scale=4).edge_samples(
+        np.full(10, 0.001), 32) == 48  # the least is capped by the floor too
+    for bad in (-1.0, float("nan"), float("inf")):
+        with pytest.raises(hg.InputError, match="edge_noise_scale"):
+            SamplingPlan(1024, 32, 0.01, edge_min_samples=256, edge_noise_scale=bad)
+
+
+def test_edge_pixels_stop_together_where_their_common_error_reaches_the_target() -> None:
+    """Edge pixels of known error (the noisy stand-in's estimate does not fall with samples, so only the first
+    round's sets the count): all of them get the one count, reached with a partial last round, then stop; quiet
+    pixels off the edges stop at the minimum; an unconverged edge pixel goes on as before."""
+    spread = np.zeros((7, 9))
+    edges = np.zeros((7, 9), bool)
+    edges[1, 1:4] = edges[5, 6] = True
+    target = 0.01 * 5 / 8  # threshold 0.01, Cycles' factor 5, edge_noise_scale 8
+    spread[edges] = target * math.sqrt(39.9 / 4) / _estimate(1.0)  # 4 samples at this error need 39.9: 40
+    plan = SamplingPlan(256, 4, 0.01, edge_min_samples=128, edge_noise_scale=8)
+    tracer = _NoisyTracer(9, 7, spread)
+    _, counts = render_adaptive(tracer, plan, 1, lambda: edges)
+    assert (counts[edges] == 40).all()  # 4 -> 8 -> 16 -> 32 -> 40 (a round of 8, not 32)
+    assert (counts[~edges] == 4).all()
+    assert [len(r) for r in tracer.rounds] == [63, 4, 4, 4, 4]
+    fixed = SamplingPlan(256, 4, 0.01, edge_min_samples=128)
+    _, counts = render_adaptive(_NoisyTracer(9, 7, spread), fixed, 1, lambda: edges)
+    assert (counts[edges] == 128).all() and (counts[~edges] == 4).all()
+    spread[5, 6] = 0.07  # error 0.061 >= 5 x 0.01: unconverged, it and its neighbours go on to the maximum
+    _, counts = render_adaptive(_NoisyTracer(9, 7, spread), plan, 1, lambda: edges)
+    assert counts[5, 6] == 256 and (counts[4:7, 5:8] == 256).all()
+    common = 4 * np.mean(_estimate(spread[edges]) ** 2) / target ** 2  # its error counts in the common one
+    assert 120 < common < 128 and (counts[1, 1:4] == 2 * math.ceil(common / 2)).all()  # 64 + a round of 62
+
+
+def _estimate(spread: np.ndarray | float) -> np.ndarray | float:
+    """:class:`_NoisyTracer`'s error estimate for ``spread`` (Cycles' formula on its halves: |I - A| = 0.25 x spread
+    per channel, intensity 0.75)."""
+    return 0.75 * np.asarray(spread) / (1e-4 + math.sqrt(0.75))
+
+
 def _silhouette_scene() -> hg.Scene:
     """A white cube lit by a sun against a black sky (sky pixels: every sample 0)."""
     scene = hg.Scene()
@@ -282,6 +334,7 @@ def test_blenderproc_scripts_denoise_from_half_the_minimum_with_four_times_it_on
     assert denoised.plan().min_samples == 32 and denoised.plan().rounds()[:2] == [32, 32]  # half of it
     assert denoised.plan().max_samples == 256  # a quarter of Cycles' 1024, not below the edge floor
     assert denoised.edge_raw_weight == 0.6 and denoised.flat_noise_scale == 1.5 and denoised.guide_factor == 2
+    assert denoised.edge_noise_scale == 4 and denoised.plan().edge_noise_scale == 4  # 256 only where edges need it
     assert denoised.texture_min_samples == 64 and denoised.plan().texture_floor  # Cycles' minimum on textures
     assert render("INTEL", samples=4096).plan().max_samples == 1024
     assert render("INTEL", threshold=0.001).plan().min_samples == 64  # Cycles' 128 at 0.001, halved
@@ -290,7 +343,7 @@ def test_blenderproc_scripts_denoise_from_half_the_minimum_with_four_times_it_on
     capped = render("INTEL", samples=20)  # the minimum is capped at the maximum first, then halved
     assert capped.plan().min_samples == 10 and capped.edge_min_samples == 20
     for plain in (render(None), render("INTEL", threshold=0.0)):
-        assert plain.edge_min_samples == 0 and plain.edge_raw_weight == 0.0
+        assert plain.edge_min_samples == 0 and plain.edge_raw_weight == 0.0 and plain.edge_noise_scale == 0
         assert plain.flat_noise_scale == 1.0 and plain.guide_factor == 3 and plain.texture_min_samples == 0
     assert render(None).plan().min_samples == 64  # without the denoiser: Cycles' minimum
     assert render(None).plan().max_samples == 1024

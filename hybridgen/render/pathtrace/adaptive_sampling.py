@@ -13,6 +13,13 @@ Knobs (Cycles' and BlenderProc's names and meaning):
 - ``edge_min_samples`` (hybridgen's, 0 = off): samples a pixel the denoiser cannot smooth (an edge of the denoising
   guides, :mod:`hybridgen.render.guide_edges`) gets at least, whatever its error estimate; the render's caller
   hands the edge pixels to :func:`render_adaptive`, which asks for them after the first round.
+- ``edge_noise_scale`` (hybridgen's, 0 = off): with ``edge_min_samples``, the edge pixels get only as many samples
+  as bring their *common* error to the threshold divided by this scale: after the first round, the root mean square
+  of the edge pixels' error estimates, falling as 1 / sqrt(samples), sets one count for all of them
+  (:meth:`SamplingPlan.edge_samples`), at least twice the first round and at most ``edge_min_samples``. Off, every
+  edge pixel gets ``edge_min_samples``. (The edge pixels keep their own noise - the denoiser leaves them as they
+  are - so they are held to a stricter threshold; one pixel's estimate from the first round is too noisy to stop on,
+  the mean over thousands of edge pixels is not: measurements in :mod:`hybridgen.bproc.render_frames`.)
 - ``flat_noise_scale`` (hybridgen's, default 1): with ``edge_min_samples``, the pixels off the edges (which the
   denoiser smooths) stop at this many times the threshold.
 - ``texture_min_samples`` (hybridgen's, 0 = off): samples the pixels of textured surfaces
@@ -109,6 +116,8 @@ class SamplingPlan:
     texture_min_samples: int = 0
     """Samples the pixels of textured surfaces get at least (0 = off), in place of ``edge_min_samples`` on the
     texture's own albedo edges."""
+    edge_noise_scale: float = 0.0
+    """With ``edge_min_samples``: the edge pixels' common count is set by :meth:`edge_samples` (0 = off)."""
 
     def __post_init__(self) -> None:
         if self.max_samples < 1:
@@ -125,6 +134,8 @@ class SamplingPlan:
         if not 0 <= self.texture_min_samples <= self.max_samples:
             raise InputError(f"texture_min_samples must be in 0..samples ({self.max_samples}), "
                              f"got {self.texture_min_samples}")
+        if not (math.isfinite(self.edge_noise_scale) and self.edge_noise_scale >= 0):
+            raise InputError(f"edge_noise_scale must be >= 0 (0 = off), got {self.edge_noise_scale}")
         if not 0 <= self.edge_min_samples <= self.max_samples:
             raise InputError(f"edge_min_samples must be in 0..samples ({self.max_samples}), "
                              f"got {self.edge_min_samples}")
@@ -142,6 +153,18 @@ class SamplingPlan:
     def edge_floor(self) -> bool:
         """Whether ``edge_min_samples`` gives some pixels more samples than the first round."""
         return self.adaptive and self.edge_min_samples > self.rounds()[0]
+
+    def edge_samples(self, errors: np.ndarray, samples: int) -> int:
+        """The samples every edge pixel gets from their ``errors`` after ``samples`` each: the even count at which
+        their root mean square, falling as 1 / sqrt(samples), reaches ``noise_threshold * CYCLES_THRESHOLD_SCALE /
+        edge_noise_scale``, in [2 x the first round, ``edge_min_samples``]; that maximum if the scale is 0."""
+        most = self.edge_min_samples
+        if self.edge_noise_scale == 0 or len(errors) == 0:
+            return most
+        target = self.noise_threshold * CYCLES_THRESHOLD_SCALE / self.edge_noise_scale
+        needed = samples * float(np.mean(np.square(errors))) / target ** 2
+        least = min(2 * self.rounds()[0], most)
+        return int(min(max(math.ceil(needed / 2) * 2, least), most))
 
     def rounds(self) -> list[int]:
         """Samples added to every still-active pixel in each round. Adaptive rounds add even counts (the two
@@ -213,11 +236,14 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
     active = np.arange(h * w)
     floor: np.ndarray | None = None  # the edge pixels (flat bool), once asked for
     texture: np.ndarray | None = None  # the textured pixels (flat bool), once asked for
+    edge_target = plan.edge_min_samples  # the samples the edge floor gives (plan.edge_samples, once known)
+    finished = np.zeros(h * w, dtype=bool)  # pixels whose edge floor ended with a partial round: done
     if pool is not None:
         pool.reset()
         if not getattr(tracer, "owen_sobol", False):
             pool = None
     for round_index, spp in enumerate(plan.rounds()):
+        groups: list[tuple[np.ndarray, int]] = []  # (pixels, samples each) traced this round; none: all active
         if round_index > 0:
             rows = slice(None) if len(active) == h * w else active  # all: views, not copies
             error = pixel_error(sum_a[rows], sum_b[rows], count[rows])
@@ -231,10 +257,18 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
             keep = dilate(unconverged.reshape(h, w)).ravel()
             if plan.texture_floor and textured is not None and texture is None:
                 texture = _pixel_mask(textured(), h * w)
-            if floor is not None:  # an edge of a texture gets the texture's minimum (guide_edges.textured_pixels)
-                keep |= (floor if texture is None else floor & ~texture) & (count < plan.edge_min_samples)
             if texture is not None:
                 keep |= texture & (count < plan.texture_min_samples)
+            floor_only = np.zeros(h * w, dtype=bool)  # pixels kept for the edge floor alone
+            if floor is not None:  # an edge of a texture gets the texture's minimum (guide_edges.textured_pixels)
+                edge = floor if texture is None else floor & ~texture
+                if round_index == 1:  # every pixel has had the first round: one count for the edges
+                    errors = np.zeros(h * w)
+                    errors[active] = error
+                    edge_target = plan.edge_samples(errors[edge], plan.rounds()[0])
+                floor_only = edge & (count < edge_target) & ~keep
+                keep |= floor_only
+            keep &= ~finished
             active = active[keep[active]]
             if len(active) == 0:
                 break
@@ -242,18 +276,25 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
                 if not pool.started:  # the edges are known from the second round on
                     pool.start(floor, sum_a + sum_b, count)
                 pool.round(active)
-        # a whole-frame tracer (scalar_rgb's) renders every pixel per call: one call per round
-        per_chunk = len(active) if tracer.whole_frames else max(1, MAX_WAVEFRONT // spp)
-        for chunk, start in enumerate(range(0, len(active), per_chunk)):
-            pixels = active[start:start + per_chunk]
-            if tracer.owen_sobol:  # one pattern per pixel, continued from round to round
-                pooling = {"pool": pool} if pool is not None and pool.started else {}
-                a, b = tracer.trace(pixels, spp, seed, first=count[pixels], **pooling)
-            else:
-                a, b = tracer.trace(pixels, spp, round_seed(seed, round_index, chunk))
-            rows = slice(start, start + len(pixels)) if len(active) == h * w else pixels  # all: no index lists
-            sum_a[rows] += a
-            sum_b[rows] += b
-        count[active if len(active) < h * w else slice(None)] += spp
+            short = floor_only[active] & (count[active] + spp > edge_target)  # a partial round ends their floor
+            if short.any():  # (active pixels share one count)
+                finished[active[short]] = True
+                groups = [(active[~short], spp), (active[short], edge_target - int(count[active[short][0]]))]
+        chunk = 0
+        for pixels_of, samples in groups or [(active, spp)]:
+            # a whole-frame tracer (scalar_rgb's) renders every pixel per call: one call per group
+            per_chunk = len(pixels_of) if tracer.whole_frames else max(1, MAX_WAVEFRONT // samples)
+            for start in range(0, len(pixels_of), per_chunk):
+                pixels = pixels_of[start:start + per_chunk]
+                if tracer.owen_sobol:  # one pattern per pixel, continued from round to round
+                    pooling = {"pool": pool} if pool is not None and pool.started else {}
+                    a, b = tracer.trace(pixels, samples, seed, first=count[pixels], **pooling)
+                else:
+                    a, b = tracer.trace(pixels, samples, round_seed(seed, round_index, chunk))
+                chunk += 1
+                rows = slice(start, start + len(pixels)) if len(pixels_of) == h * w else pixels  # all: no index lists
+                sum_a[rows] += a
+                sum_b[rows] += b
+            count[pixels_of if len(pixels_of) < h * w else slice(None)] += samples
     image = (sum_a + sum_b) / np.maximum(count, 1)[:, None]
     return image.reshape(h, w, 3).astype(np.float32), count.reshape(h, w)

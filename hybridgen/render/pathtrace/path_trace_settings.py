@@ -89,6 +89,11 @@ class PathTraceSettings:
     the pixels on edges of the denoising guides get at least (:mod:`hybridgen.render.guide_edges`; at most the
     maximum). BlenderProc scripts render with four times Cycles' automatic minimum (:mod:`hybridgen.bproc.render_frames`).
 
+    ``edge_noise_scale`` (hybridgen's; default 0 = off): with ``edge_min_samples``, the edge pixels get only as many
+    samples (at most ``edge_min_samples``) as bring the root mean square of their error estimates to the noise
+    threshold divided by this (:meth:`~hybridgen.render.pathtrace.adaptive_sampling.SamplingPlan.edge_samples`).
+    BlenderProc scripts render with 4.
+
     ``edge_raw_weight`` (hybridgen's; default 0 = off): with denoising, the share of the raw (not denoised) value in
     the colors of pixels on strong edges of the denoising guides (:mod:`hybridgen.render.edge_blend`), 0..1.
     BlenderProc scripts render with 0.6, and on every edge pixel with the pooled estimate of
@@ -121,6 +126,7 @@ class PathTraceSettings:
     filter_glossy: float = glossy_filter.DEFAULT_FILTER_GLOSSY
     caustics_refractive: bool = True
     edge_min_samples: int = 0
+    edge_noise_scale: float = 0.0
     edge_raw_weight: float = 0.0
     flat_noise_scale: float = 1.0
     guide_factor: int = 3  # denoise_guides.DEFAULT_FACTOR
@@ -164,7 +170,7 @@ class PathTraceSettings:
                 return SamplingPlan(most, most, 0.0)
             least = self._min_samples(threshold)
         return SamplingPlan(most, min(least, most), threshold, min(self.edge_min_samples, most), self.flat_noise_scale,
-                            min(self.texture_min_samples, most))
+                            min(self.texture_min_samples, most), self.edge_noise_scale)
 
     def _min_samples(self, threshold: float) -> int:
         """``min_samples``, or Cycles' automatic minimum for ``threshold`` (> 0) when it is 0."""
