@@ -34,16 +34,17 @@ textured pixel (:func:`textured_pixels`), whatever its albedo does."""
 
 def _largest_step(image: np.ndarray) -> np.ndarray:
     """Per pixel of an H x W x C image, the largest sum of absolute channel differences to any of its 8
-    neighbours (neighbours beyond the border repeat the edge pixel)."""
+    neighbours (neighbours beyond the border repeat the edge pixel: no step). A step between two pixels is theirs
+    both, so four directions are differenced, each once (half the work of eight; the same values)."""
     height, width = image.shape[:2]
-    padded = np.pad(np.asarray(image, dtype=np.float32), ((1, 1), (1, 1), (0, 0)), mode="edge")
+    image = np.asarray(image, dtype=np.float32)
     largest = np.zeros((height, width), dtype=np.float32)
-    for dy in range(3):
-        for dx in range(3):
-            if dy == 1 and dx == 1:
-                continue
-            step = np.abs(padded[dy:dy + height, dx:dx + width] - image).sum(axis=2)
-            np.maximum(largest, step, out=largest)
+    for dy, dx in ((0, 1), (1, 0), (1, 1), (1, -1)):  # from pixel p to its neighbour q = p + (dy, dx)
+        left, right = max(0, -dx), width - max(0, dx)  # the columns of the p that have such a q
+        near, far = largest[:height - dy, left:right], largest[dy:, left + dx:right + dx]
+        step = np.abs(image[dy:, left + dx:right + dx] - image[:height - dy, left:right]).sum(axis=2)
+        np.maximum(near, step, out=near)
+        np.maximum(far, step, out=far)
     return largest
 
 

@@ -34,6 +34,22 @@ def test_an_albedo_step_marks_the_two_columns_beside_it() -> None:
     assert not guide_edges(albedo, normals).any()
 
 
+def test_the_largest_step_is_the_largest_of_the_eight_neighbours_steps() -> None:
+    """Against the definition, neighbour by neighbour on an edge-padded copy (four directions are computed, each
+    step counting for both its pixels): the same float32 values, on thin images too."""
+    from hybridgen.render.guide_edges import _largest_step
+
+    rng = np.random.default_rng(5)
+    for shape in ((37, 53, 3), (1, 6, 3), (6, 1, 3), (2, 2, 3)):
+        image = rng.random(shape).astype(np.float32)
+        image[image < 0.4] = 0.25  # flat runs: zero steps
+        padded = np.pad(image, ((1, 1), (1, 1), (0, 0)), mode="edge")
+        h, w = shape[:2]
+        steps = [np.abs(padded[dy:dy + h, dx:dx + w] - image).sum(axis=2)
+                 for dy in range(3) for dx in range(3) if (dy, dx) != (1, 1)]
+        assert np.array_equal(_largest_step(image), np.max(steps, axis=0))
+
+
 def test_edge_strength_is_the_largest_step_in_units_of_the_thresholds() -> None:
     albedo, normals = _flat()
     albedo[:, 5:, 0] += 0.3  # an albedo step of 0.3 = 6 x ALBEDO_STEP
