@@ -53,6 +53,7 @@ class ColorProducer:
         self._denoiser: ThreadPoolExecutor | None = None  # denoising and encoding, one keypoint at a time
         self._filtering: ThreadPoolExecutor | None = None  # the shared raster's guides filtered while sampling
         self._pool: PooledEdges | None | bool = None  # edge pixels' pooled samples (False: the view cannot pool)
+        self._ahead: dict[tuple[int, int, bytes], KeypointGuides] = {}  # the worker's guides of prefetched keypoints
         if denoise and raster is None and not denoise_guides.FOLLOW_SPECULAR:
             # guides of their own: drawn on a thread of their own, its GL context made while Mitsuba starts
             self._worker = GuideWorker(scene, factor=settings.guide_factor)
@@ -107,17 +108,16 @@ class ColorProducer:
         denoising and encoding run meanwhile on a thread of their own, so that the keypoint loop can trace the
         next keypoint while Open Image Denoise works on this one (:func:`hybridgen.render.keypoint_loop.run_keypoints`;
         the same values as in order)."""
-        worker = self._worker  # guides drawn on their own thread while the samples are traced
         plan = self.settings.plan()
         guides: KeypointGuides | None = None
-        if worker is not None:
-            guides = KeypointGuides(partial(worker.result, worker.submit(cam2world, self.view.filter_width)))
+        if self._worker is not None:  # guides drawn on their own thread: since prefetch(), or from now
+            key = (index, eye, np.asarray(cam2world).tobytes())
+            guides = self._ahead.pop(key, None) or self._worker_guides(cam2world)
+            self._ahead = {k: v for k, v in self._ahead.items() if k[0] > index}  # a later keypoint's, if any
         elif self._guides is not None and plan.edge_floor:  # the shared raster: drawn here, filtered meanwhile
             fine = self._guides.draw(cam2world, self.view)
-            if self._filtering is None:
-                self._filtering = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hybridgen-guide-filter")
             guides = KeypointGuides(partial(self._guides.filtered, fine))
-            self._filtering.submit(guides.prepare)  # filtered, edges and textures found while the first round samples
+            self._filtering_thread().submit(guides.prepare)  # filtered, edges and textures found while the first round samples
         edges = guides.edges if guides is not None and self.denoise and plan.edge_floor else None
         textured = guides.textured if guides is not None and self.denoise and plan.texture_floor else None
         pool = self._edge_pool() if edges is not None else None
@@ -137,6 +137,29 @@ class ColorProducer:
         if self._denoiser is None:
             self._denoiser = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hybridgen-denoise")
         return self._denoiser.submit(finish).result
+
+    def prefetch(self, index: int, cam2world: np.ndarray, eye: int = 0) -> None:
+        """Starts drawing keypoint ``index``'s guides on the guide worker, ahead of :meth:`produce_later` (the keypoint
+        loop calls it one keypoint ahead where the objects stay put: :func:`hybridgen.render.keypoint_loop.run_keypoints`),
+        so that they are drawn while the keypoint before is traced instead of while this one's first round is; nothing
+        without a worker (the shared raster view draws on the caller's thread)."""
+        key = (index, eye, np.asarray(cam2world).tobytes())
+        if self._worker is not None and key not in self._ahead:
+            self._ahead[key] = self._worker_guides(cam2world)
+
+    def _worker_guides(self, cam2world: np.ndarray) -> KeypointGuides:
+        """The worker's guides of ``cam2world``, submitted now; their edges and textured pixels are found on the
+        filtering thread as soon as they are drawn (not on the render loop's thread when the first round asks)."""
+        assert self._worker is not None
+        guides = KeypointGuides(partial(self._worker.result, self._worker.submit(cam2world, self.view.filter_width)))
+        if self.denoise and self.settings.plan().edge_floor:
+            self._filtering_thread().submit(guides.prepare)
+        return guides
+
+    def _filtering_thread(self) -> ThreadPoolExecutor:
+        if self._filtering is None:
+            self._filtering = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hybridgen-guide-filter")
+        return self._filtering
 
     def _edge_pool(self) -> PooledEdges | None:
         """The view's pool of edge pixels' samples when raw samples are mixed back on edges (made once per view)."""

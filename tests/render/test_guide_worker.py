@@ -154,3 +154,43 @@ def test_a_job_that_outlives_the_timeout_is_an_error_and_close_does_not_wait_for
     worker.thread.join(timeout=5)
     assert not worker.thread.is_alive()  # the job ended, and the thread with it (the close was queued)
 
+
+
+def test_prefetched_guides_are_drawn_once_ahead_and_give_the_same_bytes(gl_context, jit_variant, monkeypatch):
+    """ColorProducer.prefetch queues a keypoint's guides on the worker (the keypoint loop calls it one keypoint
+    ahead); produce() then uses them instead of drawing again, and the colors are those of a producer that drew
+    each keypoint's guides when it got to it. A prefetched keypoint that is never produced is dropped."""
+    scene = _scene()
+    poses = scene.camera.keypoints
+    submitted: list[bytes] = []
+    submit = GuideWorker.submit
+
+    def counting(self, cam2world, filter_width):
+        submitted.append(np.asarray(cam2world).tobytes())
+        return submit(self, cam2world, filter_width)
+
+    monkeypatch.setattr(GuideWorker, "submit", counting)
+    settings = PathTraceSettings(samples=16, noise_threshold=0.01, min_samples=4, edge_min_samples=8, max_bounces=1)
+    frames = []
+    for ahead in (True, False):
+        producer = ColorProducer(scene, settings, variant=jit_variant, denoise=True, sample_counts=True)
+        try:
+            if ahead:
+                producer.prefetch(0, poses[0])
+                producer.prefetch(1, poses[1])
+                producer.prefetch(1, poses[1])  # asked twice: queued once
+                assert submitted == [poses[0].tobytes(), poses[1].tobytes()]
+            frames.append([producer.produce(i, pose) for i, pose in enumerate(poses)])
+            if ahead:
+                assert len(submitted) == 2  # not drawn again
+                producer.prefetch(7, poses[0])
+                assert len(producer._ahead) == 1
+                producer.produce(0, poses[1])  # another pose: drawn now; keypoint 7's are kept, not used
+                assert len(submitted) == 4 and list(producer._ahead) == [(7, 0, poses[0].tobytes())]
+        finally:
+            producer.close()
+    assert len(submitted) == 6
+    for prefetched, drawn in zip(*frames):
+        assert (prefetched["sample_counts"] > 4).any()  # the edge floor read the guides' edges
+        np.testing.assert_array_equal(prefetched["sample_counts"], drawn["sample_counts"])
+        np.testing.assert_array_equal(prefetched["colors"], drawn["colors"])
