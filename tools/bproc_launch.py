@@ -26,8 +26,8 @@ render, ``{"K": 3x3, "cam2world": [4x4 per frame, Blender camera axes], "objects
 its bproc layer), ``scene_load`` (``bproc.loader.*``), ``render`` (``bproc.renderer.render`` as a whole) and, within
 it, ``mitsuba_scene`` (building Mitsuba's scene), ``sampling`` (path tracing, split by Dr.Jit's kernel history into
 ``kernel_compile`` and the rest), ``labels`` (raster label passes), ``denoise_guides`` (drawing, filtering or
-waiting for the guides on the render loop's thread), ``denoise`` (Open Image Denoise and the guides' filtering on the
-color producer's own thread, overlapping the next keypoint's sampling), ``denoise_wait`` (the render loop waiting for a keypoint's denoised colors), then ``write``
+waiting for the guides on the render loop's thread), ``denoise`` (beside the render loop, on other threads: Open
+Image Denoise, the guide worker's draws and the guides' filtering, overlapping sampling), ``denoise_wait`` (the render loop waiting for a keypoint's denoised colors), then ``write``
 (``bproc.writer.*``) and ``in_process`` (everything after the interpreter started, to exit).
 """
 from __future__ import annotations
@@ -153,15 +153,18 @@ def instrument_hybridgen(spent: dict[str, float]) -> None:
                 setattr(module, name, accumulating(spent, stage, getattr(module, name)))
     PathTraceView.__init__ = accumulating(spent, "mitsuba_scene", PathTraceView.__init__)
     LabelProducer.produce = accumulating(spent, "labels", LabelProducer.produce)
-    DenoiseGuides.draw = accumulating(spent, "denoise_guides", DenoiseGuides.draw)
-    filtered = DenoiseGuides.filtered
 
-    def filter_guides(*args: Any, **kwargs: Any) -> Any:  # the render loop's thread, or the denoising thread
-        stage = "denoise_guides" if threading.current_thread() is threading.main_thread() else "denoise"
-        return accumulating(spent, stage, filtered)(*args, **kwargs)
+    def guide_stage(call: Any) -> Any:
+        """``call`` timed as ``denoise_guides`` on the render loop's thread, as ``denoise`` (beside) on others: the
+        guide worker's draws, the filtering thread's filter and its waits for the worker."""
+        def timed(*args: Any, **kwargs: Any) -> Any:
+            stage = "denoise_guides" if threading.current_thread() is threading.main_thread() else "denoise"
+            return accumulating(spent, stage, call)(*args, **kwargs)
+        return timed
 
-    DenoiseGuides.filtered = filter_guides
-    GuideWorker.result = accumulating(spent, "denoise_guides", GuideWorker.result)
+    DenoiseGuides.draw = guide_stage(DenoiseGuides.draw)
+    DenoiseGuides.filtered = guide_stage(DenoiseGuides.filtered)
+    GuideWorker.result = guide_stage(GuideWorker.result)
     render_color.oidn_denoise = accumulating(spent, "denoise", render_color.oidn_denoise)
     produce_later = render_color.ColorProducer.produce_later
 

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..io.frame_sink import FrameSink, PassLayout
 from ..io.texture_needs import require_base_colors
+from ..scene.object_keyframes import varies_per_keypoint
 from ..scene.scene import Scene
 from . import denoise_guides
 from .denoise_guides import DenoiseGuides
@@ -45,7 +46,8 @@ class ColorProducer:
 
     def __init__(self, scene: Scene, settings: PathTraceSettings, *, seed: int = 0, variant: str | None = None,
                  hdr: bool = False, denoise: bool = False, view: PathTraceView | None = None,
-                 keep_raw: bool = False, sample_counts: bool = False, raster: SceneRaster | None = None) -> None:
+                 keep_raw: bool = False, sample_counts: bool = False, raster: SceneRaster | None = None,
+                 first: tuple[int, np.ndarray] | None = None) -> None:
         self.scene, self.settings, self.seed, self.hdr, self.denoise = scene, settings, int(seed), hdr, denoise
         self.keep_raw, self.sample_counts = keep_raw and denoise, sample_counts
         self._guides: DenoiseGuides | None = None
@@ -53,7 +55,7 @@ class ColorProducer:
         self._denoiser: ThreadPoolExecutor | None = None  # denoising and encoding, one keypoint at a time
         self._filtering: ThreadPoolExecutor | None = None  # the shared raster's guides filtered while sampling
         self._pool: PooledEdges | None | bool = None  # edge pixels' pooled samples (False: the view cannot pool)
-        self._ahead: dict[tuple[int, int, bytes], KeypointGuides] = {}  # the worker's guides of prefetched keypoints
+        self._ahead: dict[tuple[int, int, bytes, float], KeypointGuides] = {}  # the worker's, of prefetched keypoints
         if denoise and raster is None and not denoise_guides.FOLLOW_SPECULAR:
             # guides of their own: drawn on a thread of their own, its GL context made while Mitsuba starts
             self._worker = GuideWorker(scene, factor=settings.guide_factor)
@@ -62,6 +64,8 @@ class ColorProducer:
                 require_oidn()
                 if self._worker is not None:
                     self._worker.prepare_denoiser()
+                    if first is not None:  # drawn while Mitsuba starts (the path tracer's filter width, if JIT)
+                        self._prefetch(first[0], first[1], 0, settings.filter_width)
             self.view = view or PathTraceView(scene, settings, variant=variant)
         except BaseException:
             self.close()
@@ -111,8 +115,8 @@ class ColorProducer:
         plan = self.settings.plan()
         guides: KeypointGuides | None = None
         if self._worker is not None:  # guides drawn on their own thread: since prefetch(), or from now
-            key = (index, eye, np.asarray(cam2world).tobytes())
-            guides = self._ahead.pop(key, None) or self._worker_guides(cam2world)
+            key = (index, eye, np.asarray(cam2world).tobytes(), self.view.filter_width)
+            guides = self._ahead.pop(key, None) or self._worker_guides(cam2world, self.view.filter_width)
             self._ahead = {k: v for k, v in self._ahead.items() if k[0] > index}  # a later keypoint's, if any
         elif self._guides is not None and plan.edge_floor:  # the shared raster: drawn here, filtered meanwhile
             fine = self._guides.draw(cam2world, self.view)
@@ -143,15 +147,19 @@ class ColorProducer:
         loop calls it one keypoint ahead where the objects stay put: :func:`hybridgen.render.keypoint_loop.run_keypoints`),
         so that they are drawn while the keypoint before is traced instead of while this one's first round is; nothing
         without a worker (the shared raster view draws on the caller's thread)."""
-        key = (index, eye, np.asarray(cam2world).tobytes())
-        if self._worker is not None and key not in self._ahead:
-            self._ahead[key] = self._worker_guides(cam2world)
+        self._prefetch(index, cam2world, eye, self.view.filter_width)
 
-    def _worker_guides(self, cam2world: np.ndarray) -> KeypointGuides:
-        """The worker's guides of ``cam2world``, submitted now; their edges and textured pixels are found on the
-        filtering thread as soon as they are drawn (not on the render loop's thread when the first round asks)."""
+    def _prefetch(self, index: int, cam2world: np.ndarray, eye: int, filter_width: float) -> None:
+        key = (index, eye, np.asarray(cam2world).tobytes(), float(filter_width))
+        if self._worker is not None and key not in self._ahead:
+            self._ahead[key] = self._worker_guides(cam2world, filter_width)
+
+    def _worker_guides(self, cam2world: np.ndarray, filter_width: float) -> KeypointGuides:
+        """The worker's guides of ``cam2world`` for pixels of ``filter_width``, submitted now; their edges and
+        textured pixels are found on the filtering thread as soon as they are drawn (not on the render loop's thread
+        when the first round asks)."""
         assert self._worker is not None
-        guides = KeypointGuides(partial(self._worker.result, self._worker.submit(cam2world, self.view.filter_width)))
+        guides = KeypointGuides(partial(self._worker.result, self._worker.submit(cam2world, filter_width)))
         if self.denoise and self.settings.plan().edge_floor:
             self._filtering_thread().submit(guides.prepare)
         return guides
@@ -222,9 +230,12 @@ def render_color(scene: Scene, sinks: Iterable[FrameSink], settings: PathTraceSe
         if labels is not None:
             producers.append(LabelProducer(scene, labels.with_sinks(sinks), default_category_id=default_category_id,
                                            raster=raster))
+        start = indices[0] if indices is not None and len(indices) else 0  # the loop's first keypoint: its guides
+        first = (start, scene.camera.keypoints[start]) if 0 <= start < len(scene.camera) and \
+            stereo_baseline is None and not varies_per_keypoint(scene) else None  # are drawn while Mitsuba starts
         producers.insert(0, ColorProducer(scene, settings or PathTraceSettings(), seed=seed, variant=variant,
                                           hdr=hdr, denoise=denoise, keep_raw=keep_raw, sample_counts=sample_counts,
-                                          raster=raster))
+                                          raster=raster, first=first))
         if stereo_baseline is not None:
             producers = [StereoProducer(producers, stereo_baseline, scene)]
         return run_keypoints(scene, sinks, producers, progress=progress, what="color", indices=indices)

@@ -186,7 +186,7 @@ def test_prefetched_guides_are_drawn_once_ahead_and_give_the_same_bytes(gl_conte
                 producer.prefetch(7, poses[0])
                 assert len(producer._ahead) == 1
                 producer.produce(0, poses[1])  # another pose: drawn now; keypoint 7's are kept, not used
-                assert len(submitted) == 4 and list(producer._ahead) == [(7, 0, poses[0].tobytes())]
+                assert len(submitted) == 4 and list(producer._ahead) == [(7, 0, poses[0].tobytes(), 1.5)]
         finally:
             producer.close()
     assert len(submitted) == 6
@@ -194,3 +194,32 @@ def test_prefetched_guides_are_drawn_once_ahead_and_give_the_same_bytes(gl_conte
         assert (prefetched["sample_counts"] > 4).any()  # the edge floor read the guides' edges
         np.testing.assert_array_equal(prefetched["sample_counts"], drawn["sample_counts"])
         np.testing.assert_array_equal(prefetched["colors"], drawn["colors"])
+
+
+def test_the_first_keypoints_guides_are_drawn_while_mitsuba_starts(gl_context, jit_variant, monkeypatch):
+    """render_color hands the producer the loop's first keypoint (objects that stay put, no stereo): its guides are
+    queued before the Mitsuba scene is built and drawn once; every keypoint is drawn once."""
+    from hybridgen.render import render_color as render_color_module
+
+    scene = _scene()
+    events: list[str] = []
+    submit, view = GuideWorker.submit, render_color_module.PathTraceView
+
+    def counting(self, cam2world, filter_width):
+        which = [i for i, pose in enumerate(scene.camera.keypoints) if np.array_equal(pose, cam2world)]
+        events.append(f"guides {which}")
+        return submit(self, cam2world, filter_width)
+
+    def building(*args, **kwargs):
+        events.append("mitsuba")
+        return view(*args, **kwargs)
+
+    monkeypatch.setattr(GuideWorker, "submit", counting)
+    monkeypatch.setattr(render_color_module, "PathTraceView", building)
+    render_color(scene, [MemorySink()], PathTraceSettings(samples=4, max_bounces=1), variant=jit_variant,
+                 denoise=True)
+    assert events == ["guides [0]", "mitsuba", "guides [1]"]
+    events.clear()
+    render_color(scene, [MemorySink()], PathTraceSettings(samples=4, max_bounces=1), variant=jit_variant,
+                 denoise=True, indices=[1])
+    assert events == ["guides [1]", "mitsuba"]  # the loop starts at keypoint 1
