@@ -23,8 +23,8 @@ tree that others are editing can be half-way through a change.
 ``--profile`` adds one hybridgen run through tools/bproc_launch.py ``--profile`` (not timed against BlenderProc) and
 prints where its time goes: start-up (interpreter and exit: the whole process minus what ran in it), imports,
 scene load, Mitsuba scene build, kernel compilation, sampling, labels, denoising guides, waiting for the denoiser,
-writing - the render loop's thread, adding up to the whole process - and, beside them, Open Image Denoise on the
-color producer's own thread (it overlaps the next frame's sampling).
+writing - the render loop's thread, adding up to the whole process - and, beside them, what other threads do: Open
+Image Denoise (it overlaps the next frame's sampling), the guide worker's draws and the guides' filtering.
 """
 from __future__ import annotations
 
@@ -189,7 +189,7 @@ def print_profile(spent: dict[str, float], markdown: bool) -> None:
     for name, seconds in rows:
         table.row(name, seconds, seconds / spent["whole_process"])
     table.row("whole process", spent["whole_process"], 1.0)
-    table.row("denoise, guide filtering (own thread, beside)", spent.get("denoise", 0.0),
+    table.row("denoise, guides drawn and filtered (other threads, beside)", spent.get("denoise", 0.0),
               spent.get("denoise", 0.0) / spent["whole_process"])
 
 
