@@ -201,8 +201,8 @@ class ColorProducer:
         """Release the denoising guides' GL resources and thread and the denoising thread (the Mitsuba scene goes
         with this producer)."""
         for pool in (self._denoiser, self._filtering):
-            if pool is not None:
-                pool.shutdown(wait=True)
+            if pool is not None:  # what has not started (a prefetched keypoint's, after an error) is dropped
+                pool.shutdown(wait=True, cancel_futures=True)
         self._denoiser = self._filtering = None
         if self._guides is not None:
             self._guides.release()

@@ -242,6 +242,8 @@ def test_edge_samples_bring_the_edges_rms_error_to_the_threshold_over_the_scale(
     assert plan.edge_samples(np.full(10, 0.001), 32) == 64  # at least twice the first round
     assert plan.edge_samples(np.full(10, 0.1), 32) == 256  # at most the floor
     assert plan.edge_samples(np.zeros(0), 32) == 256  # no edge pixels: the floor as given
+    assert plan.edge_samples(np.r_[errors, np.nan], 32) == 256  # a non-finite estimate says nothing
+    assert plan.edge_samples(np.r_[errors, 1e300], 32) == 256  # overflowing to infinity: the floor too
     fixed = SamplingPlan(1024, 32, 0.01, edge_min_samples=256)
     assert fixed.edge_samples(errors, 32) == 256  # edge_noise_scale 0: the fixed floor
     assert SamplingPlan(1024, 32, 0.01, edge_min_samples=48, edge_noise_scale=4).edge_samples(

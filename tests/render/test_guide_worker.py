@@ -135,7 +135,8 @@ def test_the_denoiser_is_prepared_on_the_guide_thread(gl_context, monkeypatch):
 
 def test_a_job_that_outlives_the_timeout_is_an_error_and_close_does_not_wait_for_it_again(gl_context):
     """A hung job (a driver that never returns) costs one timeout: :meth:`GLWorker.wait` raises a SystemSetupError
-    naming what was waited for, and closing the worker then returns at once instead of joining the thread."""
+    naming what was waited for, a job queued behind it fails at once, and closing the worker then returns at once
+    instead of joining the thread."""
     import threading
     import time
 
@@ -145,9 +146,12 @@ def test_a_job_that_outlives_the_timeout_is_an_error_and_close_does_not_wait_for
     worker: GLWorker = GLWorker(lambda ctx: "built", lambda owned: None, "test-gl-worker", timeout=0.5)
     assert worker.wait(worker.ready, "the build") == "built"
     stuck = worker.submit(lambda owned: release.wait(30))
+    queued = worker.submit(lambda owned: "never reached while stuck")  # e.g. a prefetched keypoint's guides
     with pytest.raises(hg.SystemSetupError, match="no answer for the stuck job within 0.5 s"):
         worker.wait(stuck, "the stuck job")
     start = time.perf_counter()
+    with pytest.raises(hg.SystemSetupError, match="no answer for the next job"):
+        worker.wait(queued, "the next job")  # at once: a hung worker answers no later job
     worker.close()
     assert time.perf_counter() - start < 0.2
     release.set()

@@ -13,13 +13,11 @@ Knobs (Cycles' and BlenderProc's names and meaning):
 - ``edge_min_samples`` (hybridgen's, 0 = off): samples a pixel the denoiser cannot smooth (an edge of the denoising
   guides, :mod:`hybridgen.render.guide_edges`) gets at least, whatever its error estimate; the render's caller
   hands the edge pixels to :func:`render_adaptive`, which asks for them after the first round.
-- ``edge_noise_scale`` (hybridgen's, 0 = off): with ``edge_min_samples``, the edge pixels get only as many samples
-  as bring their *common* error to the threshold divided by this scale: after the first round, the root mean square
-  of the edge pixels' error estimates, falling as 1 / sqrt(samples), sets one count for all of them
-  (:meth:`SamplingPlan.edge_samples`), at least twice the first round and at most ``edge_min_samples``. Off, every
-  edge pixel gets ``edge_min_samples``. (The edge pixels keep their own noise - the denoiser leaves them as they
-  are - so they are held to a stricter threshold; one pixel's estimate from the first round is too noisy to stop on,
-  the mean over thousands of edge pixels is not: measurements in :mod:`hybridgen.bproc.render_frames`.)
+- ``edge_noise_scale`` (hybridgen's, 0 = off: ``edge_min_samples`` each): with ``edge_min_samples``, one count for all
+  edge pixels, set after the first round by the root mean square of their error estimates (falling as 1 /
+  sqrt(samples)) reaching the threshold divided by this (:meth:`SamplingPlan.edge_samples`). The denoiser leaves edge
+  pixels as they are, so they are held to a stricter threshold; one pixel's first estimate is too noisy to stop on,
+  the mean over thousands is not (measurements in :mod:`hybridgen.bproc.render_frames`).
 - ``flat_noise_scale`` (hybridgen's, default 1): with ``edge_min_samples``, the pixels off the edges (which the
   denoiser smooths) stop at this many times the threshold.
 - ``texture_min_samples`` (hybridgen's, 0 = off): samples the pixels of textured surfaces
@@ -155,14 +153,16 @@ class SamplingPlan:
         return self.adaptive and self.edge_min_samples > self.rounds()[0]
 
     def edge_samples(self, errors: np.ndarray, samples: int) -> int:
-        """The samples every edge pixel gets from their ``errors`` after ``samples`` each: the even count at which
-        their root mean square, falling as 1 / sqrt(samples), reaches ``noise_threshold * CYCLES_THRESHOLD_SCALE /
-        edge_noise_scale``, in [2 x the first round, ``edge_min_samples``]; that maximum if the scale is 0."""
+        """Every edge pixel's samples: the even count where the root mean square of ``errors`` (after ``samples``)
+        reaches the threshold x 5 / ``edge_noise_scale``, in [2 x first round, ``edge_min_samples``] (that if 0)."""
         most = self.edge_min_samples
         if self.edge_noise_scale == 0 or len(errors) == 0:
             return most
-        target = self.noise_threshold * CYCLES_THRESHOLD_SCALE / self.edge_noise_scale
-        needed = samples * float(np.mean(np.square(errors))) / target ** 2
+        with np.errstate(over="ignore", invalid="ignore"):
+            needed = samples * float(np.mean(np.square(errors))) / \
+                (self.noise_threshold * CYCLES_THRESHOLD_SCALE / self.edge_noise_scale) ** 2
+        if not math.isfinite(needed):  # a non-finite estimate says nothing: the floor
+            return most
         least = min(2 * self.rounds()[0], most)
         return int(min(max(math.ceil(needed / 2) * 2, least), most))
 

@@ -76,9 +76,10 @@ class GLWorker(Generic[T]):
 
     def wait(self, result: Future, what: str) -> Any:
         """The value of ``result`` (raised again if it is an exception), or a SystemSetupError naming ``what``
-        when the worker gives no answer within the timeout."""
+        when the worker gives no answer within the timeout - at once once a job has outlived it (a hung worker
+        answers no later job: jobs queued ahead cost one timeout, not one each)."""
         try:
-            return result.result(timeout=self.timeout)
+            return result.result(timeout=0 if self.hung else self.timeout)
         except TimeoutError as exc:
             self.hung = True
             raise SystemSetupError(f"a raster thread gave no answer for {what} within {self.timeout:g} s") from exc
