@@ -87,8 +87,8 @@ most, and only as many as bring the root mean square of their error estimates to
 edge pixels, from their first round. The denoiser leaves those pixels as they are, so they are held to a stricter
 threshold than Cycles' per-pixel one; 4 keeps the full 256 spp on the edges of basics/basic and camera_sampling,
 where hybridgen is within 0.1-0.5 dB of BlenderProc (the root mean square after 32 spp: 0.037-0.052 on their frames
-0-1, which asks 277-556 spp, capped), and gives fewer where edges are quieter. Frame 0 (the exp harness; PSNR against the converged
-image, sampling CPU of the frame; BlenderProc 53.36 / 56.80 dB):
+0-1, which asks 277-556 spp, capped), and gives fewer where edges are quieter. Frame 0 (the exp harness; PSNR
+against the converged image, sampling CPU of the frame; BlenderProc 53.36 / 56.80 dB):
 
 | | basics/basic, camera_sampling | material_manipulation | light_sampling |
 |---|---|---|---|

@@ -53,7 +53,7 @@ class ColorProducer:
         self._guides: DenoiseGuides | None = None
         self._worker: GuideWorker | None = None
         self._denoiser: ThreadPoolExecutor | None = None  # denoising and encoding, one keypoint at a time
-        self._filtering: ThreadPoolExecutor | None = None  # the shared raster's guides filtered while sampling
+        self._filtering: ThreadPoolExecutor | None = None  # guides filtered, their edges found, while sampling
         self._pool: PooledEdges | None | bool = None  # edge pixels' pooled samples (False: the view cannot pool)
         self._ahead: dict[tuple[int, int, bytes, float], KeypointGuides] = {}  # the worker's, of prefetched keypoints
         if denoise and raster is None and not denoise_guides.FOLLOW_SPECULAR:
@@ -121,7 +121,7 @@ class ColorProducer:
         elif self._guides is not None and plan.edge_floor:  # the shared raster: drawn here, filtered meanwhile
             fine = self._guides.draw(cam2world, self.view)
             guides = KeypointGuides(partial(self._guides.filtered, fine))
-            self._filtering_thread().submit(guides.prepare)  # filtered, edges and textures found while the first round samples
+            self._filtering_thread().submit(guides.prepare)  # filtered, edges found while the first round samples
         edges = guides.edges if guides is not None and self.denoise and plan.edge_floor else None
         textured = guides.textured if guides is not None and self.denoise and plan.texture_floor else None
         pool = self._edge_pool() if edges is not None else None
@@ -143,10 +143,11 @@ class ColorProducer:
         return self._denoiser.submit(finish).result
 
     def prefetch(self, index: int, cam2world: np.ndarray, eye: int = 0) -> None:
-        """Starts drawing keypoint ``index``'s guides on the guide worker, ahead of :meth:`produce_later` (the keypoint
-        loop calls it one keypoint ahead where the objects stay put: :func:`hybridgen.render.keypoint_loop.run_keypoints`),
-        so that they are drawn while the keypoint before is traced instead of while this one's first round is; nothing
-        without a worker (the shared raster view draws on the caller's thread)."""
+        """Starts drawing keypoint ``index``'s guides on the guide worker, ahead of :meth:`produce_later` (the
+        keypoint loop calls it one keypoint ahead where the objects stay put:
+        :func:`hybridgen.render.keypoint_loop.run_keypoints`), so that they are drawn while the keypoint before is
+        traced instead of while this one's first round is; nothing without a worker (the shared raster view draws on
+        the caller's thread)."""
         self._prefetch(index, cam2world, eye, self.view.filter_width)
 
     def _prefetch(self, index: int, cam2world: np.ndarray, eye: int, filter_width: float) -> None:
