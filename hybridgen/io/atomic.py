@@ -12,6 +12,7 @@ from __future__ import annotations
 import errno
 import os
 import tempfile
+import threading
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Iterator
@@ -22,6 +23,10 @@ from ..stop_request import deferred
 TEMP_SUFFIX = ".incomplete"
 _RANDOM_PART = 8 + 2  # mkstemp's random characters plus the dots around them
 _LIVE: set[Path] = set()
+_LISTING = threading.RLock()
+"""Held while a temporary file is listed and made, and while the listed ones are deleted: a signal handler (main
+thread) deleting them waits for another thread's file to exist; re-entrant, for one that lands in the main thread's
+own making."""
 _PRUNE_AT = 4096
 
 
@@ -77,28 +82,50 @@ def temporary_path(final: Path) -> Path:
     stem = os.fsdecode(os.fsencode(final.name)[:room]) if room > 0 else ""
     if len(_LIVE) >= _PRUNE_AT:
         _LIVE.difference_update([p for p in _LIVE if not os.path.lexists(p)])
-    # A stop request (SIGTERM's SystemExit) between creating the file and listing it would leave it behind:
-    # the two happen inside stop_request.deferred(), which raises the request once the file is listed.
+    # The name is listed before the file exists: a signal handler that deletes the live files (a worker's
+    # SIGTERM exits at once, between any two bytecodes, from the main thread while another writes) can never
+    # miss a file that exists. A stop request of the main process (SystemExit) waits for the descriptor to close.
     with deferred():
         try:
-            fd, name = tempfile.mkstemp(prefix=f".{stem}.", suffix=TEMP_SUFFIX, dir=final.parent)
-        except UnicodeDecodeError:  # cut inside a multi-byte character: drop the final name from the temp name
-            fd, name = tempfile.mkstemp(prefix=".", suffix=TEMP_SUFFIX, dir=final.parent)
-        except OSError as exc:
-            raise InputError(f"cannot write in '{final.parent}': {exc.strerror or exc}") from None
-        temp = Path(name)
-        _LIVE.add(temp)
+            return _created(final.parent, f".{stem}.")
+        except UnicodeError:  # cut inside a multi-byte character: drop the final name from the temp name
+            return _created(final.parent, ".")
+
+
+def _created(folder: Path, prefix: str) -> Path:
+    """A new empty file ``<prefix><random><TEMP_SUFFIX>`` in ``folder``, made as :func:`tempfile.mkstemp` makes
+    its files (its random names, ``O_CREAT | O_EXCL | O_NOFOLLOW``, mode 0600), listed in the live temporaries
+    before it is created."""
+    flags = os.O_RDWR | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+    names = tempfile._get_candidate_names()  # mkstemp's own source of random names
+    for _ in range(tempfile.TMP_MAX):
+        temp = folder / f"{prefix}{next(names)}{TEMP_SUFFIX}"
+        with _LISTING:
+            _LIVE.add(temp)
+            try:
+                fd = os.open(temp, flags, 0o600)
+            except FileExistsError:  # taken (or a planted symlink): another name
+                _LIVE.discard(temp)
+                continue
+            except OSError as exc:
+                _LIVE.discard(temp)
+                raise InputError(f"cannot write in '{folder}': {exc.strerror or exc}") from None
+            except BaseException:
+                _LIVE.discard(temp)
+                raise
         os.close(fd)
-    return temp
+        return temp
+    raise InputError(f"cannot write in '{folder}': no free temporary file name")
 
 
 def discard(temp: Path) -> None:
-    """Delete a temporary file (if it is still there) and forget it."""
-    _LIVE.discard(temp)
+    """Delete a temporary file (if it is still there), then forget it (in that order: a signal handler that
+    deletes the live files in between finds it listed)."""
     try:
         os.unlink(temp)
     except FileNotFoundError:
         pass
+    _LIVE.discard(temp)
 
 
 def close_discarded_hdf5(h5: Any) -> None:
@@ -155,13 +182,14 @@ def remove_live_temporaries() -> int:
     """Delete every temporary file this process created and has not committed; returns how many.
     Safe to call from a signal handler's exit path."""
     removed = 0
-    for temp in list(_LIVE):
-        try:
-            os.unlink(temp)
-            removed += 1
-        except OSError:
-            pass
-    _LIVE.clear()
+    with _LISTING:
+        for temp in list(_LIVE):
+            try:
+                os.unlink(temp)
+                removed += 1
+            except OSError:
+                pass
+        _LIVE.clear()
     return removed
 
 
