@@ -263,9 +263,7 @@ def render_adaptive(tracer: PixelTracer, plan: SamplingPlan, seed: int,
             if floor is not None:  # an edge of a texture gets the texture's minimum (guide_edges.textured_pixels)
                 edge = floor if texture is None else floor & ~texture
                 if round_index == 1:  # every pixel has had the first round: one count for the edges
-                    errors = np.zeros(h * w)
-                    errors[active] = error
-                    edge_target = plan.edge_samples(errors[edge], plan.rounds()[0])
+                    edge_target = plan.edge_samples(error[edge[active]], plan.rounds()[0])
                 floor_only = edge & (count < edge_target) & ~keep
                 keep |= floor_only
             keep &= ~finished

@@ -55,15 +55,11 @@ def split(lay: Any, sample1: Any, sample2: Any, has_sheen: bool) -> tuple[Choice
         ends.append(ends[-1] + share)
     pick_sheen = x >= ends[4] if has_sheen else None
     choice = Choice(sample1, x < ends[0], (x >= ends[1]) & (x < ends[2]), x >= ends[3], pick_sheen)
-    if not has_sheen:
-        ends[-1] = mi.Float(1.0)
+    bounds = ends if has_sheen else ends[:4]  # without sheen the diffuse interval runs to 1
     lo, hi = mi.Float(0.0), ends[0]
-    for low, high in zip(ends[:-1], ends[1:]):  # the last interval starting at or below x (empty ones skipped)
+    for low, high in zip(bounds, [*bounds[1:], mi.Float(1.0)]):  # the last interval starting at or below x
         inside = x >= low
         lo, hi = dr.select(inside, low, lo), dr.select(inside, high, hi)
-    if has_sheen:
-        inside = x >= ends[-1]
-        lo, hi = dr.select(inside, ends[-1], lo), dr.select(inside, 1.0, hi)
     rescaled = dr.clip((x - lo) / dr.maximum(hi - lo, 1e-20), 0.0, 1.0 - 2.0 ** -24)
     return choice, mi.Point2f(rescaled, sample2.y)
 
