@@ -42,9 +42,9 @@ import numpy as np
 TOOLS = Path(__file__).resolve().parent
 sys.path.insert(0, str(TOOLS))
 
-from blenderproc_reference import (CACHE, REPO, Invocation, ReferenceUnavailable, commit_of,  # noqa: E402
-                                   example_args, examples_tree, hybridgen_invocation, key_of, reference_invocation,
-                                   script_path)
+from blenderproc_reference import (CACHE, REPO, Invocation, ReferenceUnavailable, check_ready,  # noqa: E402
+                                   commit_of, example_args, examples_tree, hybridgen_invocation, key_of,
+                                   reference_invocation, script_path, source_tree)
 from bproc_outputs import hdf5_frames  # noqa: E402
 from harness import Table, alternating, load_average, paired_ratio, run_process  # noqa: E402
 from image_scores import db, mse  # noqa: E402
@@ -78,6 +78,17 @@ def timed(engine: str, script: str, work: Path, label: str, launch: list[str] | 
     # bpy 4.2 may segfault on its way out after BlenderProc has written everything (basics/material_manipulation)
     crash_after = BLENDERPROC_DONE if engine == "blenderproc" else None
     return run_process(run.command, env=run.env, cwd=run.cwd, crash_after=crash_after), output
+
+
+def compile_bytecode() -> None:
+    """Writes the bytecode of both engines' Python sources before the timed runs, as a regular ``pip install`` does.
+    hybridgen (installed editable) and BlenderProc (its source folder on PYTHONPATH) are plain source trees here, and
+    this machine sets PYTHONDONTWRITEBYTECODE, so without this every process compiles each module it imports
+    (hybridgen ~120 modules, ~0.1 s a run)."""
+    trees = [(Path(sys.executable), (HYBRIDGEN_TREE[0] or REPO) / "hybridgen"),
+             (check_ready(), source_tree() / "blenderproc")]
+    for python, tree in trees:
+        subprocess.run([str(python), "-m", "compileall", "-q", str(tree)], stdout=subprocess.DEVNULL, check=True)
 
 
 def first_colors(output: Path) -> np.ndarray:
@@ -217,6 +228,7 @@ def main() -> None:
     try:
         with tempfile.TemporaryDirectory(prefix="bench-bproc-") as temp:
             work = Path(temp)
+            compile_bytecode()
             print(f"{script}: {ns.rounds} rounds, load average {load_average():.1f} at start", flush=True)
             for round_index in range(ns.rounds):
                 for engine in alternating(ENGINES, round_index):

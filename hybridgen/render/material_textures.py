@@ -61,9 +61,12 @@ def color_height(texture: Any, owner: str, slot: str) -> np.ndarray:
     from .tonemap import srgb_decode
 
     array = _decoded(texture, owner, slot)
-    values = array.astype(np.float32) / 255.0 if array.dtype == np.uint8 else array.astype(np.float32)
-    rgb = values[..., :3] if values.shape[-1] >= 3 else np.repeat(values[..., :1], 3, axis=-1)
-    return np.ascontiguousarray((srgb_decode(rgb) @ REC709_LUMINANCE)[..., None], dtype=np.float32)
+    channels = array[..., :3] if array.shape[-1] >= 3 else np.repeat(array[..., :1], 3, axis=-1)
+    if array.dtype == np.uint8:  # each of the 256 codes decoded once (the same values, a table lookup)
+        linear = srgb_decode(np.arange(256, dtype=np.float32) / 255.0)[channels]
+    else:
+        linear = srgb_decode(channels.astype(np.float32))
+    return np.ascontiguousarray((linear @ REC709_LUMINANCE)[..., None], dtype=np.float32)
 
 
 def alpha_coverage(texture: Any, owner: str) -> np.ndarray:

@@ -30,6 +30,8 @@ def test_color_height_is_the_luminance_of_the_linear_color(tmp_path) -> None:
     gray = np.full((2, 3), 128, np.uint8)
     np.testing.assert_allclose(color_height(gray, "o", "displacement_texture"), 0.2158605, atol=1e-6)
     assert color_height(image, "o", "displacement_texture").dtype == np.float32
+    # a float image in 0..1 is decoded as the same codes are
+    np.testing.assert_allclose(color_height(image / 255.0, "o", "displacement_texture")[..., 0], expected, atol=1e-6)
 
 
 @pytest.mark.parametrize("from_color", [True, False])

@@ -3,6 +3,7 @@ same as with every placement uploaded on its own."""
 from __future__ import annotations
 
 import copy
+from pathlib import Path
 
 import numpy as np
 
@@ -83,3 +84,41 @@ def test_equal_materials_share_one_bsdf_and_read_textures_once(monkeypatch):
         scene.add(wall)
     scene_dict(scene)
     assert sorted(calls) == ["displacement_texture", "roughness_texture"]
+
+
+def test_materials_showing_one_image_file_share_its_texture(tmp_path, monkeypatch):
+    """Boxes whose materials differ (roughness) but show the same image file: Mitsuba reads the file once, another
+    file once more, and the colors are the bytes of a build that loads the file in every material's BSDF."""
+    import mitsuba as mi
+    from PIL import Image
+
+    from hybridgen.render.pathtrace import mitsuba_materials
+
+    mi.set_variant(choose_variant())
+    rng = np.random.default_rng(4)
+    for name in ("wood.png", "stone.png"):
+        Image.fromarray(rng.integers(0, 256, (16, 16, 3), dtype=np.uint8)).save(tmp_path / name)
+    scene = _scene()
+    boxes = [obj for obj in scene.objects if obj.name != "floor"]
+    for i, box in enumerate(boxes):
+        box.material = hg.Material(base_color_texture=str(tmp_path / ("stone.png" if i == 3 else "wood.png")),
+                                   roughness=0.2 + 0.2 * i, specular=0.5)
+    files: list[str] = []
+    real = mi.load_dict
+
+    def counting(description, *args, **kwargs):
+        if isinstance(description, dict) and description.get("type") == "bitmap" and "filename" in description:
+            files.append(Path(description["filename"]).name)
+        return real(description, *args, **kwargs)
+
+    monkeypatch.setattr(mi, "load_dict", counting)
+    monkeypatch.setattr(shared_geometry, "ENABLED", False)  # one BSDF per box, not per model
+    pose = scene.camera.keypoints[0]
+    settings = PathTraceSettings(samples=8, max_bounces=2)
+    shared = PathTraceView(scene, settings, variant=choose_variant()).render(pose, seed=3)
+    assert sorted(files) == ["stone.png", "wood.png"]
+    # each BSDF with its own textures (loaded inside its dictionary)
+    monkeypatch.setattr(mitsuba_materials, "shared_file_textures", lambda description, cache: description)
+    own = PathTraceView(scene, settings, variant=choose_variant()).render(pose, seed=3)
+    np.testing.assert_array_equal(shared, own)
+    assert len(np.unique(shared.reshape(-1, 3), axis=0)) > 100  # the textured boxes are in view
