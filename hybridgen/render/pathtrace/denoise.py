@@ -1,38 +1,29 @@
-"""Denoising with Intel Open Image Denoise (PyPI ``pyoidn``, a core dependency), guided by the raster
-view's exact albedo and normals: the guides are noise-free (``clean_aux``), which Mitsuba's own AOVs are
-not, and they cost a raster draw instead of doubling the render time."""
+"""Denoising with Intel Open Image Denoise (the library of PyPI ``pyoidn``, a core dependency, called through
+:mod:`.oidn_library`), guided by the raster view's exact albedo and normals: the guides are noise-free
+(``clean_aux``), which Mitsuba's own AOVs are not, and they cost a raster draw instead of doubling the render
+time."""
 from __future__ import annotations
-
-import sys
-from typing import Any
 
 import numpy as np
 
 from ...errors import SystemSetupError
+from .oidn_library import Denoiser, library_file, shared_denoiser
 
 INSTALL_HINT = ("denoising needs pyoidn (a hybridgen dependency): `pip install pyoidn`, or set `denoise: false` "
                 "on renderer.RgbRenderer")
 
 
-def require_oidn() -> Any:
-    """The ``pyoidn`` module, or a SystemSetupError that says how to install it.
-
-    pyoidn imports PyTorch at import time when it is installed (for its tensor inputs), which costs ~1.1 s of
-    CPU per process; hybridgen passes NumPy arrays only, so unless torch is already imported, pyoidn is
-    imported with torch hidden (pyoidn then takes NumPy arrays only, in this process)."""
-    if "pyoidn" in sys.modules:
-        return sys.modules["pyoidn"]
-    hide_torch = "torch" not in sys.modules
-    if hide_torch:
-        sys.modules["torch"] = None  # type: ignore[assignment]  # `import torch` raises ImportError
+def require_oidn() -> Denoiser:
+    """The process's Open Image Denoise filter (:func:`.oidn_library.shared_denoiser`), or a SystemSetupError that
+    says how to install it. pyoidn's Python package is not imported (nor the PyTorch it would import when
+    installed): only its library file is used."""
+    path = library_file()
+    if path is None:
+        raise SystemSetupError(INSTALL_HINT)
     try:
-        import pyoidn
-    except ImportError:
-        raise SystemSetupError(INSTALL_HINT) from None
-    finally:
-        if hide_torch:
-            del sys.modules["torch"]
-    return pyoidn
+        return shared_denoiser(path)
+    except OSError as exc:  # the file is there but does not load (a broken or foreign wheel)
+        raise SystemSetupError(f"{INSTALL_HINT} ({path.name} does not load: {exc})") from None
 
 
 BORDER_PAD = 8
@@ -48,18 +39,14 @@ input there: 0.44 %), about a quarter of the whole image's squared error. With t
 def denoise(linear: np.ndarray, albedo: np.ndarray, normals: np.ndarray) -> np.ndarray:
     """Denoised linear HDR RGB (float32, H x W x 3) from noisy ``linear`` and clean guides (each mirrored
     outwards by :data:`BORDER_PAD` px for the denoiser)."""
-    oidn = require_oidn()
-
-    if BORDER_PAD == 0:
-        return np.asarray(oidn.denoise(*(np.ascontiguousarray(x, np.float32) for x in (linear, albedo, normals)),
-                                       hdr=True, clean_aux=True), dtype=np.float32)
+    denoiser = require_oidn()
 
     def padded(image: np.ndarray) -> np.ndarray:
         pad = ((BORDER_PAD, BORDER_PAD), (BORDER_PAD, BORDER_PAD), (0, 0))
         return np.ascontiguousarray(np.pad(np.asarray(image, np.float32), pad, mode="symmetric"))
 
-    out = oidn.denoise(padded(linear), padded(albedo), padded(normals), hdr=True, clean_aux=True)
-    return np.asarray(out, dtype=np.float32)[BORDER_PAD:-BORDER_PAD, BORDER_PAD:-BORDER_PAD].copy()
+    out = denoiser.run(padded(linear), padded(albedo), padded(normals), hdr=True, clean_aux=True)
+    return out[BORDER_PAD:-BORDER_PAD, BORDER_PAD:-BORDER_PAD].copy() if BORDER_PAD else out
 
 
 WARM_UP_SIZE = 8
