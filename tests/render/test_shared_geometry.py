@@ -122,3 +122,24 @@ def test_materials_showing_one_image_file_share_its_texture(tmp_path, monkeypatc
     own = PathTraceView(scene, settings, variant=choose_variant()).render(pose, seed=3)
     np.testing.assert_array_equal(shared, own)
     assert len(np.unique(shared.reshape(-1, 3), axis=0)) > 100  # the textured boxes are in view
+
+
+def test_materials_with_equal_bsdfs_share_one(tmp_path):
+    """Materials that differ only where the BSDF does not look (the base color value under a base-color image, the
+    name) get one Mitsuba BSDF; another roughness gets its own."""
+    import mitsuba as mi
+    from PIL import Image
+
+    mi.set_variant(choose_variant())
+    Image.fromarray(np.full((4, 4, 3), 90, np.uint8)).save(tmp_path / "wood.png")
+    scene = hg.Scene()
+    for i, (color, roughness) in enumerate([((1, 0, 0), 0.4), ((0, 1, 0), 0.4), ((0, 0, 1), 0.7)]):
+        box = hg.make_primitive("cube", 0.5, name=f"box{i}", category_id=1)
+        box.material = hg.Material(name=f"material{i}", base_color=color, roughness=roughness,
+                                   base_color_texture=str(tmp_path / "wood.png"))
+        box.local2world = hg.object_pose([2.0 * i, 0, 0])
+        scene.add(box)
+    bsdfs = [value.bsdf() for value in scene_dict(scene).values() if isinstance(value, mi.Mesh)]  # scene order
+    assert len(bsdfs) == 3
+    assert bsdfs[0] is bsdfs[1]
+    assert bsdfs[2] is not bsdfs[0]

@@ -264,8 +264,10 @@ def bsdf_is_plugin(bsdf: dict[str, Any]) -> bool:
 
 def loaded_bsdf(material: Material, owner: str, *, vertex_colors: bool = False, uvs: bool = True,
                 cache: dict[Any, Any] | None = None) -> Any:
-    """The Mitsuba BSDF object of ``material``; with ``cache`` (one per scene build), equal materials get the
-    same object, so their textures are read and held once however many shapes use them."""
+    """The Mitsuba BSDF object of ``material``; with ``cache`` (one per scene build), materials with equal fields,
+    or whose BSDF descriptions are equal (materials that differ only where the BSDF does not look, e.g. a base color
+    value under a base-color image, or a name), get the same object: their textures are read and held once however
+    many shapes use them, and the path kernel calls one BSDF where it called several."""
     import mitsuba as mi
 
     from ..shared_geometry import material_key
@@ -275,8 +277,24 @@ def loaded_bsdf(material: Material, owner: str, *, vertex_colors: bool = False, 
     key = (material_key(material), vertex_colors and material.base_color_from_vertices, bool(material.dust) and uvs)
     if key not in cache:
         description = shared_file_textures(bsdf_dict(material, owner, vertex_colors=vertex_colors, uvs=uvs), cache)
-        cache[key] = mi.load_dict(description)
+        same = ("bsdf", _hashable(description))
+        if same not in cache:  # the description is kept with it: the ids in ``same`` stay unique meanwhile
+            cache[same] = (mi.load_dict(description), description)
+        cache[key] = cache[same][0]
     return cache[key]
+
+
+def _hashable(value: Any) -> Any:
+    """``value`` (a BSDF description) as a hashable value equal for equal descriptions: dictionaries by their sorted
+    items, sequences by their items, plain values as they are, anything else (loaded textures, bitmaps) by
+    identity."""
+    if isinstance(value, dict):
+        return ("dict", tuple(sorted((name, _hashable(item)) for name, item in value.items())))
+    if isinstance(value, (list, tuple)):
+        return ("sequence", tuple(_hashable(item) for item in value))
+    if value is None or isinstance(value, (str, bool, int, float)):
+        return value
+    return ("object", id(value))
 
 
 def shared_file_textures(description: dict[str, Any], cache: dict[Any, Any]) -> dict[str, Any]:
