@@ -82,3 +82,21 @@ def test_a_library_that_does_not_load_is_one_line(tmp_path, monkeypatch) -> None
     monkeypatch.setattr("hybridgen.render.pathtrace.oidn_library._SHARED", [])
     with pytest.raises(SystemSetupError, match="does not load"):
         denoise_module.require_oidn()
+
+
+def test_the_library_is_found_by_its_versioned_name_and_missing_is_said(tmp_path, monkeypatch) -> None:
+    from hybridgen.render.pathtrace import oidn_library
+
+    package = tmp_path / "pyoidn"
+    (package / "oidn" / "lib").mkdir(parents=True)
+    (package / "oidn" / "lib" / "libOpenImageDenoise_core.so.2.5.1").write_bytes(b"")
+    monkeypatch.setattr(oidn_library, "pyoidn_folder", lambda: package)
+    monkeypatch.setattr(denoise_module, "pyoidn_folder", lambda: package)
+    monkeypatch.setattr(sys, "platform", "linux")
+    assert oidn_library.library_file() is None  # the core library is not the API's
+    with pytest.raises(SystemSetupError, match="has no Open Image Denoise library"):
+        denoise_module.require_oidn()
+    (package / "oidn" / "lib" / "libOpenImageDenoise.so.2").write_bytes(b"")
+    assert oidn_library.library_file() == package / "oidn" / "lib" / "libOpenImageDenoise.so.2"
+    (package / "oidn" / "lib" / "libOpenImageDenoise.so").write_bytes(b"")
+    assert oidn_library.library_file() == package / "oidn" / "lib" / "libOpenImageDenoise.so"

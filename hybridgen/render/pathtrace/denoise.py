@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import SystemSetupError
-from .oidn_library import Denoiser, library_file, shared_denoiser
+from .oidn_library import Denoiser, library_file, pyoidn_folder, shared_denoiser
 
 INSTALL_HINT = ("denoising needs pyoidn (a hybridgen dependency): `pip install pyoidn`, or set `denoise: false` "
                 "on renderer.RgbRenderer")
@@ -19,7 +19,10 @@ def require_oidn() -> Denoiser:
     installed): only its library file is used."""
     path = library_file()
     if path is None:
-        raise SystemSetupError(INSTALL_HINT)
+        package = pyoidn_folder()
+        raise SystemSetupError(INSTALL_HINT if package is None else
+                               f"{INSTALL_HINT} (pyoidn at {package} has no Open Image Denoise library under oidn/: "
+                               f"reinstall it)")
     try:
         return shared_denoiser(path)
     except OSError as exc:  # the file is there but does not load (a broken or foreign wheel)

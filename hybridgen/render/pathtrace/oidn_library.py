@@ -29,15 +29,32 @@ IMAGES = ("color", "albedo", "normal", "output")
 """The ``RT`` filter's images, in the order :meth:`Denoiser.run` takes them."""
 
 
-def library_file() -> Path | None:
-    """The OIDN library inside the installed ``pyoidn`` package (found without importing it), or None."""
+LIBRARY_NAMES = {"win32": ("bin", "OpenImageDenoise.dll"), "darwin": ("lib", "libOpenImageDenoise.dylib")}
+"""Where the pyoidn wheel keeps the library on each platform (its ``oidn`` folder); elsewhere ``lib`` and
+``libOpenImageDenoise.so``. A versioned name (``libOpenImageDenoise.2.dylib``, ``.so.2``) is taken if the plain one
+is missing."""
+
+
+def pyoidn_folder() -> Path | None:
+    """The installed ``pyoidn`` package's folder (found without importing it), or None."""
     spec = importlib.util.find_spec("pyoidn")
     if spec is None or not spec.submodule_search_locations:
         return None
-    root = Path(next(iter(spec.submodule_search_locations))) / "oidn"
-    name = {"win32": "bin/OpenImageDenoise.dll", "darwin": "lib/libOpenImageDenoise.dylib"}.get(
-        sys.platform, "lib/libOpenImageDenoise.so")
-    return root / name if (root / name).is_file() else None
+    return Path(next(iter(spec.submodule_search_locations)))
+
+
+def library_file() -> Path | None:
+    """The OIDN library inside the installed ``pyoidn`` package, or None (no pyoidn, or no library in it)."""
+    package = pyoidn_folder()
+    if package is None:
+        return None
+    folder, name = LIBRARY_NAMES.get(sys.platform, ("lib", "libOpenImageDenoise.so"))
+    plain = package / "oidn" / folder / name
+    if plain.is_file():
+        return plain
+    stem, suffix = name.rsplit(".", 1)
+    versioned = sorted((package / "oidn" / folder).glob(f"{stem}.*{suffix}*"))
+    return versioned[0] if versioned else None
 
 
 def _declared(path: Path) -> ctypes.CDLL:
