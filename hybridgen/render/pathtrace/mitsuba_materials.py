@@ -286,14 +286,14 @@ def loaded_bsdf(material: Material, owner: str, *, vertex_colors: bool = False, 
 
 def _hashable(value: Any) -> Any:
     """``value`` (a BSDF description) as a hashable value equal for equal descriptions: dictionaries by their sorted
-    items, sequences by their items, plain values as they are, anything else (loaded textures, bitmaps) by
+    items, sequences by their items, plain values with their type, anything else (loaded textures, bitmaps) by
     identity."""
     if isinstance(value, dict):
         return ("dict", tuple(sorted((name, _hashable(item)) for name, item in value.items())))
     if isinstance(value, (list, tuple)):
         return ("sequence", tuple(_hashable(item) for item in value))
     if value is None or isinstance(value, (str, bool, int, float)):
-        return value
+        return type(value).__name__, value  # typed: True and 1, 1 and 1.0 are different properties
     return ("object", id(value))
 
 
@@ -309,7 +309,7 @@ def shared_file_textures(description: dict[str, Any], cache: dict[Any, Any]) -> 
             return value
         if value.get("type") == "bitmap" and "filename" in value and \
                 all(isinstance(v, (str, bool, int, float)) for v in value.values()):
-            key = ("file texture", *sorted(value.items()))
+            key = ("file texture", _hashable(value))
             if key not in cache:
                 cache[key] = mi.load_dict(value)
             return cache[key]
