@@ -92,7 +92,7 @@ def test_materials_showing_one_image_file_share_its_texture(tmp_path, monkeypatc
     import mitsuba as mi
     from PIL import Image
 
-    from hybridgen.render.pathtrace import mitsuba_materials
+    from hybridgen.render.pathtrace import shared_bsdfs
 
     mi.set_variant(choose_variant())
     rng = np.random.default_rng(4)
@@ -118,7 +118,7 @@ def test_materials_showing_one_image_file_share_its_texture(tmp_path, monkeypatc
     shared = PathTraceView(scene, settings, variant=choose_variant()).render(pose, seed=3)
     assert sorted(files) == ["stone.png", "wood.png"]
     # each BSDF with its own textures (loaded inside its dictionary)
-    monkeypatch.setattr(mitsuba_materials, "shared_file_textures", lambda description, cache: description)
+    monkeypatch.setattr(shared_bsdfs, "shared_file_textures", lambda description, cache: description)
     own = PathTraceView(scene, settings, variant=choose_variant()).render(pose, seed=3)
     np.testing.assert_array_equal(shared, own)
     assert len(np.unique(shared.reshape(-1, 3), axis=0)) > 100  # the textured boxes are in view

@@ -33,9 +33,10 @@ from ...scene.vertex_normals import angle_weighted_normals
 from . import light_selection
 from .material_emission import emitted_radiance, radiance_texture
 from .mitsuba_instances import instanced_entries
-from .mitsuba_materials import VERTEX_COLOR_ATTRIBUTE, loaded_bsdf
+from .mitsuba_materials import VERTEX_COLOR_ATTRIBUTE
 from .mitsuba_materials import rgb as _rgb
 from .principled_tangent import ATTRIBUTE as RADIAL_TANGENT, needs_radial_tangent, radial_tangents
+from .shared_bsdfs import loaded_bsdf
 
 ENVMAP_TO_WORLD = np.array([[0.0, 0, 1, 0], [1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 0, 1]])
 """Lays Mitsuba's lat-long map (local +Y up, u = atan2(x, -z) / 2 pi mod 1) out as Blender's equirectangular
