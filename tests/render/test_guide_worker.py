@@ -143,17 +143,17 @@ def test_a_job_that_outlives_the_timeout_is_an_error_and_close_does_not_wait_for
     from hybridgen.render.raster.gl_worker import GLWorker
 
     release = threading.Event()
-    worker: GLWorker = GLWorker(lambda ctx: "built", lambda owned: None, "test-gl-worker", timeout=0.5)
+    worker: GLWorker = GLWorker(lambda ctx: "built", lambda owned: None, "test-gl-worker", timeout=2.0)
     assert worker.wait(worker.ready, "the build") == "built"
     stuck = worker.submit(lambda owned: release.wait(30))
     queued = worker.submit(lambda owned: "never reached while stuck")  # e.g. a prefetched keypoint's guides
-    with pytest.raises(hg.SystemSetupError, match="no answer for the stuck job within 0.5 s"):
+    with pytest.raises(hg.SystemSetupError, match="no answer for the stuck job within 2 s"):
         worker.wait(stuck, "the stuck job")
     start = time.perf_counter()
     with pytest.raises(hg.SystemSetupError, match="no answer for the next job"):
         worker.wait(queued, "the next job")  # at once: a hung worker answers no later job
     worker.close()
-    assert time.perf_counter() - start < 0.2
+    assert time.perf_counter() - start < 1.0  # no second timeout (2 s), with room for a loaded machine
     release.set()
     worker.thread.join(timeout=5)
     assert not worker.thread.is_alive()  # the job ended, and the thread with it (the close was queued)

@@ -101,14 +101,24 @@ class Denoiser:
             raise RuntimeError(f"Open Image Denoise: {operation} failed (error {code}): {text}")
 
     def _made(self) -> int:
+        """The filter, made with its device on the first call (a failure releases what was made)."""
         if self._filter is None:
             self._device = self._lib.oidnNewDevice(DEVICE_TYPE_CPU)
             if not self._device:
+                self._device = None
                 raise RuntimeError("Open Image Denoise: no CPU device could be made")
-            self._lib.oidnCommitDevice(self._device)
-            self._check("committing the device")
-            self._filter = self._lib.oidnNewFilter(self._device, b"RT")
-            self._check("making the RT filter")
+            try:
+                self._lib.oidnCommitDevice(self._device)
+                self._check("committing the device")
+                made = self._lib.oidnNewFilter(self._device, b"RT")
+                self._check("making the RT filter")
+                if not made:
+                    raise RuntimeError("Open Image Denoise: no RT filter could be made")
+            except BaseException:
+                self._lib.oidnReleaseDevice(self._device)
+                self._device = None
+                raise
+            self._filter = made
         return self._filter
 
     def run(self, color: np.ndarray, albedo: np.ndarray, normal: np.ndarray, *, hdr: bool, clean_aux: bool,
