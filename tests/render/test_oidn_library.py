@@ -100,3 +100,31 @@ def test_the_library_is_found_by_its_versioned_name_and_missing_is_said(tmp_path
     assert oidn_library.library_file() == package / "oidn" / "lib" / "libOpenImageDenoise.so.2"
     (package / "oidn" / "lib" / "libOpenImageDenoise.so").write_bytes(b"")
     assert oidn_library.library_file() == package / "oidn" / "lib" / "libOpenImageDenoise.so"
+
+
+def test_a_filter_that_cannot_be_made_releases_its_device() -> None:
+    path = library_file()
+    assert path is not None
+    ours = Denoiser(path)
+    real = ours._lib
+    released: list[object] = []
+
+    class NoFilter:  # the library, except that it makes no RT filter
+        def __getattr__(self, name: str):
+            return getattr(real, name)
+
+        def oidnNewFilter(self, device, kind):
+            return None
+
+        def oidnReleaseDevice(self, device):
+            released.append(device)
+            return real.oidnReleaseDevice(device)
+
+    ours._lib = NoFilter()
+    color, albedo, normals = _inputs(4)
+    with pytest.raises(RuntimeError, match="no RT filter"):
+        ours.run(color, albedo, normals, hdr=True, clean_aux=True)
+    assert len(released) == 1 and ours._device is None and ours._filter is None
+    ours._lib = real  # the next call starts over and denoises
+    assert ours.run(color, albedo, normals, hdr=True, clean_aux=True).shape == color.shape
+    ours.close()
