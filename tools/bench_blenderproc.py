@@ -7,7 +7,8 @@ its OWN converged reference.
 Timed runs are the plain user commands, from the extracted examples (tools/blenderproc_reference.py; make its venv
 with ``tools/blenderproc_reference.py setup``): ``hybridgen run examples/.../main.py ARGS`` and BlenderProc's
 ``python examples/.../main.py ARGS`` (USE_EXTERNAL_BPY_MODULE), with the README's arguments, each into a fresh
-output folder, ``BLENDER_PROC_RANDOM_SEED=1``, in ABBA order (tools/harness.py). Wall seconds are spawn to exit;
+output folder, ``BLENDER_PROC_RANDOM_SEED=1``, in ABBA order (tools/harness.py), after both engines' Python sources
+are compiled to bytecode (as a pip install does; see :func:`compile_bytecode`). Wall seconds are spawn to exit;
 CPU seconds are the process's user + system.
 
 Quality: frame 0's ``colors`` (uint8 sRGB, what users get: hybridgen's Standard view, BlenderProc's Filmic) of the
