@@ -115,7 +115,7 @@ class ColorProducer:
         plan = self.settings.plan()
         guides: KeypointGuides | None = None
         if self._worker is not None:  # guides drawn on their own thread: since prefetch(), or from now
-            key = (index, eye, np.asarray(cam2world).tobytes(), self.view.filter_width)
+            key = _ahead_key(index, cam2world, eye, self.view.filter_width)
             guides = self._ahead.pop(key, None) or self._worker_guides(cam2world, self.view.filter_width)
             self._ahead = {k: v for k, v in self._ahead.items() if k[0] > index}  # a later keypoint's, if any
         elif self._guides is not None and plan.edge_floor:  # the shared raster: drawn here, filtered meanwhile
@@ -151,7 +151,7 @@ class ColorProducer:
         self._prefetch(index, cam2world, eye, self.view.filter_width)
 
     def _prefetch(self, index: int, cam2world: np.ndarray, eye: int, filter_width: float) -> None:
-        key = (index, eye, np.asarray(cam2world).tobytes(), float(filter_width))
+        key = _ahead_key(index, cam2world, eye, filter_width)
         if self._worker is not None and key not in self._ahead:
             self._ahead[key] = self._worker_guides(cam2world, filter_width)
 
@@ -211,6 +211,11 @@ class ColorProducer:
         if self._worker is not None:
             worker, self._worker = self._worker, None
             worker.release()
+
+
+def _ahead_key(index: int, cam2world: np.ndarray, eye: int, filter_width: float) -> tuple[int, int, bytes, float]:
+    """What identifies a keypoint's prefetched guides: the keypoint, the eye, the pose and the pixel filter."""
+    return index, eye, np.asarray(cam2world).tobytes(), float(filter_width)
 
 
 def render_color(scene: Scene, sinks: Iterable[FrameSink], settings: PathTraceSettings | None = None, *,
