@@ -7,7 +7,8 @@
 // scenes that have dust: compiled in, llvmpipe ran its code in every fragment even with u_dust_count 0 - 0.14 of
 // 0.21 s CPU per 1536 x 1536 draw of BlenderProc's basics/basic scene). The diffuse-color variant
 // (PRINCIPLED_DIFFUSE defined, render/raster/principled_diffuse.py) shows Cycles' Diffuse Color pass instead of
-// the base color: what the Principled BSDF's layers leave of it from the view direction.
+// the base color: what the Principled BSDF's layers leave of it from the view direction. Infused images
+// (color_layers.glsl, with COLOR_LAYERS defined in scenes that have them) blend over the base color first.
 uniform vec4 u_base_color;
 uniform bool u_textured;
 uniform bool u_vertex_colored;
@@ -27,6 +28,10 @@ in vec3 v_normal;
 #ifdef DUST_FILMS
 // dust.glsl
 #endif
+#ifdef COLOR_LAYERS
+// color_layers.glsl
+uniform bool u_layer_uv;  // the mesh has UVs (else the layers read (0, 0), as Cycles a missing UV map)
+#endif
 #ifdef PRINCIPLED_DIFFUSE
 // principled_diffuse.glsl
 #endif
@@ -39,6 +44,9 @@ void main() {
         if (alpha < 0.5) discard;
     }
     vec3 albedo = u_textured ? texture(u_texture, v_uv).rgb : (u_vertex_colored ? v_color : u_base_color.rgb);
+#ifdef COLOR_LAYERS
+    albedo = infused_color(albedo, u_layer_uv ? v_uv : vec2(0.0));
+#endif
 #ifdef PRINCIPLED_DIFFUSE
     albedo = principled_diffuse(albedo, v_uv, abs(dot(normalize(v_normal), normalize(u_camera - v_world))));
 #endif

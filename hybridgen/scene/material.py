@@ -6,6 +6,7 @@ from typing import Any
 
 import numpy as np
 
+from .color_layer import ColorLayer
 from .dust import Dust
 
 TEXTURE_SLOTS = ("base_color_texture", "roughness_texture", "metallic_texture", "alpha_texture",
@@ -65,6 +66,8 @@ class Material:
       ``base_color`` or ``base_color_texture`` through a config clears them.
     - ``dust``: dust films over the material, innermost first (:mod:`hybridgen.scene.dust`; BlenderProc's
       ``add_dust``); empty for none.
+    - ``base_color_layers``: images blended over the base color, innermost first (:mod:`hybridgen.scene.color_layer`;
+      BlenderProc's ``infuse_texture``); the base color under them is the texture, vertex colors or value above.
     """
 
     name: str = "default"
@@ -95,6 +98,7 @@ class Material:
     missing_files: tuple[str, ...] = ()  # base-color files the mesh names that do not exist (texture_needs)
     extra: dict[str, Any] = field(default_factory=dict)
     dust: tuple[Dust, ...] = ()
+    base_color_layers: tuple[ColorLayer, ...] = ()
 
     @property
     def cuts_out(self) -> bool:
@@ -104,7 +108,7 @@ class Material:
     @property
     def uses_uvs(self) -> bool:
         """True if any texture is set (they are all sampled with the mesh UVs)."""
-        return any(getattr(self, name) is not None for name in TEXTURE_SLOTS)
+        return any(getattr(self, name) is not None for name in TEXTURE_SLOTS) or bool(self.base_color_layers)
 
     @staticmethod
     def from_trimesh_visual(visual: Any, fallback_name: str) -> "Material":

@@ -194,7 +194,7 @@ def bsdf_dict(material: Material, owner: str, *, vertex_colors: bool = False, uv
     """Mitsuba BSDF of ``material`` (see the module docstring for the nesting); with ``vertex_colors`` (the
     mesh carries :data:`VERTEX_COLOR_ATTRIBUTE`) and the material's ``base_color_from_vertices``, the base
     color is that attribute (a base-color texture still wins, as a linked image in Blender). ``uvs``: the mesh
-    has texture coordinates (dust patterns read them, :mod:`.dust_mix`)."""
+    has texture coordinates (dust patterns and infused images read them, :mod:`.dust_mix`, :mod:`.color_layers`)."""
     from . import principled_material
 
     blender = principled_material.enabled()  # hybridgen's Principled BSDF (JIT variants)
@@ -205,6 +205,10 @@ def bsdf_dict(material: Material, owner: str, *, vertex_colors: bool = False, uv
         base = {"type": "mesh_attribute", "name": VERTEX_COLOR_ATTRIBUTE}
     else:
         base = rgb(material.base_color)
+    if material.base_color_layers:  # infused images over it (render/pathtrace/color_layers.py)
+        from .color_layers import layered
+
+        base = layered(base, material, owner, uvs=uvs)
     bsdf: dict[str, Any]
     levels, weights = specular_levels(material, owner)
     plain = levels[-1] == 0 and material.metallic == 0 and material.metallic_texture is None

@@ -26,7 +26,7 @@ def loaded_bsdf(material: Material, owner: str, *, vertex_colors: bool = False, 
 
     if cache is None:
         return mi.load_dict(bsdf_dict(material, owner, vertex_colors=vertex_colors, uvs=uvs))
-    key = (material_key(material), vertex_colors and material.base_color_from_vertices, bool(material.dust) and uvs)
+    key = (material_key(material), vertex_colors and material.base_color_from_vertices, bool(material.dust or material.base_color_layers) and uvs)
     if key not in cache:
         description = shared_file_textures(bsdf_dict(material, owner, vertex_colors=vertex_colors, uvs=uvs), cache)
         same = ("bsdf", _hashable(description))

@@ -3,7 +3,8 @@
 The guide image for denoising, and a label of its own: the material's base color, or its base-color
 texture (decoded from sRGB, bilinear, repeating, as Mitsuba samples it) or the interpolated per-vertex
 colors at the surface point seen through the pixel centre; surfaces of alpha-clipped materials are cut out
-where their alpha is below 0.5; dust films mix in their colors by their weights (:mod:`.albedo_dust`).
+where their alpha is below 0.5; infused images blend over the base color (:mod:`.albedo_layers`); dust films mix
+in their colors by their weights (:mod:`.albedo_dust`).
 Background pixels get ``background`` (by default the world color). The ``diffuse_color`` variant draws Cycles'
 Diffuse Color pass instead of the base color (:mod:`.principled_diffuse`); the plain pass is unchanged by it.
 Textures and UVs are uploaded on first use only.
@@ -22,6 +23,7 @@ from .projection import projection_from_K
 from .raster_view import RasterView
 from .shader_source import shader_source
 from .albedo_dust import ObjectDust, active_layers, no_dust, world_uniforms
+from .albedo_layers import ObjectLayers, no_layers
 from . import principled_diffuse
 from .label_framebuffers import release_framebuffer
 
@@ -63,6 +65,9 @@ class AlbedoPass:
         fragment = shader_source("albedo.frag").replace("// dust.glsl", shader_source("dust.glsl"))
         if any(active_layers(obj) for obj in view.scene.objects):  # the dust code only where it can show
             fragment = fragment.replace("\n", "\n#define DUST_FILMS\n", 1)
+        if any(obj.material.base_color_layers for obj in view.scene.objects):  # infused images (albedo_layers.py)
+            fragment = fragment.replace("\n", "\n#define COLOR_LAYERS\n", 1)
+            fragment = fragment.replace("// color_layers.glsl", shader_source("color_layers.glsl"))
         self._tables = None  # the Principled tables' storage buffer (diffuse color only)
         if diffuse_color:
             fragment = fragment.replace("\n", "\n#define PRINCIPLED_DIFFUSE\n" + principled_diffuse.table_defines(), 1)
@@ -72,6 +77,7 @@ class AlbedoPass:
         self._draws: list[tuple[Any, Any, Any, MeshObject]] = []
         self._dust: dict[int, ObjectDust] = {}  # draw index -> its dust layers (render/raster/albedo_dust.py)
         self._principled: dict[int, principled_diffuse.ObjectPrincipled] = {}  # draw index -> its inputs
+        self._layers: dict[int, ObjectLayers] = {}  # draw index -> its infused images
         self._resources: list[Any] = [] if self._tables is None else [self._tables]
         for gpu, obj in zip(view.gpu_objects, view.scene.objects):
             image = _texture_image(obj)
@@ -86,9 +92,10 @@ class AlbedoPass:
 
             alpha_image = _alpha_image(obj)
             layers = active_layers(obj)
+            infused = obj.material.base_color_layers
             inputs = principled_diffuse.ObjectPrincipled(ctx, obj, self._resources) if diffuse_color else None
-            if (image is not None or alpha_image is not None or layers or (inputs and inputs.needs_uv)) and \
-                    obj.uvs is not None:
+            if (image is not None or alpha_image is not None or layers or infused or (inputs and inputs.needs_uv)) \
+                    and obj.uvs is not None:
                 per_vertex(np.asarray(obj.uvs), "2f", "in_uv")
             if layers or inputs:
                 content.extend(entry for entry in gpu.content if entry[2] == "in_normal")
@@ -96,6 +103,8 @@ class AlbedoPass:
                 self._dust[len(self._draws)] = ObjectDust(ctx, obj, layers, self._resources)
             if inputs:
                 self._principled[len(self._draws)] = inputs
+            if infused:
+                self._layers[len(self._draws)] = ObjectLayers(ctx, obj, self._resources)
             if image is not None:
                 texture = ctx.texture((image.shape[1], image.shape[0]), 4, image.tobytes(),
                                       internal_format=GL_SRGB8_ALPHA8)
@@ -141,6 +150,10 @@ class AlbedoPass:
                 self._dust[index].apply(self.program, obj, cam2world)
             elif self._dust:
                 no_dust(self.program)
+            if index in self._layers:
+                self._layers[index].apply(self.program)
+            elif self._layers:
+                no_layers(self.program)
             if index in self._principled:
                 world_uniforms(self.program, obj, cam2world)
                 self._principled[index].apply(self.program)
