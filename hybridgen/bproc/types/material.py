@@ -130,6 +130,8 @@ class Material(Struct):
             return
         field, texture = _input(input_name)
         mat = self.blender_obj
+        if field == "base_color":  # an image or a value replaces whatever was linked (BlenderProc unlinks it)
+            mat.base_color_layers, mat.base_color_from_vertices = (), False
         if _is_image(value):
             if texture is None:
                 raise InputError(f"an image on Principled BSDF input '{input_name}' is not supported by hybridgen yet")
@@ -176,6 +178,9 @@ class Material(Struct):
         if non_emissive_color_socket is not None:
             raise InputError("make_emissive(non_emissive_color_socket=...) is not supported by hybridgen yet")
         mat = self.blender_obj
+        if emission_color is None and mat.base_color_layers:
+            raise InputError("make_emissive of a base color with an infused texture (infuse_texture) is not supported "
+                             "by hybridgen yet; pass emission_color")
         if emission_color is None:
             mat.emission, mat.emission_texture = tuple(mat.base_color[:3]), mat.base_color_texture  # type: ignore[assignment]
         else:
@@ -198,6 +203,9 @@ class Material(Struct):
         Math node takes from a linked color: the luminance of the image's linear color (``displacement_from_color``);
         the image linked now, as in BlenderProc, whatever is linked to ``input_name`` later."""
         _, texture = _input(input_name)
+        if texture == "base_color_texture" and self.blender_obj.base_color_layers:
+            raise InputError(f"set_displacement_from_principled_shader_value('{input_name}') of a base color with an "
+                             "infused texture (infuse_texture) is not supported by hybridgen yet")
         linked = getattr(self.blender_obj, texture) if texture is not None else None
         if linked is None:
             raise InputError(f"material '{self.get_name()}': the input {input_name} of the principled shader does "
@@ -206,9 +214,21 @@ class Material(Struct):
         self.blender_obj.displacement_scale = float(multiply_factor)
         self.blender_obj.displacement_from_color = True
 
+    def infuse_texture(self, texture: Any, mode: str = "overlay", connection: str = "Base Color",
+                       texture_scale: float = 0.05, strength: float = 0.5, invert_texture: bool = False) -> None:
+        """Blend ``texture`` (``bproc.loader.load_texture``'s) into the input ``connection``: ``set`` links it,
+        ``overlay`` / ``mix`` blend it over what is linked there (nothing without a link), at factor ``strength``,
+        read at UV / ``texture_scale``; BlenderProc's semantics, quirks included (:mod:`hybridgen.bproc.material_infuse`)."""
+        from ..material_infuse import infuse_texture
+
+        infuse_texture(self.blender_obj, texture, mode, connection, texture_scale, strength, invert_texture,
+                       inputs=INPUTS, normal_inputs=NORMAL_INPUTS)
+
     def map_vertex_color(self, layer_name: str = "Col", active_shading: bool = True) -> None:
-        """The mesh's vertex colors become the base color (Blender's color attribute linked to Base Color)."""
-        self.blender_obj.base_color_from_vertices = True
+        """The mesh's vertex colors become the base color (Blender's color attribute linked to Base Color, in place
+        of what was linked there: an image, infused images)."""
+        mat = self.blender_obj
+        mat.base_color_from_vertices, mat.base_color_texture, mat.base_color_layers = True, None, ()
 
     def _attribute(self, attr_name: str) -> Any:
         return self.get_users() if attr_name == "users" else self.get_name()
@@ -224,5 +244,4 @@ class Material(Struct):
     unlink: Callable[..., Any] = unsupported_method("Material", "unlink")
     get_node_connected_to_the_output_and_unlink_it: Callable[..., Any] = unsupported_method(
         "Material", "get_node_connected_to_the_output_and_unlink_it")
-    infuse_texture: Callable[..., Any] = unsupported_method("Material", "infuse_texture")
     infuse_material: Callable[..., Any] = unsupported_method("Material", "infuse_material")

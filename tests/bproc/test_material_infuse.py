@@ -1,0 +1,95 @@
+"""Material.infuse_texture as BlenderProc 2.8 runs it: ``mix`` blends by OVERLAY and ``overlay`` by MIX (its substring
+test), both only over something linked to the input; ``set`` links the image alone, inverted on request; a value or an
+image set on Base Color afterwards unlinks the infused image; modes and inputs it does not know raise its message.
+Rendered end to end: the ``diffuse`` output of a matte square (Specular IOR Level 0: Cycles' Diffuse Color pass is the
+base color) equals Cycles' MixRGB of the two uniform images, as 8-bit sRGB."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from hybridgen.errors import InputError
+from writer_session import bproc  # noqa: F401 - the fixture
+
+A, B = (200, 60, 30), (40, 150, 230)
+
+
+def _srgb8(linear: np.ndarray) -> np.ndarray:
+    srgb = np.where(linear <= 0.0031308, 12.92 * linear, 1.055 * linear ** (1 / 2.4) - 0.055)
+    return np.clip(np.rint(srgb * 255), 0, 255).astype(np.uint8)
+
+
+def _linear(srgb8: tuple[int, int, int]) -> np.ndarray:
+    value = np.asarray(srgb8) / 255.0
+    return np.where(value <= 0.04045, value / 12.92, ((value + 0.055) / 1.055) ** 2.4)
+
+
+def _overlay(base: np.ndarray, layer: np.ndarray, f: float) -> np.ndarray:
+    return np.where(base < 0.5, base * (1 - f + 2 * f * layer), 1 - (1 - f + 2 * f * (1 - layer)) * (1 - base))
+
+
+def _images(bproc, tmp_path):  # noqa: F811
+    for name, color in (("a.png", A), ("b.png", B)):
+        Image.new("RGB", (8, 8), color).save(tmp_path / name)
+    a = bproc.loader.load_texture(str(tmp_path / "a.png"))[0]
+    b = bproc.loader.load_texture(str(tmp_path / "b.png"))[0]
+    return a, b
+
+
+def _matte_square(bproc, name: str, x: float):  # noqa: F811
+    square = bproc.object.create_primitive("PLANE", location=[x, 0, 0])
+    material = square.new_material(name)
+    material.set_principled_shader_value("Specular IOR Level", 0.0)
+    return material
+
+
+@pytest.mark.parametrize("mode", ["mix", "overlay", "set", "set_inverted", "unlinked_mix"])
+def test_diffuse_output_shows_the_blend(gl_context, bproc, tmp_path, mode: str) -> None:  # noqa: F811
+    a, b = _images(bproc, tmp_path)
+    material = _matte_square(bproc, "square", 0.0)
+    base_value = [0.3, 0.5, 0.1, 1.0]
+    if mode == "unlinked_mix":
+        material.set_principled_shader_value("Base Color", base_value)
+    else:
+        material.set_principled_shader_value("Base Color", a.image)
+    mode_name = {"set_inverted": "set", "unlinked_mix": "mix"}.get(mode, mode)
+    material.infuse_texture(b, mode=mode_name.upper() if mode == "overlay" else mode_name, texture_scale=0.3,
+                            strength=0.7, invert_texture=mode == "set_inverted")
+    pose = np.eye(4)
+    pose[:3, 3] = [0.0, 0.0, 3.0]
+    bproc.camera.add_camera_pose(pose)
+    bproc.renderer.enable_diffuse_color_output()
+    diffuse = bproc.renderer.render()["diffuse"][0]
+    la, lb = _linear(A), _linear(B)
+    expected = {"mix": _overlay(la, lb, 0.7), "overlay": 0.3 * la + 0.7 * lb, "set": lb, "set_inverted": 1 - lb,
+                "unlinked_mix": np.asarray(base_value[:3])}[mode]
+    centre = diffuse[8:16, 12:20].reshape(-1, 3).astype(int)
+    assert np.all(np.abs(centre - _srgb8(expected)) <= 1), (centre[0], _srgb8(expected))
+
+
+def test_links_and_errors(bproc, tmp_path) -> None:  # noqa: F811
+    a, b = _images(bproc, tmp_path)
+    material = _matte_square(bproc, "square", 0.0)
+    scene_material = material.blender_obj
+    material.infuse_texture(b, mode="mix")  # nothing linked: nothing happens
+    assert scene_material.base_color_layers == ()
+    material.set_principled_shader_value("Base Color", a.image)
+    material.infuse_texture(b, mode="mix", strength=0.25, texture_scale=2.0)
+    material.infuse_texture(b, mode="overlay", invert_texture=True)
+    first, second = scene_material.base_color_layers
+    assert (first.blend, first.factor, first.texture_scale, first.invert) == ("OVERLAY", 0.25, 2.0, False)
+    assert (second.blend, second.factor, second.texture_scale, second.invert) == ("MIX", 0.5, 0.05, True)
+    assert scene_material.base_color_texture == a.image.filepath  # still under the layers
+    material.infuse_texture(b, mode="set")  # the image alone
+    (only,) = scene_material.base_color_layers
+    assert scene_material.base_color_texture is None and (only.blend, only.factor) == ("MIX", 1.0)
+    material.set_principled_shader_value("Base Color", [0.1, 0.2, 0.3, 1.0])  # unlinks it
+    assert scene_material.base_color_layers == ()
+    material.infuse_texture(b, connection="roughness", mode="overlay")  # title-cased; nothing linked there
+    with pytest.raises(InputError, match=r"This mode is unknown here: add, only \["):
+        material.infuse_texture(b, mode="add")
+    with pytest.raises(InputError, match="The Shininess is not an input to Principled BSDF!"):
+        material.infuse_texture(b, connection="shininess")
+    with pytest.raises(InputError, match="infuse_texture into 'Roughness' is not supported by hybridgen yet"):
+        material.infuse_texture(b, connection="Roughness", mode="set")
