@@ -8,6 +8,7 @@ import numpy as np
 
 from ..config.displacement_config import displacement_from_config
 from ..config.dust_config import dust_layer, with_dust
+from ..config.infuse_config import infused
 from ..config.material_config import apply_material_config
 from ..config.registry import register_module
 from ..config.schema import Param
@@ -43,6 +44,11 @@ class MaterialManipulator(SelectingModule):
         Param("color_link_to_displacement", "float|null", None, "m", sampleable=True,
               doc="BlenderProc's cf_color_link_to_displacement: the material's base-color image becomes its "
                   "displacement (bump) map, scaled by this factor"),
+        Param("infuse_texture", "dict|null", None, sampleable=True,
+              doc="BlenderProc's cf_infuse_texture: an image blended into the base color, {texture: an image path / "
+                  "getter.Texture, mode: overlay (a MIX blend, as BlenderProc's code runs) | mix (OVERLAY) | set, "
+                  "connection: Base Color, strength: 0.5, texture_scale: 0.05, invert_texture: false} "
+                  "(hybridgen/scene/infused_texture.py)"),
         Param("dust", "dict|null", None, sampleable=True,
               doc="BlenderProc's cf_add_dust: a dust film over the material, {strength, texture_scale: 0.1, "
                   "texture: null (generated noise) or an image path / getter.Texture} (hybridgen/scene/dust.py)"),
@@ -60,6 +66,9 @@ class MaterialManipulator(SelectingModule):
             factor = self.value(context, "color_link_to_displacement")
             if factor is not None:
                 obj.material = linked_displacement(obj.material, float(factor), obj.name)
+            infuse = self.value(context, "infuse_texture")
+            if infuse is not None:
+                obj.material = infused(obj.material, infuse, context.rng, context.scene.textures)
             dust = self.value(context, "dust")
             if dust is not None:
                 obj.material = with_dust(obj.material, dust_layer(dust, context.rng, context.scene.textures))

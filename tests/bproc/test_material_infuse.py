@@ -91,5 +91,5 @@ def test_links_and_errors(bproc, tmp_path) -> None:  # noqa: F811
         material.infuse_texture(b, mode="add")
     with pytest.raises(InputError, match="The Shininess is not an input to Principled BSDF!"):
         material.infuse_texture(b, connection="shininess")
-    with pytest.raises(InputError, match="infuse_texture into 'Roughness' is not supported by hybridgen yet"):
+    with pytest.raises(InputError, match="infuse_texture: an image infused into .Roughness. is not supported by hybridgen yet"):
         material.infuse_texture(b, connection="Roughness", mode="set")

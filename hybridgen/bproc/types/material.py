@@ -19,32 +19,10 @@ import numpy as np
 from ...errors import InputError
 from ...scene import principled_inputs
 from ...scene.material import Material as SceneMaterial
+from ...scene.principled_links import COLOR_FIELDS, INPUTS, NORMAL_INPUTS
 from ..session import SESSION
 from .struct import Struct
 from .unsupported import unsupported_method
-
-INPUTS: dict[str, tuple[str, str | None]] = {
-    "Base Color": ("base_color", "base_color_texture"),
-    "Metallic": ("metallic", "metallic_texture"),
-    "Roughness": ("roughness", "roughness_texture"),
-    "Specular": ("specular", "specular_texture"),
-    "Specular IOR Level": ("specular", "specular_texture"),
-    "IOR": ("ior", None),
-    "Alpha": ("alpha", "alpha_texture"),
-    "Transmission": ("transmission", None),
-    "Transmission Weight": ("transmission", None),
-    "Emission": ("emission", "emission_texture"),
-    "Emission Color": ("emission", "emission_texture"),
-    "Emission Strength": ("emission_strength", None),
-}
-"""Principled BSDF input (Blender 3 and 4 names) -> (hybridgen material field, its texture field or None)."""
-COLOR_FIELDS = ("base_color", "emission")
-NORMAL_INPUTS = {"Normal": "normal_texture", "Coat Normal": "coat_normal_texture"}
-"""Normal sockets -> the tangent-space map hybridgen keeps for them. BlenderProc's ``set_principled_shader_value``
-links an image's Color straight into such a socket (no Normal Map node), which Cycles reads as a world-space
-normal; hybridgen keeps tangent-space maps only (set by its loaders, config ``material:`` keys or
-``blender_obj``). A value (Blender ignores an unlinked normal socket's value: the surface's own normal) unlinks
-the map, as BlenderProc does."""
 
 
 def _is_image(value: Any) -> bool:
@@ -218,11 +196,10 @@ class Material(Struct):
                        texture_scale: float = 0.05, strength: float = 0.5, invert_texture: bool = False) -> None:
         """Blend ``texture`` (``bproc.loader.load_texture``'s) into the input ``connection``: ``set`` links it,
         ``overlay`` / ``mix`` blend it over what is linked there (nothing without a link), at factor ``strength``,
-        read at UV / ``texture_scale``; BlenderProc's semantics, quirks included (:mod:`hybridgen.bproc.material_infuse`)."""
-        from ..material_infuse import infuse_texture
+        read at UV / ``texture_scale``; BlenderProc's semantics, quirks included (:mod:`hybridgen.scene.infused_texture`)."""
+        from ..material_infuse import infuse
 
-        infuse_texture(self.blender_obj, texture, mode, connection, texture_scale, strength, invert_texture,
-                       inputs=INPUTS, normal_inputs=NORMAL_INPUTS)
+        infuse(self.blender_obj, texture, mode, connection, texture_scale, strength, invert_texture)
 
     def map_vertex_color(self, layer_name: str = "Col", active_shading: bool = True) -> None:
         """The mesh's vertex colors become the base color (Blender's color attribute linked to Base Color, in place

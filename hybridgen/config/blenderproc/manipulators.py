@@ -148,6 +148,12 @@ def material(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, An
                 dust["texture"] = dust.pop("used_dust_texture")
             cfg["dust"] = dust
             continue
+        if function == "infuse_texture":  # {used_texture, mode, ...} -> infuse_texture (config/infuse_config.py)
+            infuse = dict(cfg.pop(key) or {})
+            if "used_texture" in infuse:
+                infuse["texture"] = infuse.pop("used_texture")
+            cfg["infuse_texture"] = infuse
+            continue
         if function == "switch_to_emission_shader":
             emission = cfg.pop(key) or {}
             color = emission.get("color", [1.0, 1.0, 1.0, 1.0]) if isinstance(emission, dict) else [1, 1, 1, 1]
