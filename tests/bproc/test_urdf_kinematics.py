@@ -166,3 +166,17 @@ def test_unsupported_uses_are_one_line(arm) -> None:
     arm.create_ik_bone_controller()
     with pytest.raises(InputError, match="already has an IK controller"):
         arm.create_ik_bone_controller()
+
+
+def test_robot_types_are_bproc_types(arm, bproc) -> None:  # noqa: F811
+    """``bproc.types.URDFObject`` (and BlenderProc's internal ``LinkUtility.Link`` / ``URDFUtility.URDFObject``) are
+    the classes load_urdf's robot and links are; Armature stays a one-line stand-in."""
+    from hybridgen.bproc.internal_modules import internal_module
+
+    assert isinstance(arm, bproc.types.URDFObject)
+    assert all(isinstance(link, bproc.types.Link) for link in arm.links)
+    URDFObject = internal_module("blenderproc.python.types.URDFUtility", "hybridgen.bproc").URDFObject  # noqa: N806
+    Link = internal_module("blenderproc.python.types.LinkUtility", "hybridgen.bproc").Link  # noqa: N806
+    assert URDFObject is bproc.types.URDFObject and Link is bproc.types.Link
+    with pytest.raises(InputError, match="bproc.types.Armature is not supported by hybridgen yet"):
+        bproc.types.Armature()

@@ -21,4 +21,10 @@ from .unsupported import module_getattr
 
 __all__ = ["Entity", "Light", "Material", "MeshObject", "Struct"]
 
-__getattr__ = module_getattr("types", ["Armature", "URDFObject"])
+__getattr__ = module_getattr("types", ["Armature"], namespace=globals(),
+                             lazy={"URDFObject": "urdf_object", "Link": "urdf_link", "Inertial": "urdf_link"})
+"""``URDFObject`` (``bproc.loader.load_urdf``'s robots) and its ``Link`` / ``Inertial`` parts (BlenderProc's
+``LinkUtility`` / ``InertialUtility``) are imported on first use. ``Armature`` (Blender's bone objects) is a stand-in:
+one line for a BlenderProc call hybridgen does not implement, ``bproc.<area>.<name> is not supported by hybridgen
+yet``. Never a silent no-op: such a call would change BlenderProc's output, so it stops the script (exit status 2
+under ``hybridgen run``)."""
