@@ -5,6 +5,8 @@ from __future__ import annotations
 from typing import Any, Sequence
 
 from .material_dust import add_dust as add_dust  # noqa: F401 (bproc.material.add_dust)
+from .material_library import (change_to_texture_less_render, create_material_from_texture,  # noqa: F401
+                               create_new_cc_material, find_cc_material_by_name)
 from .session import SESSION
 from .types import Material, MeshObject
 from .types.unsupported import module_getattr
@@ -33,7 +35,6 @@ def is_material_used(material: Material) -> bool:
 __getattr__ = module_getattr("material", [
     "add_alpha", "add_alpha_channel_to_textures", "add_alpha_texture_node", "add_ambient_occlusion",
     "add_base_color", "add_bump", "add_displacement", "add_metal", "add_normal", "add_roughness", "add_specular",
-    "change_to_texture_less_render", "connect_uv_maps", "create_image_node", "create_new_cc_material",
-    "find_cc_material_by_name", "create_material_from_texture"],
+    "connect_uv_maps", "create_image_node"],
     # procedural textures (~15 ms of imports) are imported when first made
     lazy={"create_procedural_texture": "procedural_texture"}, namespace=globals())

@@ -211,10 +211,18 @@ class MeshObject(Entity, MeshGeometry, MeshEditing, MeshModifiers, RigidBodyMixi
     update_from_bmesh: Callable[..., Any] = unsupported_method("MeshObject", "update_from_bmesh")
     edit_mode: Callable[..., Any] = unsupported_method("MeshObject", "edit_mode")
     object_mode: Callable[..., Any] = unsupported_method("MeshObject", "object_mode")
-    scale_uv_coordinates: Callable[..., Any] = unsupported_method("MeshObject", "scale_uv_coordinates")
     add_geometry_nodes: Callable[..., Any] = unsupported_method("MeshObject", "add_geometry_nodes")
     add_auto_smooth_modifier: Callable[..., Any] = unsupported_method("MeshObject", "add_auto_smooth_modifier")
     clear_custom_splitnormals: Callable[..., Any] = unsupported_method("MeshObject", "clear_custom_splitnormals")
+
+    def scale_uv_coordinates(self, factor: float) -> None:
+        """Every UV coordinate times ``factor`` (above 1 the texture looks smaller on the object)."""
+        if not self.parts or not self.has_uv_mapping():
+            raise InputError("Cannot scale UV coordinates of a MeshObject that has no UV mapping.")
+        for index, part in enumerate(self.parts):
+            twin = copy.copy(part)  # parts may be shared with duplicates: replaced, not changed
+            twin.uvs = np.asarray(part.uvs, dtype=np.float64) * float(factor)
+            self.parts[index] = twin
 
     def has_uv_mapping(self) -> bool:
         """Whether every part has texture coordinates."""
