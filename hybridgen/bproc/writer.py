@@ -30,14 +30,28 @@ def _json_ready(value: Any) -> Any:
     return value
 
 
+def _frame_entries(output_data_dict: dict[str, Any], index: int, stereo_separate_keys: bool) -> dict[str, Any]:
+    """The datasets of frame ``index``: each key's value, or with ``stereo_separate_keys`` a stereo value as
+    ``<key>_0`` (left) and ``<key>_1`` (right) - every key when stereo rendering is on, else an array whose first
+    axis has 2 entries (BlenderProc's test, which also splits such an array of a mono render)."""
+    entries: dict[str, Any] = {}
+    for key, block in output_data_dict.items():
+        value = block[index]
+        pair = isinstance(value, np.ndarray) and value.ndim > 0 and value.shape[0] == 2
+        if stereo_separate_keys and (SESSION.camera.stereo or pair):
+            entries[f"{key}_0"], entries[f"{key}_1"] = value[0], value[1]
+        else:
+            entries[key] = value
+    return entries
+
+
 def write_hdf5(output_dir_path: str, output_data_dict: dict[str, Any], append_to_existing_output: bool = False,
                stereo_separate_keys: bool = False) -> None:
-    """Write ``output_data_dict`` (``{key: [value per frame]}``) as BlenderProc's per-frame HDF5 files."""
+    """Write ``output_data_dict`` (``{key: [value per frame]}``) as BlenderProc's per-frame HDF5 files
+    (``stereo_separate_keys``: :func:`_frame_entries`)."""
     from ..io.frame_sink import PassLayout
     from ..io.hdf5_blenderproc import BlenderProcHdf5Writer
 
-    if stereo_separate_keys:
-        raise InputError("bproc.writer.write_hdf5(stereo_separate_keys=True) is not supported by hybridgen yet")
     count = max((len(v) for v in output_data_dict.values() if isinstance(v, list)), default=0)
     frames = SESSION.frame_end - SESSION.frame_start
     if count != frames:
@@ -47,14 +61,15 @@ def write_hdf5(output_dir_path: str, output_data_dict: dict[str, Any], append_to
         if len(block) < count:
             raise InputError(f"There are more frames {count} then there are blocks of information {len(block)} in "
                              f"the given list for key {key}.")
-    json_keys = {key for key, block in output_data_dict.items() if not isinstance(block[0], np.ndarray)}
+    frames = [_frame_entries(output_data_dict, index, stereo_separate_keys) for index in range(count)]
+    json_keys = {key for key, value in (frames[0].items() if frames else ()) if not isinstance(value, np.ndarray)}
     writer = BlenderProcHdf5Writer(output_dir_path, append=append_to_existing_output, encoded=True)
     writer.offset += SESSION.frame_start
     try:
         writer.begin(count, [PassLayout(key, "json", ()) for key in json_keys], {}, {"hybridgen_version": __version__})
-        for index in range(count):
-            writer.write(index, {key: _json_ready(block[index]) if key in json_keys else np.asarray(block[index])
-                                 for key, block in output_data_dict.items()})
+        for index, entries in enumerate(frames):
+            writer.write(index, {key: _json_ready(value) if key in json_keys else np.asarray(value)
+                                 for key, value in entries.items()})
         writer.finalize()
     except BaseException:
         writer.abort()
