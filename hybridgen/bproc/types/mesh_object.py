@@ -136,8 +136,9 @@ class MeshObject(Entity, MeshGeometry, MeshEditing, MeshModifiers, RigidBodyMixi
         return self.get_location()
 
     def set_origin(self, point: Sequence[float] | None = None, mode: str = "POINT") -> np.ndarray:
-        """Move the origin to ``point`` (world, ``POINT``) or to the area-weighted surface centroid
-        (``CENTER_OF_MASS``) without moving the geometry; returns the new origin."""
+        """Move the origin to ``point`` (world, ``POINT``), to the area-weighted surface centroid
+        (``CENTER_OF_MASS``) or to the centroid of the enclosed volume (``CENTER_OF_VOLUME``) without moving the
+        geometry; returns the new origin."""
         basis = self.basis()
         if mode == "POINT":
             if point is None:
@@ -149,8 +150,10 @@ class MeshObject(Entity, MeshGeometry, MeshEditing, MeshModifiers, RigidBodyMixi
             corners = np.concatenate([part.vertices[part.faces] for part in self.parts])
             areas = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
             target = (corners.mean(axis=1) * areas[:, None]).sum(axis=0) / max(areas.sum(), 1e-300)
+        elif mode == "CENTER_OF_VOLUME":
+            target = _volume_centroid(self.parts)
         else:
-            raise InputError(f"bproc.types.MeshObject.set_origin(mode={mode!r}) is not supported by hybridgen yet")
+            raise InputError(f"bproc.types.MeshObject.set_origin: No such mode: {mode}")
         shift = np.eye(4)
         shift[:3, 3] = -target
         self._transform_parts(shift)
@@ -232,3 +235,16 @@ class MeshObject(Entity, MeshGeometry, MeshEditing, MeshModifiers, RigidBodyMixi
 def get_all_mesh_objects() -> list[MeshObject]:
     """Every mesh object of the session, in creation order (``bproc.object.get_all_mesh_objects``)."""
     return [e for e in SESSION.entities if isinstance(e, MeshObject)]
+
+
+def _volume_centroid(parts: list[Any]) -> np.ndarray:
+    """Blender's ``ORIGIN_CENTER_OF_VOLUME`` in the local frame: the centroid of the volume the triangles enclose
+    (signed tetrahedra from the vertices' mean, for precision), or that mean when they enclose none."""
+    vertices = np.concatenate([part.vertices for part in parts]) if parts else np.zeros((1, 3))
+    mean = vertices.mean(axis=0)
+    corners = np.concatenate([part.vertices[part.faces] for part in parts]) - mean if parts else np.zeros((0, 3, 3))
+    volumes = np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2])) / 6.0
+    total = volumes.sum()
+    if abs(total) <= np.finfo(np.float32).eps:
+        return mean
+    return mean + (volumes[:, None] * corners.sum(axis=1) / 4.0).sum(axis=0) / total
