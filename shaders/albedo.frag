@@ -19,6 +19,7 @@ uniform float u_alpha;
 uniform sampler2D u_alpha_texture;
 uniform vec3 u_camera;   // world position of the camera (dust's view direction)
 uniform bool u_dust_uv;  // the mesh has UVs (else dust reads (0, 0), as Cycles a missing UV map)
+uniform float u_weight;  // the material's share of the surface (1; a mixed material's weight, render/raster/albedo_pass.py)
 
 in vec2 v_uv;
 in vec3 v_color;
@@ -59,5 +60,5 @@ void main() {
         albedo = dust_albedo(albedo, u_dust_uv ? v_uv : vec2(0.0), n.z, abs(cosine));
     }
 #endif
-    out_albedo = vec4(albedo, 1.0);
+    out_albedo = vec4(albedo * u_weight, 1.0);
 }

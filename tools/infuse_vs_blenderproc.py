@@ -1,6 +1,7 @@
-"""``Material.infuse_texture`` in the real BlenderProc against hybridgen: the same script (written here, run by
-both) renders five matte squares - a base-color image with an image infused by ``mix``, ``overlay``, ``set``,
-``set`` inverted, and ``mix`` over an unlinked base color - and saves Cycles' Diffuse Color pass (BlenderProc's
+"""``Material.infuse_texture`` and ``infuse_material`` in the real BlenderProc against hybridgen: the same script
+(written here, run by both) renders seven matte squares - a base-color image with an image infused by ``mix``,
+``overlay``, ``set``, ``set`` inverted, ``mix`` over an unlinked base color, and a red material with a blue one
+infused by ``infuse_material`` ``mix`` (0.3) and ``add`` - and saves Cycles' Diffuse Color pass (BlenderProc's
 ``diffuse`` output: the base color, as the squares have Specular IOR Level 0). Prints, per square, the median
 color of each engine (8-bit sRGB), the share of pixels within 2 codes of each other and, inside the pattern's
 blocks (away from its edges, where Cycles' pixel filter blends neighbouring texels), the share within 1 code.
@@ -23,10 +24,12 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from blenderproc_reference import execute, hybridgen_invocation, reference_invocation  # noqa: E402
 
-FOV = 1.6
-"""Horizontal field of view (rad): 12.3 m wide at the squares, 6 m away."""
+FOV = 1.8
+"""Horizontal field of view (rad): 15.4 m wide at the squares, 6 m away."""
+SPACING, FIRST = 2.2, -6.6
+"""The squares' spacing and the first one's x (m)."""
 SCRIPT = '''
-FOV = %r
+FOV, SPACING, FIRST = %r, %r, %r
 import blenderproc as bproc
 import sys
 import numpy as np
@@ -37,7 +40,7 @@ pattern = bproc.loader.load_texture(folder + "/pattern.png")[0]
 cases = [("mix", False, True), ("overlay", False, True), ("set", False, True), ("set", True, True),
          ("mix", False, False)]
 for index, (mode, invert, linked) in enumerate(cases):
-    square = bproc.object.create_primitive("PLANE", location=[2.2 * index - 4.4, 0, 0])
+    square = bproc.object.create_primitive("PLANE", location=[SPACING * index + FIRST, 0, 0])
     material = square.new_material(f"case{index}")
     material.set_principled_shader_value("Specular IOR Level", 0.0)
     if linked:
@@ -45,9 +48,18 @@ for index, (mode, invert, linked) in enumerate(cases):
     else:
         material.set_principled_shader_value("Base Color", [0.3, 0.5, 0.1, 1.0])
     material.infuse_texture(pattern, mode=mode, texture_scale=0.5, strength=0.7, invert_texture=invert)
+for index, mode in enumerate(["mix", "add"], start=len(cases)):
+    square = bproc.object.create_primitive("PLANE", location=[SPACING * index + FIRST, 0, 0])
+    material = square.new_material(f"case{index}")
+    material.set_principled_shader_value("Specular IOR Level", 0.0)
+    material.set_principled_shader_value("Base Color", [0.8, 0.1, 0.1, 1.0])
+    blue = bproc.material.create(f"blue{index}")
+    blue.set_principled_shader_value("Specular IOR Level", 0.0)
+    blue.set_principled_shader_value("Base Color", [0.1, 0.2, 0.9, 1.0])
+    material.infuse_material(blue, mode=mode, mix_strength=0.3)
 light = bproc.types.Light()
 light.set_location([0, 0, 5])
-bproc.camera.set_resolution(440, 100)
+bproc.camera.set_resolution(620, 100)
 bproc.camera.set_intrinsics_from_blender_params(lens=FOV, lens_unit="FOV")
 pose = np.eye(4)
 pose[:3, 3] = [0.0, 0.0, 6.0]
@@ -56,8 +68,8 @@ bproc.renderer.set_max_amount_of_samples(4)
 bproc.renderer.enable_diffuse_color_output()
 data = bproc.renderer.render()
 np.save(out, np.asarray(data["diffuse"][0]))
-''' % FOV
-CASES = ("mix (OVERLAY)", "overlay (MIX)", "set", "set, inverted", "mix, unlinked")
+''' % (FOV, SPACING, FIRST)
+CASES = ("mix (OVERLAY)", "overlay (MIX)", "set", "set, inverted", "mix, unlinked", "material mix", "material add")
 
 
 def main() -> None:
@@ -94,7 +106,7 @@ def main() -> None:
     print(f"{'case':16s} {'BlenderProc median':>20s} {'hybridgen median':>20s} {'<=2 codes':>10s} "
           f"{'block px':>9s} {'<=1 there':>10s}")
     for index, name in enumerate(CASES):
-        centre = int(width / 2 + (2.2 * index - 4.4) * width / (12.0 * np.tan(FOV / 2)))
+        centre = int(width / 2 + (SPACING * index + FIRST) * width / (12.0 * np.tan(FOV / 2)))
         region = (slice(35, 65), slice(centre - 15, centre + 15))
         difference = np.abs(reference[region] - ours[region]).max(axis=-1)
         inside = flat[region]

@@ -8,6 +8,7 @@ import numpy as np
 
 from .color_layer import ColorLayer
 from .dust import Dust
+from .material_mix import MaterialMix
 
 TEXTURE_SLOTS = ("base_color_texture", "roughness_texture", "metallic_texture", "alpha_texture",
                  "normal_texture", "displacement_texture", "specular_texture", "emission_texture",
@@ -68,6 +69,8 @@ class Material:
       ``add_dust``); empty for none.
     - ``base_color_layers``: images blended over the base color, innermost first (:mod:`hybridgen.scene.color_layer`;
       BlenderProc's ``infuse_texture``); the base color under them is the texture, vertex colors or value above.
+    - ``mixes``: other materials mixed into the surface, in order (:mod:`hybridgen.scene.material_mix`; BlenderProc's
+      ``infuse_material``); the surface is a weighted sum of the materials' closures.
     """
 
     name: str = "default"
@@ -99,6 +102,7 @@ class Material:
     extra: dict[str, Any] = field(default_factory=dict)
     dust: tuple[Dust, ...] = ()
     base_color_layers: tuple[ColorLayer, ...] = ()
+    mixes: tuple[MaterialMix, ...] = ()
 
     @property
     def cuts_out(self) -> bool:

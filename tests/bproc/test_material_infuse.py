@@ -93,3 +93,33 @@ def test_links_and_errors(bproc, tmp_path) -> None:  # noqa: F811
         material.infuse_texture(b, connection="shininess")
     with pytest.raises(InputError, match="infuse_texture: an image infused into .Roughness. is not supported by hybridgen yet"):
         material.infuse_texture(b, connection="Roughness", mode="set")
+
+
+@pytest.mark.parametrize("mode, expected", [("mix", 0.7 * np.array([0.8, 0.1, 0.1]) + 0.3 * np.array([0.1, 0.2, 0.9])),
+                                            ("ADD", 0.5 * np.array([0.1, 0.2, 0.9]))])
+def test_infuse_material_diffuse_output(gl_context, bproc, mode: str, expected: np.ndarray) -> None:  # noqa: F811
+    """Cycles' Diffuse Color pass of a Mix Shader is the weighted sum; ``add`` leaves half of the infused material
+    alone (the real BlenderProc, Standard view: (202, 101, 158) for mix 0.3 and (63, 89, 179) for add)."""
+    material = _matte_square(bproc, "red", 0.0)
+    material.set_principled_shader_value("Base Color", [0.8, 0.1, 0.1, 1.0])
+    blue = bproc.material.create("blue")
+    blue.set_principled_shader_value("Base Color", [0.1, 0.2, 0.9, 1.0])
+    blue.set_principled_shader_value("Specular IOR Level", 0.0)
+    material.infuse_material(blue, mode=mode, mix_strength=0.3)
+    blue.set_principled_shader_value("Base Color", [1.0, 1.0, 1.0, 1.0])  # after infusing: BlenderProc's copy stays
+    pose = np.eye(4)
+    pose[:3, 3] = [0.0, 0.0, 3.0]
+    bproc.camera.add_camera_pose(pose)
+    bproc.renderer.enable_diffuse_color_output()
+    diffuse = bproc.renderer.render()["diffuse"][0]
+    assert np.all(np.abs(diffuse[8:16, 12:20].reshape(-1, 3).astype(int) - _srgb8(expected)) <= 1)
+    assert tuple(_srgb8(expected)) == ((202, 101, 158) if mode == "mix" else (63, 89, 179))
+
+
+def test_infuse_material_refusals(bproc) -> None:  # noqa: F811
+    a, b = bproc.material.create("a"), bproc.material.create("b")
+    with pytest.raises(InputError, match=r"This mode is unknown here: blend, only \[\"mix\", \"add\"\]!"):
+        a.infuse_material(b, mode="blend")
+    b.set_principled_shader_value("Alpha", 0.5)
+    with pytest.raises(InputError, match="'b' has transparency"):
+        a.infuse_material(b)

@@ -12,6 +12,7 @@ with a ``filepath``) linked to an input becomes that input's texture map. Node-l
 """
 from __future__ import annotations
 
+import copy
 from typing import Any, Callable
 
 import numpy as np
@@ -201,6 +202,27 @@ class Material(Struct):
 
         infuse(self.blender_obj, texture, mode, connection, texture_scale, strength, invert_texture)
 
+    def infuse_material(self, material: "Material", mode: str = "mix", mix_strength: float = 0.5) -> None:
+        """Mix ``material`` (as it is now) into this one's surface: ``mix`` keeps ``1 - mix_strength`` of it and adds
+        ``mix_strength`` of the other; ``add`` - as BlenderProc's code runs - leaves the other at half strength alone
+        (:mod:`hybridgen.scene.material_mix`)."""
+        from ...scene.material_mix import MODES, MaterialMix, unsupported_in_mix
+
+        used_mode = str(mode).lower()
+        if used_mode not in MODES:
+            raise InputError(f'bproc.types.Material.infuse_material: This mode is unknown here: {used_mode}, only '
+                             '["mix", "add"]!')
+        if not isinstance(material, Material):
+            raise InputError(f"bproc.types.Material.infuse_material: material must be a bproc material, got "
+                             f"{type(material).__name__}")
+        for part in (self.blender_obj, material.blender_obj):
+            reason = unsupported_in_mix(part)
+            if reason is not None:
+                raise InputError(f"bproc.types.Material.infuse_material: material '{part.name}' has {reason}; mixing "
+                                 "that is not supported by hybridgen yet")
+        snapshot = copy.deepcopy(material.blender_obj)  # BlenderProc copies the node tree: later changes stay out
+        self.blender_obj.mixes = (*self.blender_obj.mixes, MaterialMix.of_mode(snapshot, used_mode, mix_strength))
+
     def map_vertex_color(self, layer_name: str = "Col", active_shading: bool = True) -> None:
         """The mesh's vertex colors become the base color (Blender's color attribute linked to Base Color, in place
         of what was linked there: an image, infused images)."""
@@ -221,4 +243,3 @@ class Material(Struct):
     unlink: Callable[..., Any] = unsupported_method("Material", "unlink")
     get_node_connected_to_the_output_and_unlink_it: Callable[..., Any] = unsupported_method(
         "Material", "get_node_connected_to_the_output_and_unlink_it")
-    infuse_material: Callable[..., Any] = unsupported_method("Material", "infuse_material")

@@ -34,7 +34,10 @@ from .material_emission import emitted_radiance
 
 
 def layered(material: Material) -> bool:
-    """Whether ``material``'s emission lies under a coat or a sheen (a weight > 0 of either)."""
+    """Whether ``material``'s emission lies under a coat or a sheen (a weight > 0 of either); never for a mix of
+    materials, whose components cannot emit under their layers (:func:`hybridgen.scene.material_mix.unsupported_in_mix`)."""
+    if material.mixes:
+        return False
     return any(isinstance(material.extra.get(key, 0.0), (int, float)) and material.extra.get(key, 0.0) > 0
                for key in ("coat_weight", "sheen_weight"))
 

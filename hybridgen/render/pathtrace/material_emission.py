@@ -32,8 +32,20 @@ def emission_image(material: Material, owner: str) -> np.ndarray | None:
 
 def emitted_radiance(obj: MeshObject) -> np.ndarray:
     """Mean linear RGB radiance (W sr^-1 m^-2) the object's surface emits: emission x emission_strength, or
-    the emission texture's mean x strength (its mean over the image, not over the surface)."""
+    the emission texture's mean x strength (its mean over the image, not over the surface); a material with others
+    mixed in emits their weighted sum (:mod:`.material_mixes`)."""
     material = obj.material
+    if material.mixes:
+        import copy
+
+        from .material_mixes import mixed_radiance
+
+        def radiance_of(part: Material) -> np.ndarray:
+            twin = copy.copy(obj)
+            twin.material = part
+            return emitted_radiance(twin)
+
+        return mixed_radiance(material, obj.name, radiance_of)
     strength = float(material.emission_strength)
     if material.emission_texture is not None and strength != 0:
         image = emission_image(material, obj.name)

@@ -197,6 +197,10 @@ def bsdf_dict(material: Material, owner: str, *, vertex_colors: bool = False, uv
     has texture coordinates (dust patterns and infused images read them, :mod:`.dust_mix`, :mod:`.color_layers`)."""
     from . import principled_material
 
+    if material.mixes:  # other materials mixed in (render/pathtrace/material_mixes.py)
+        from .material_mixes import mixed_bsdf
+
+        return mixed_bsdf(material, owner, lambda part: bsdf_dict(part, owner, vertex_colors=vertex_colors, uvs=uvs))
     blender = principled_material.enabled()  # hybridgen's Principled BSDF (JIT variants)
     check_material(material, owner, extra_inputs=blender)
     if material.base_color_texture is not None:

@@ -38,7 +38,10 @@ class SurfaceLobes:
 
 def can_be_specular_like(material: Material) -> bool:
     """Whether ``material``'s specular lobes are specular-like (roughness^2 <= :data:`SPECULAR_ALPHA`, no
-    roughness/metallic map) and it has any (specular layer, metal or glass)."""
+    roughness/metallic map) and it has any (specular layer, metal or glass); never for a mix of materials (the
+    denoising guides stay on its surface)."""
+    if material.mixes:
+        return False
     if material.roughness_texture is not None or material.metallic_texture is not None:
         return False
     has_specular = material.metallic > 0 or material.transmission > 0 or material.specular > 0

@@ -11,11 +11,13 @@ Textures and UVs are uploaded on first use only.
 """
 from __future__ import annotations
 
+import copy
 from typing import Any
 
 import numpy as np
 
 from ...scene.camera import Intrinsics
+from ...scene.material_mix import components
 from ...scene.mesh_object import MeshObject
 from .gl_context import compile_program
 from ..material_textures import alpha_coverage
@@ -28,6 +30,21 @@ from . import principled_diffuse
 from .label_framebuffers import release_framebuffer
 
 GL_SRGB8_ALPHA8 = 0x8C43
+
+
+def surface_parts(obj: MeshObject) -> list[tuple[MeshObject, float]]:
+    """``obj`` alone (weight 1), or for a material with others mixed in (:mod:`hybridgen.scene.material_mix`) a
+    shallow copy of ``obj`` per mixed material with its weight - the object's own surface first, kept even at weight
+    0 (it draws the depth the others are added at)."""
+    if not obj.material.mixes:
+        return [(obj, 1.0)]
+    parts = []
+    for index, (material, weight) in enumerate(components(obj.material)):
+        if weight > 0 or index == 0:
+            twin = copy.copy(obj)
+            twin.material = material
+            parts.append((twin, weight))
+    return parts
 
 
 def _texture_image(obj: MeshObject) -> np.ndarray | None:
@@ -74,14 +91,13 @@ class AlbedoPass:
             fragment = fragment.replace("// principled_diffuse.glsl", shader_source("principled_diffuse.glsl"))
             self._tables = ctx.buffer(principled_diffuse.table_values().tobytes())
         self.program = compile_program(ctx, vertex_shader=shader_source("albedo.vert"), fragment_shader=fragment)
-        self._draws: list[tuple[Any, Any, Any, MeshObject]] = []
+        self._draws: list[tuple[Any, Any, Any, MeshObject, float, bool]] = []  # vao, texture, alpha, obj, weight, first
         self._dust: dict[int, ObjectDust] = {}  # draw index -> its dust layers (render/raster/albedo_dust.py)
         self._principled: dict[int, principled_diffuse.ObjectPrincipled] = {}  # draw index -> its inputs
         self._layers: dict[int, ObjectLayers] = {}  # draw index -> its infused images
         self._resources: list[Any] = [] if self._tables is None else [self._tables]
         for gpu, obj in zip(view.gpu_objects, view.scene.objects):
-            image = _texture_image(obj)
-            texture = alpha = None
+            parts = surface_parts(obj)  # (object with one material, weight): materials mixed in are drawn added
             content = [(gpu.positions, "3f", "in_position")]
 
             def per_vertex(values: np.ndarray, layout: str, name: str) -> None:
@@ -90,36 +106,44 @@ class AlbedoPass:
                 content.append((buffer, layout, name))
                 self._resources.append(buffer)
 
-            alpha_image = _alpha_image(obj)
-            layers = active_layers(obj)
-            infused = obj.material.base_color_layers
-            inputs = principled_diffuse.ObjectPrincipled(ctx, obj, self._resources) if diffuse_color else None
-            if (image is not None or alpha_image is not None or layers or infused or (inputs and inputs.needs_uv)) \
-                    and obj.uvs is not None:
+            draws, needs_uv, needs_normal, colored = [], False, False, False
+            for part, weight in parts:
+                index = len(self._draws) + len(draws)
+                image, alpha_image, layers = _texture_image(part), _alpha_image(part), active_layers(part)
+                inputs = principled_diffuse.ObjectPrincipled(ctx, part, self._resources) if diffuse_color else None
+                needs_uv |= bool(image is not None or alpha_image is not None or layers or
+                                 part.material.base_color_layers or (inputs and inputs.needs_uv))
+                needs_normal |= bool(layers or inputs)
+                colored |= obj.vertex_colors is not None and part.material.base_color_from_vertices
+                if layers:
+                    self._dust[index] = ObjectDust(ctx, part, layers, self._resources)
+                if inputs:
+                    self._principled[index] = inputs
+                if part.material.base_color_layers:
+                    self._layers[index] = ObjectLayers(ctx, part, self._resources)
+                texture = self._texture(image, 4, GL_SRGB8_ALPHA8)
+                draws.append((texture, self._texture(alpha_image, 1), part, weight))
+            if needs_uv and obj.uvs is not None:
                 per_vertex(np.asarray(obj.uvs), "2f", "in_uv")
-            if layers or inputs:
+            if needs_normal:
                 content.extend(entry for entry in gpu.content if entry[2] == "in_normal")
-            if layers:
-                self._dust[len(self._draws)] = ObjectDust(ctx, obj, layers, self._resources)
-            if inputs:
-                self._principled[len(self._draws)] = inputs
-            if infused:
-                self._layers[len(self._draws)] = ObjectLayers(ctx, obj, self._resources)
-            if image is not None:
-                texture = ctx.texture((image.shape[1], image.shape[0]), 4, image.tobytes(),
-                                      internal_format=GL_SRGB8_ALPHA8)
-                texture.repeat_x = texture.repeat_y = True
-                self._resources.append(texture)
-            if alpha_image is not None:
-                alpha = ctx.texture((alpha_image.shape[1], alpha_image.shape[0]), 1, alpha_image.tobytes())
-                alpha.repeat_x = alpha.repeat_y = True
-                self._resources.append(alpha)
-            if obj.vertex_colors is not None and obj.material.base_color_from_vertices:
+            if colored:
                 per_vertex(obj.vertex_colors, "3f", "in_color")
             vao = ctx.vertex_array(self.program, content, index_buffer=gpu.indices, index_element_size=4)
             self._resources.append(vao)
-            self._draws.append((vao, texture, alpha, obj))
+            self._draws.extend((vao, texture, alpha, part, weight, first == 0)
+                               for first, (texture, alpha, part, weight) in enumerate(draws))
         self._fbos: dict[tuple[int, int], Any] = {}  # one per image size (labels, supersampled guides)
+
+    def _texture(self, image: np.ndarray | None, components: int, internal_format: int | None = None) -> Any:
+        """A repeating GL texture of a bottom-up uint8 image (None for none), released with the pass."""
+        if image is None:
+            return None
+        extra = {} if internal_format is None else {"internal_format": internal_format}
+        texture = self.view.ctx.texture((image.shape[1], image.shape[0]), components, image.tobytes(), **extra)
+        texture.repeat_x = texture.repeat_y = True
+        self._resources.append(texture)
+        return texture
 
     def render(self, cam2world: np.ndarray, background: tuple[float, float, float] | None = None,
                intrinsics: Intrinsics | None = None) -> np.ndarray:
@@ -144,8 +168,16 @@ class AlbedoPass:
             self._tables.bind_to_storage_buffer(principled_diffuse.STORAGE_BINDING)
         self.program["u_projection"].write(projection_from_K(intr.K, intr.width, intr.height, intr.clip_start,
                                                              intr.clip_end).T.astype(np.float32).tobytes())
-        for index, (vao, texture, alpha, obj) in enumerate(self._draws):
+        for index, (vao, texture, alpha, obj, weight, first) in enumerate(self._draws):
             material = obj.material
+            if first:  # an object's own surface: drawn over what is behind, its depth kept
+                ctx.disable(moderngl.BLEND)
+                ctx.depth_func = "<"
+            else:  # a material mixed into it: added where the object's surface is
+                ctx.enable(moderngl.BLEND)
+                ctx.blend_func = moderngl.ONE, moderngl.ONE
+                ctx.depth_func = "=="
+            self.program["u_weight"].value = float(weight)
             if index in self._dust:
                 self._dust[index].apply(self.program, obj, cam2world)
             elif self._dust:
@@ -172,6 +204,8 @@ class AlbedoPass:
                 alpha.use(1)
                 self.program["u_alpha_texture"].value = 1
             vao.render()
+        ctx.disable(moderngl.BLEND)
+        ctx.depth_func = "<"
         out = np.empty((intr.height, intr.width, 4), dtype=np.float32)
         fbo.read_into(out, components=4, dtype="f4")
         return np.ascontiguousarray(out[..., :3])
