@@ -64,6 +64,6 @@ def infuse_texture(mat: Material, texture: str, texture_srgb: bool, mode: str = 
         raise InfuseError(f"an image infused into '{connector}' is not supported by hybridgen yet (Base Color is)")
     if used_mode == "set":
         mat.base_color_texture, mat.base_color_from_vertices = None, False
-        mat.base_color_layers = (layer,)
+        mat.base_color_layers, mat.missing_files = (layer,), ()
     elif _linked(mat, connector):
         mat.base_color_layers = (*mat.base_color_layers, layer)

@@ -17,10 +17,10 @@ absorbs, as an empty shader input does).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
+from typing import Any
 
-if TYPE_CHECKING:
-    from .material import Material
+Material = Any
+"""A :class:`hybridgen.scene.material.Material` (not imported: that module imports this one)."""
 
 MODES = {"mix", "add"}
 
@@ -30,12 +30,12 @@ class MaterialMix:
     """One Mix Shader step: the surface becomes ``keep x surface + weight x material`` (``material`` a snapshot of
     the infused material, its own mixes included)."""
 
-    material: "Material"
+    material: Material
     weight: float
     keep: float
 
     @staticmethod
-    def of_mode(material: "Material", mode: str, mix_strength: float) -> "MaterialMix":
+    def of_mode(material: Material, mode: str, mix_strength: float) -> "MaterialMix":
         """The step BlenderProc's ``infuse_material(material, mode, mix_strength)`` builds (module docstring)."""
         if mode == "add":
             return MaterialMix(material, 0.5, 0.0)
@@ -43,7 +43,7 @@ class MaterialMix:
         return MaterialMix(material, factor, 1.0 - factor)
 
 
-def components(material: "Material") -> list[tuple["Material", float]]:
+def components(material: Material) -> list[tuple[Material, float]]:
     """(material without mixes, weight) pairs whose weighted sum ``material``'s surface is, the material's own
     surface first; weights in [0, 1] summing to at most 1."""
     out = [(replace(material, mixes=(), extra=dict(material.extra)), 1.0)]
@@ -52,7 +52,7 @@ def components(material: "Material") -> list[tuple["Material", float]]:
     return out
 
 
-def unsupported_in_mix(material: "Material") -> str | None:
+def unsupported_in_mix(material: Material) -> str | None:
     """Why a component of a mix cannot be rendered by hybridgen (None when it can): transparency, displacement,
     emission from an image or hidden from the camera do not mix yet."""
     if material.alpha_texture is not None or material.alpha < 1.0:

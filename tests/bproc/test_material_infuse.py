@@ -123,3 +123,23 @@ def test_infuse_material_refusals(bproc) -> None:  # noqa: F811
     b.set_principled_shader_value("Alpha", 0.5)
     with pytest.raises(InputError, match="'b' has transparency"):
         a.infuse_material(b)
+
+
+def test_replacing_a_missing_base_color_image_lets_color_render(gl_context, bproc, tmp_path) -> None:  # noqa: F811
+    """An OBJ whose MTL names a missing map_Kd: a color render stops with one line naming it, unless the script
+    replaced the base color (a value, an image, vertex colors or an infused image with ``set``), which unlinks it."""
+    (tmp_path / "quad.mtl").write_text("newmtl tiles\nKd 0.5 0.5 0.5\nmap_Kd gone.png\n")
+    (tmp_path / "quad.obj").write_text("mtllib quad.mtl\no Quad\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
+                                       "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl tiles\nf 1/1 2/2 3/3 4/4\n")
+    (quad,) = bproc.loader.load_obj(str(tmp_path / "quad.obj"))
+    material = quad.get_materials()[0]
+    assert material.blender_obj.missing_files
+    pose = np.eye(4)
+    pose[:3, 3] = [0.0, 0.0, 3.0]
+    bproc.camera.add_camera_pose(pose)
+    bproc.renderer.set_max_amount_of_samples(4)
+    with pytest.raises(InputError, match="gone.png"):
+        bproc.renderer.render()
+    material.set_principled_shader_value("Base Color", [0.2, 0.4, 0.6, 1.0])
+    assert material.blender_obj.missing_files == ()
+    assert bproc.renderer.render()["colors"][0].shape == (24, 32, 3)

@@ -111,6 +111,7 @@ class Material(Struct):
         mat = self.blender_obj
         if field == "base_color":  # an image or a value replaces whatever was linked (BlenderProc unlinks it)
             mat.base_color_layers, mat.base_color_from_vertices = (), False
+            mat.missing_files = ()  # the mesh's own (missing) base-color files are no longer used
         if _is_image(value):
             if texture is None:
                 raise InputError(f"an image on Principled BSDF input '{input_name}' is not supported by hybridgen yet")
@@ -228,6 +229,7 @@ class Material(Struct):
         of what was linked there: an image, infused images)."""
         mat = self.blender_obj
         mat.base_color_from_vertices, mat.base_color_texture, mat.base_color_layers = True, None, ()
+        mat.missing_files = ()
 
     def _attribute(self, attr_name: str) -> Any:
         return self.get_users() if attr_name == "users" else self.get_name()
