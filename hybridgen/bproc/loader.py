@@ -18,10 +18,12 @@ from .types.unsupported import module_getattr
 
 __all__ = ["get_random_world_background_hdr_img_path_from_haven", "load_AMASS", "load_blend", "load_bop_intrinsics",
            "load_bop_objs", "load_bop_scene", "load_ccmaterials", "load_front3d", "load_haven_mat", "load_ikea",
-           "load_matterport3d", "load_obj", "load_pix3d", "load_replica", "load_scenenet", "load_shapenet",
+           "load_matterport3d", "load_obj", "load_pix3d", "load_replica", "load_replica_segmented_mesh",
+           "load_scenenet", "load_shapenet",
            "load_texture", "load_urdf"]
 
 # BOP's and URDF's loaders pull in hybridgen's BOP module and the URDF stack (~70 ms): imported when first used
-__getattr__ = module_getattr("loader", ["load_replica_segmented_mesh", "load_suncg"],
+__getattr__ = module_getattr("loader", ["load_suncg"],
                              lazy={"load_bop_intrinsics": "loader_bop", "load_bop_objs": "loader_bop",
+                                   "load_replica_segmented_mesh": "loader_replica_segmented",
                                    "load_bop_scene": "loader_bop", "load_urdf": "loader_urdf"}, namespace=globals())
