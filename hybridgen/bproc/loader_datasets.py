@@ -85,14 +85,16 @@ def load_AMASS(data_path: str, sub_dataset_id: str, temp_dir: str | None = None,
 
 
 def load_replica(data_path: str, data_set_name: str, use_smooth_shading: bool = False) -> list[MeshObject]:
-    """``<data_path>/<data_set_name>/mesh.ply`` as :func:`load_obj` reads a PLY (vertex colors as base color),
-    smooth shaded with ``use_smooth_shading``."""
+    """``<data_path>/<data_set_name>/mesh.ply`` as :func:`load_obj` reads a PLY (vertex colors as base color), its
+    file normals cleared (``clear_custom_splitnormals``), smooth shaded with ``use_smooth_shading``."""
     from .loader_object import load_obj
 
     path = os.path.join(resolve_path(data_path), str(data_set_name), "mesh.ply")
     if not os.path.isfile(path):
         raise InputError(f"bproc.loader.load_replica: the Replica mesh does not exist: '{path}'")
     objects = load_obj(path)
+    for obj in objects:  # Replica's file normals are wrong: BlenderProc clears them
+        obj.clear_custom_splitnormals()
     if use_smooth_shading:
         for obj in objects:
             obj.set_shading_mode("SMOOTH")

@@ -121,6 +121,7 @@ def load_obj(filepath: str, cached_objects: dict[str, list[MeshObject]] | None =
     for group in groups:
         pose = group[0].local2world if turn is None else group[0].local2world @ turn
         obj = MeshObject(group[0].name, group, _slots(group, own, default), pose)
+        obj.normals_from_file = any(part.vertex_normals is not None for part in group)
         obj.set_cp("model_path", path)
         objects.append(obj)
     return objects

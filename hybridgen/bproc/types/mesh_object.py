@@ -53,6 +53,8 @@ class MeshObject(Entity, MeshGeometry, MeshEditing, MeshModifiers, RigidBodyMixi
         self.loose_vertices = np.zeros((0, 3))
         """Vertices of no face (a point cloud's points), local frame, m: they count for the bound box only."""
         self._slots: list[Material | None] = list(slots)
+        self.normals_from_file = False
+        """Whether the parts' vertex normals are the file's (Blender's custom split normals; set by the loaders)."""
 
     # --- materials ----------------------------------------------------------------------------------------
     def get_materials(self) -> list[Material | None]:
@@ -169,17 +171,33 @@ class MeshObject(Entity, MeshGeometry, MeshEditing, MeshModifiers, RigidBodyMixi
         shift[:3, 3] = np.linalg.solve(self.get_local2world_mat()[:3, :3], delta)
         self._transform_parts(shift)
 
+    def clear_custom_splitnormals(self) -> None:
+        """Drop the normals read from the file (:attr:`normals_from_file`): the parts that had them shade smooth
+        from their faces, as Blender's importers leave such faces smooth (measured with BlenderProc on bpy 4.2: a
+        PLY with normals loads smooth, one without flat). Normals hybridgen computed (``set_shading_mode``) stay."""
+        if not self.normals_from_file:
+            return
+        for index, part in enumerate(self.parts):
+            if part.vertex_normals is not None:
+                self._shade_part(index, "SMOOTH", 30.0)
+        self.normals_from_file = False
+
     def set_shading_mode(self, mode: str, angle_value: float = 30) -> None:
         """Blender's ``FLAT``, ``SMOOTH`` or ``AUTO`` (smooth up to ``angle_value`` degrees) shading."""
-        for index, part in enumerate(self.parts):
-            try:
-                shaded = shade(part.vertices, part.faces, mode, angle_value, part.uvs, part.vertex_colors)
-            except ValueError as exc:
-                raise InputError(str(exc)) from None
-            twin = copy.copy(part)
-            twin.vertices, twin.faces, twin.vertex_normals = shaded.vertices, shaded.faces, shaded.vertex_normals
-            twin.uvs, twin.vertex_colors = shaded.uvs, shaded.vertex_colors
-            self.parts[index] = twin
+        self.normals_from_file = False
+        for index in range(len(self.parts)):
+            self._shade_part(index, mode, angle_value)
+
+    def _shade_part(self, index: int, mode: str, angle_value: float) -> None:
+        part = self.parts[index]
+        try:
+            shaded = shade(part.vertices, part.faces, mode, angle_value, part.uvs, part.vertex_colors)
+        except ValueError as exc:
+            raise InputError(str(exc)) from None
+        twin = copy.copy(part)  # parts may be shared with duplicates: replaced, not changed
+        twin.vertices, twin.faces, twin.vertex_normals = shaded.vertices, shaded.faces, shaded.vertex_normals
+        twin.uvs, twin.vertex_colors = shaded.uvs, shaded.vertex_colors
+        self.parts[index] = twin
 
     def mesh_as_trimesh(self) -> Any:
         """The local-frame mesh (all parts) as a ``trimesh.Trimesh``."""
@@ -216,7 +234,6 @@ class MeshObject(Entity, MeshGeometry, MeshEditing, MeshModifiers, RigidBodyMixi
     object_mode: Callable[..., Any] = unsupported_method("MeshObject", "object_mode")
     add_geometry_nodes: Callable[..., Any] = unsupported_method("MeshObject", "add_geometry_nodes")
     add_auto_smooth_modifier: Callable[..., Any] = unsupported_method("MeshObject", "add_auto_smooth_modifier")
-    clear_custom_splitnormals: Callable[..., Any] = unsupported_method("MeshObject", "clear_custom_splitnormals")
 
     def scale_uv_coordinates(self, factor: float) -> None:
         """Every UV coordinate times ``factor`` (above 1 the texture looks smaller on the object)."""
