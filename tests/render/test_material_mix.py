@@ -116,3 +116,16 @@ def test_path_traced_mix_is_the_weighted_sum_of_renders(jit_variant: str, mode: 
     ours = _render(mixed, jit_variant).mean((0, 1))
     np.testing.assert_allclose(ours, expected, rtol=0.02, atol=2e-3)
     assert np.abs(ours - _render(matte, jit_variant).mean((0, 1))).max() > 0.05  # the mix shows
+
+
+def test_a_mirror_in_a_mix_is_one_line(jit_variant: str) -> None:
+    """The path kernel treats singular (mirror-smooth metal or glass) surfaces by their own BSDF; inside a blend it
+    cannot tell them, so such a mix is refused rather than rendered wrong."""
+    import mitsuba as mi
+
+    from hybridgen.render.pathtrace.mitsuba_materials import bsdf_dict
+
+    mi.set_variant(jit_variant)
+    mirror = Material(name="mirror", base_color=BLUE, metallic=1.0, roughness=0.0)
+    with pytest.raises(InputError, match="'mirror' has a mirror-smooth metal or glass surface"):
+        bsdf_dict(Material(name="m", mixes=(MaterialMix.of_mode(mirror, "mix", 0.5),)), "square")

@@ -33,10 +33,8 @@ def may_be_singular(material: Material) -> bool:
     guarantees that :func:`is_singular` is false on every lane the material's BSDF is hit; True may be
     conservative. Values are compared as the BSDF holds and the kernel compares them, in float32 (1 - 1e-9 is 1
     there)."""
-    if material.mixes:  # any of the mixed materials (the blend's pick may land on it)
-        from ...scene.material_mix import components
-
-        return any(may_be_singular(part) for part, weight in components(material) if weight > 0)
+    if material.mixes:  # a mix with such a material is refused (render/pathtrace/material_mixes.py)
+        return False
     f32 = np.float32
     metal_or_glass = f32(material.metallic) >= 1 or material.metallic_texture is not None or \
         f32(material.transmission) >= 1

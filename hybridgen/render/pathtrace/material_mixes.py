@@ -19,9 +19,13 @@ BLACK = {"type": "twosided", "material": {"type": "diffuse", "reflectance": {"ty
 def checked_components(material: Material, owner: str) -> list[tuple[Material, float]]:
     """:func:`~hybridgen.scene.material_mix.components` of ``material``; one line for a component hybridgen cannot
     mix yet."""
+    from .lobe_tests import may_be_singular
+
     parts = components(material)
     for part, _ in parts:
         reason = unsupported_in_mix(part)
+        if reason is None and may_be_singular(part):  # the path kernel tells singular surfaces by their own BSDF
+            reason = "a mirror-smooth metal or glass surface (roughness at most the singular threshold)"
         if reason is not None:
             raise InputError(f"object '{owner}': material '{material.name}' mixes materials (infuse_material), and "
                              f"'{part.name}' has {reason}: mixing that is not supported by hybridgen yet")

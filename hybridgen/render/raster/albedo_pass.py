@@ -131,16 +131,16 @@ class AlbedoPass:
                 per_vertex(obj.vertex_colors, "3f", "in_color")
             vao = ctx.vertex_array(self.program, content, index_buffer=gpu.indices, index_element_size=4)
             self._resources.append(vao)
-            self._draws.extend((vao, texture, alpha, part, weight, first == 0)
-                               for first, (texture, alpha, part, weight) in enumerate(draws))
+            self._draws.extend((vao, texture, alpha, part, weight, position == 0)
+                               for position, (texture, alpha, part, weight) in enumerate(draws))
         self._fbos: dict[tuple[int, int], Any] = {}  # one per image size (labels, supersampled guides)
 
-    def _texture(self, image: np.ndarray | None, components: int, internal_format: int | None = None) -> Any:
+    def _texture(self, image: np.ndarray | None, channels: int, internal_format: int | None = None) -> Any:
         """A repeating GL texture of a bottom-up uint8 image (None for none), released with the pass."""
         if image is None:
             return None
         extra = {} if internal_format is None else {"internal_format": internal_format}
-        texture = self.view.ctx.texture((image.shape[1], image.shape[0]), components, image.tobytes(), **extra)
+        texture = self.view.ctx.texture((image.shape[1], image.shape[0]), channels, image.tobytes(), **extra)
         texture.repeat_x = texture.repeat_y = True
         self._resources.append(texture)
         return texture
