@@ -5,15 +5,15 @@ one of its textures) read as sRGB unless the scene's texture of that path is tag
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
 
 from ..errors import ConfigError
-from ..scene.dust import DATA_SPACES, SRGB_SPACES, Dust, finite_number, reads_as_srgb
+from ..scene.dust import Dust, finite_number
 from ..scene.image_texture import ImageTexture
 from ..scene.material import Material
+from .drawn_texture import drawn_texture
 
 KEYS = ("strength", "texture_scale", "texture")
 
@@ -32,22 +32,9 @@ def dust_layer(value: dict[str, Any], rng: np.random.Generator, textures: Sequen
     unknown = sorted(set(value) - set(KEYS))
     if unknown:
         raise ConfigError(f"unknown key(s) {unknown} (known: {', '.join(KEYS)})", key="dust")
-    texture = value.get("texture")
-    if isinstance(texture, (list, tuple)):
-        if not texture:
-            raise ConfigError("is an empty list of textures", key="dust.texture")
-        texture = texture[int(rng.integers(len(texture)))]
-    srgb = True
-    if texture is not None:
-        path = Path(str(texture))
-        if not path.is_file():
-            raise ConfigError(f"no such image file: {path}", key="dust.texture")
-        spaces = [t.colorspace for t in textures if Path(t.path).resolve() == path.resolve()] or ["sRGB"]
-        read = reads_as_srgb(spaces[0])
-        if read is None:
-            raise ConfigError(f"a dust texture in color space {spaces[0]!r} is not supported (supported: "
-                              f"{', '.join(SRGB_SPACES + DATA_SPACES)})", key="dust.texture")
-        srgb, texture = read, str(path)
+    drawn = drawn_texture(value.get("texture"), rng, textures, "dust.texture", "is an empty list of textures",
+                          "a dust texture")
+    texture, srgb = drawn if drawn is not None else (None, True)
     return Dust(_number(value["strength"], "strength"), _number(value.get("texture_scale", 0.1), "texture_scale"),
                 texture, srgb)
 
