@@ -14,6 +14,7 @@ from hybridgen.render.raster.albedo_pass import AlbedoPass
 from hybridgen.render.tonemap import srgb_decode
 from hybridgen.scene.color_layer import BLEND_OF_MODE, ColorLayer, apply_layer, blend_channel
 from hybridgen.scene.gradient_noise import NUMPY
+from tests.render.test_dust_albedo import _hits
 
 SIZE = (128, 96)
 BASE = np.array([0.1, 0.7, 0.45])
@@ -87,11 +88,7 @@ def _square(material: hg.Material) -> hg.Scene:
 
 def _uv_of_pixels(scene: hg.Scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(u, v, inside) of each pixel centre's ray on the square z = 0 (UV = (xy + 1) / 2)."""
-    intr, pose = scene.camera.intrinsics, scene.camera.keypoints[0]
-    v, u = np.mgrid[0:intr.height, 0:intr.width].astype(np.float64)
-    rays = np.stack([u, v, np.ones_like(u)], -1) @ np.linalg.inv(intr.K).T @ pose[:3, :3].T
-    t = -pose[2, 3] / rays[..., 2]
-    x, y = pose[0, 3] + t * rays[..., 0], pose[1, 3] + t * rays[..., 1]
+    x, y, _ = _hits(scene)
     return (x + 1) / 2, (y + 1) / 2, (np.abs(x) < 0.98) & (np.abs(y) < 0.98)
 
 
