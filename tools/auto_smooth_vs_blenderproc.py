@@ -10,7 +10,6 @@ Needs the BlenderProc venv (``tools/blenderproc_reference.py setup``).
 from __future__ import annotations
 
 import json
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -26,18 +25,14 @@ BLENDER_SIDE = '''
 import blenderproc as bproc
 import bpy, json, sys
 import numpy as np
+sys.path.insert(0, sys.argv[3])
+from auto_smooth_vs_blenderproc import apply_steps
 bproc.init()
 out = {}
 for case in sys.argv[2].split(","):
     bpy.ops.mesh.primitive_cylinder_add(vertices=8)
     obj = bproc.types.MeshObject(bpy.context.object)
-    for step in case.split("+"):
-        if step in ("smooth", "flat"):
-            obj.set_shading_mode(step.upper())
-        elif step.startswith("mod"):
-            obj.add_auto_smooth_modifier(angle=float(step[3:]))
-        else:
-            obj.set_shading_mode("AUTO", float(step[4:]))
+    apply_steps(obj, case)
     mesh = obj.blender_obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).to_mesh()
     corner = np.array([c.vector[:] for c in mesh.corner_normals])
     face = np.array([p.normal[:] for p in mesh.polygons])
@@ -46,6 +41,18 @@ for case in sys.argv[2].split(","):
     out[case] = float(np.degrees(np.arccos(np.clip((corner * face[owner]).sum(1), -1, 1)))[side].max())
 json.dump(out, open(sys.argv[1], "w"))
 '''
+
+
+def apply_steps(obj: Any, steps: str) -> None:
+    """Shade a ``bproc`` mesh object (either engine's: the same calls) by ``steps``: ``+``-joined ``smooth``,
+    ``flat``, ``mod<angle>`` (``add_auto_smooth_modifier``) and ``auto<angle>`` (``set_shading_mode("AUTO")``)."""
+    for step in steps.split("+"):
+        if step in ("smooth", "flat"):
+            obj.set_shading_mode(step.upper())
+        elif step.startswith("mod"):
+            obj.add_auto_smooth_modifier(angle=float(step[3:]))
+        else:
+            obj.set_shading_mode("AUTO", float(step[4:]))
 
 
 def side_deviation(obj: Any) -> float:
@@ -67,23 +74,20 @@ def side_deviation(obj: Any) -> float:
 def main() -> None:
     work = Path(tempfile.mkdtemp(prefix="auto-smooth-"))
     (work / "main.py").write_text(BLENDER_SIDE)
-    status = execute(reference_invocation("main.py", [str(work / "blender.json"), ",".join(STEPS)], root=work),
+    status = execute(reference_invocation("main.py", [str(work / "blender.json"), ",".join(STEPS),
+                                                      str(Path(__file__).resolve().parent)], root=work),
                      log=work / "blenderproc.log")
     if status != 0 and not (work / "blender.json").exists():
         sys.exit(f"BlenderProc failed ({status}); see {work / 'blenderproc.log'}")
     blender = json.loads((work / "blender.json").read_text())
-    probe = subprocess.run([sys.executable, "-c", (
-        "import json, sys; sys.path.insert(0, 'tools'); import hybridgen.bproc as bproc; "
-        "from auto_smooth_vs_blenderproc import side_deviation; out = {}\n"
-        f"for case in {list(STEPS)!r}:\n"
-        "    bproc.init() if not out else None; c = bproc.object.create_primitive('CYLINDER', vertices=8)\n"
-        "    for step in case.split('+'):\n"
-        "        if step in ('smooth', 'flat'): c.set_shading_mode(step.upper())\n"
-        "        elif step.startswith('mod'): c.add_auto_smooth_modifier(angle=float(step[3:]))\n"
-        "        else: c.set_shading_mode('AUTO', float(step[4:]))\n"
-        "    out[case] = side_deviation(c)\n"
-        "print(json.dumps(out))")], capture_output=True, text=True, cwd=Path(__file__).resolve().parents[1])
-    ours = json.loads(probe.stdout.strip().splitlines()[-1])
+    import hybridgen.bproc as bproc
+
+    bproc.init()
+    ours = {}
+    for case in STEPS:
+        cylinder = bproc.object.create_primitive("CYLINDER", vertices=8)
+        apply_steps(cylinder, case)
+        ours[case] = side_deviation(cylinder)
     print(f"{'steps':16s} {'Blender 4.2':>12s} {'hybridgen':>10s}")
     for case in STEPS:
         print(f"{case:16s} {blender[case]:12.2f} {ours[case]:10.2f}")

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from tools.auto_smooth_vs_blenderproc import STEPS, side_deviation
+from tools.auto_smooth_vs_blenderproc import STEPS, apply_steps, side_deviation
 from writer_session import bproc  # noqa: F401 - the fixture
 
 CASES = {"smooth+mod30": 0.0, "mod30+smooth": 0.0, "auto60": 22.5, "mod30+auto60": 0.0, "auto60+auto30": 0.0,
@@ -22,11 +22,5 @@ def test_the_table_is_the_tools() -> None:
 @pytest.mark.parametrize("steps, expected", CASES.items())
 def test_smooth_by_angle(bproc, steps: str, expected: float) -> None:  # noqa: F811
     cylinder = bproc.object.create_primitive("CYLINDER", vertices=8)
-    for step in steps.split("+"):
-        if step in ("smooth", "flat"):
-            cylinder.set_shading_mode(step.upper())
-        elif step.startswith("mod"):
-            cylinder.add_auto_smooth_modifier(angle=float(step[3:]))
-        else:
-            cylinder.set_shading_mode("AUTO", float(step[4:]))
+    apply_steps(cylinder, steps)
     assert side_deviation(cylinder) == pytest.approx(expected, abs=0.1)
