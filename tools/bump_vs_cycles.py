@@ -19,7 +19,9 @@ hybridgen renders the plane white-gray (Lambertian, albedo :data:`ALBEDO`) under
 from :data:`TOWARDS_SUN` with direct light only: a pixel's radiance is ALBEDO / pi x SUN x (n . l), so it shows
 the shading normal n along l. Printed: Cycles' tilt of the normal, and hybridgen's radiance over the radiance of
 Cycles' normal per pixel (median and the largest deviation), for the height hybridgen reads now (the color's
-linear luminance, ``displacement_from_color``) and before (the image's first channel as data). ``--store`` writes
+linear luminance, ``displacement_from_color``) and before (the image's first channel as data). ``--orientation``
+turns the whole scene so that the plane faces -y or +x (:data:`ORIENTATIONS`): Cycles dots the linked scalar with
+the normal, so facing -y its bumps are inverted (hybridgen/render/pathtrace/linked_height.py). ``--store`` writes
 a table of pixels (row, column, Cycles' normal) that tests/render/test_bump_from_color.py checks hybridgen
 against (:func:`build_scene` rebuilds this scene there).
 """
@@ -44,6 +46,12 @@ DISTANCE = 10.0  # m, camera height
 ALBEDO, SUN = 0.5, 3.0  # hybridgen's plane: Lambertian albedo, sun irradiance (W m^-2)
 TOWARDS_SUN = (0.45, 0.35, 0.82)
 STORED_PIXELS = 160
+ORIENTATIONS = {"up": np.eye(3),
+                "minus_y": np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]]),
+                "plus_x": np.array([[0.0, 0, 1], [0, 1, 0], [-1, 0, 0]])}
+"""Rotations (world from the plane's frame) of the whole scene - plane, camera, sun - so that the plane faces +z,
+-y or +x. Cycles dots a scalar linked to the displacement with the normal (hybridgen/render/pathtrace/
+linked_height.py): facing -y the bump is inverted, facing +x it is the upward plane's."""
 FOOTPRINT_STEPS = np.array([[1.0, -1.0], [1.0, 1.0]]) / np.sqrt(2.0)
 """Where Cycles 4.2 takes a bump's height differences, per unit of the pixel footprint (in x, y on the plane): one
 footprint away along two diagonals of the surface, forward (fitted here on 64 x 48 pixels: rms 2e-4 in slope)."""
@@ -65,12 +73,16 @@ def plane() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     return vertices, np.array([[0, 1, 2], [0, 2, 3]]), np.tile([0.0, 0.0, 1.0], (4, 1)), uvs
 
 
-def build_scene(factor: float, from_color: bool = True) -> Any:
+def build_scene(factor: float, from_color: bool = True, orientation: str = "up") -> Any:
     """hybridgen's plane with :func:`color_texture` as displacement (``from_color``: read as Blender reads a linked
-    color; else its first channel as data), its sun and its camera (pixel centres as in Cycles' render)."""
+    color; else its first channel as data), its sun and its camera (pixel centres as in Cycles' render), all
+    turned by :data:`ORIENTATIONS` ``[orientation]``."""
     import hybridgen as hg
 
+    turn = np.eye(4)
+    turn[:3, :3] = ORIENTATIONS[orientation]
     vertices, faces, _, uvs = plane()
+    vertices = vertices @ turn[:3, :3].T
     material = hg.Material(name="bumped", base_color=(ALBEDO, ALBEDO, ALBEDO, 1.0), specular=0.0,
                            displacement_texture=color_texture(), displacement_scale=factor,
                            displacement_from_color=from_color)
@@ -82,12 +94,12 @@ def build_scene(factor: float, from_color: bool = True) -> Any:
     x /= np.linalg.norm(x)
     pose = np.eye(4)
     pose[:3, :3] = np.stack([x, np.cross(z, x), z], axis=1)  # a SUN shines along its -z
-    scene.add_light(hg.Light("sun", "SUN", energy=SUN, local2world=pose))
+    scene.add_light(hg.Light("sun", "SUN", energy=SUN, local2world=turn @ pose))
     width, height = RESOLUTION
     f = width * DISTANCE / PLANE[0]
     scene.camera.intrinsics = hg.Intrinsics(np.array([[f, 0, (width - 1) / 2], [0, f, (height - 1) / 2], [0, 0, 1]]),
                                             width, height, clip_start=0.01)
-    scene.camera.add_keypoint(np.array([[1.0, 0, 0, 0], [0, -1, 0, 0], [0, 0, -1, DISTANCE], [0, 0, 0, 1]]))
+    scene.camera.add_keypoint(turn @ np.array([[1.0, 0, 0, 0], [0, -1, 0, 0], [0, 0, -1, DISTANCE], [0, 0, 0, 1]]))
     return scene
 
 
@@ -100,23 +112,27 @@ def render_hybridgen(scene: Any, samples: int = 16) -> np.ndarray:
     return np.asarray(view.render(scene.camera.keypoints[0], seed=1), np.float64)
 
 
-def lambert(normals: np.ndarray) -> np.ndarray:
-    """Radiance of the Lambertian plane under the sun at shading normals ``normals`` (... x 3)."""
-    light = np.asarray(TOWARDS_SUN, float) / np.linalg.norm(TOWARDS_SUN)
+def lambert(normals: np.ndarray, orientation: str = "up") -> np.ndarray:
+    """Radiance of the Lambertian plane under the sun at shading normals ``normals`` (... x 3, world axes of the
+    scene turned to ``orientation``)."""
+    light = ORIENTATIONS[orientation] @ (np.asarray(TOWARDS_SUN, float) / np.linalg.norm(TOWARDS_SUN))
     return ALBEDO / math.pi * SUN * np.maximum(normals @ light, 0.0)
 
 
-def render_cycles(factor: float, work: Path) -> dict[str, np.ndarray]:
-    """Cycles' Normal and UV passes (H x W x 3 / x 2 float) of the plane (tools/bump_cycles.py)."""
+def render_cycles(factor: float, work: Path, orientation: str = "up") -> dict[str, np.ndarray]:
+    """Cycles' Normal and UV passes (H x W x 3 / x 2 float; normals in world axes) of the plane turned to
+    ``orientation`` (tools/bump_cycles.py)."""
     from PIL import Image
 
     from blender_side import exr_passes, run_blender_side
 
+    turn = np.eye(4)
+    turn[:3, :3] = ORIENTATIONS[orientation]
     vertices, faces, normals, uvs = plane()
-    np.savez(work / "scene.npz", **{"plane.vertices": vertices, "plane.faces": faces, "plane.normals": normals,
-                                     "plane.uvs": uvs})
+    np.savez(work / "scene.npz", **{"plane.vertices": vertices @ turn[:3, :3].T, "plane.faces": faces,
+                                     "plane.normals": normals @ turn[:3, :3].T, "plane.uvs": uvs})
     Image.fromarray(color_texture()).save(work / "texture.png")
-    matrix = np.array([[1.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, DISTANCE], [0, 0, 0, 1]])  # looks along -z
+    matrix = turn @ np.array([[1.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, DISTANCE], [0, 0, 0, 1]])  # looks along -z
     spec = {"texture": str(work / "texture.png"), "factor": factor, "resolution": list(RESOLUTION),
             "camera": {"matrix_world": matrix.tolist(), "lens": 36.0 * DISTANCE / PLANE[0]}}
     (work / "spec.json").write_text(json.dumps(spec))
@@ -150,25 +166,29 @@ def stored_pixels(normals: np.ndarray, uvs: np.ndarray) -> list[list[float]]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--factor", type=float, default=0.3, help="BlenderProc's multiply_factor (m)")
+    parser.add_argument("--orientation", choices=sorted(ORIENTATIONS), default="up",
+                        help="the way the plane faces (the scene turned by ORIENTATIONS)")
     parser.add_argument("--store", type=Path, default=None, help="write Cycles' normals at sampled pixels")
     ns = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="bump-") as temp:
-        cycles = render_cycles(ns.factor, Path(temp))
+        cycles = render_cycles(ns.factor, Path(temp), ns.orientation)
     normals = cycles["Normal"]
     inside = np.zeros(normals.shape[:2], bool)
     inside[1:-1, 1:-1] = True
     cell = one_cell(cycles["UV"])
-    tilt = np.degrees(np.arccos(np.clip(normals[inside][:, 2], -1.0, 1.0)))
+    facing = normals @ ORIENTATIONS[ns.orientation][:, 2]
+    tilt = np.degrees(np.arccos(np.clip(facing[inside], -1.0, 1.0)))
     print(f"Cycles' bumped normals: tilt median {np.median(tilt):.2f} deg, max {tilt.max():.2f} deg "
           f"({inside.sum()} pixels, {cell.sum()} with their bump differences in one texel cell)")
-    expected = lambert(normals)
+    expected = lambert(normals, ns.orientation)
     for label, from_color in (("now (linear luminance)", True), ("before (first channel)", False)):
-        ratio = render_hybridgen(build_scene(ns.factor, from_color)).mean(-1) / expected
+        ratio = render_hybridgen(build_scene(ns.factor, from_color, ns.orientation)).mean(-1) / expected
         print(f"hybridgen {label:24s} radiance / Cycles' normal's: median {np.median(ratio[inside]):.4f}, "
               f"max |ratio - 1| {np.abs(ratio[inside] - 1).max():.4f}; one-cell pixels "
               f"{np.abs(ratio[cell] - 1).max():.4f}")
     if ns.store:
-        table = {"factor": ns.factor, "resolution": list(RESOLUTION), "pixels": stored_pixels(normals, cycles["UV"])}
+        table = {"factor": ns.factor, "resolution": list(RESOLUTION), "orientation": ns.orientation,
+                 "pixels": stored_pixels(normals, cycles["UV"])}
         rows = ",\n  ".join(json.dumps(pixel) for pixel in table.pop("pixels"))
         ns.store.write_text(json.dumps(table)[:-1] + f', "pixels": [\n  {rows}\n]}}\n')
         print(f"stored {ns.store}")

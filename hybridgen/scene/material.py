@@ -50,7 +50,9 @@ class Material:
       (:mod:`hybridgen.scene.displacement`, EntityManipulator ``displace``).
     - ``displacement_from_color``: ``displacement_texture`` is a color image (sRGB, a base color's) whose height is
       the Rec.709 luminance of its linear color, as Blender reads an image's Color linked to the displacement
-      (:func:`hybridgen.render.material_textures.color_height`); otherwise its first channel, as data.
+      (:func:`hybridgen.render.material_textures.color_height`), times N.x + N.y + N.z of the world shading
+      normal, as Cycles dots a scalar linked to the output's Displacement with it (a surface facing -y bumps
+      inside out: :mod:`hybridgen.render.pathtrace.linked_height`); otherwise its first channel, as data.
     - ``emission_hidden_from_camera``: the emission lights the scene but the camera does not see it - camera
       rays see the surface's BSDF without emission, every other ray sees the emission alone (a black
       emitter). What BlenderProc's ``make_emissive`` builds (a Light Path "Is Camera Ray" mix), used for

@@ -16,7 +16,8 @@ The BSDF is built inside out:
 - ``bumpmap`` for a displacement map: shading normals of the surface displaced by h x scale metres (the
   texture's gradient with respect to UV times ``displacement_scale``; the 0.5 mid level of Blender's node
   does not change a gradient; a color image linked as height, ``displacement_from_color``, is its linear
-  luminance, :func:`~hybridgen.render.material_textures.color_height`);
+  luminance, :func:`~hybridgen.render.material_textures.color_height`, times N.x + N.y + N.z, as Cycles dots a
+  scalar link with the normal: :mod:`.linked_height`);
 - both without Mitsuba's default bump-terminator shadowing (Estevez et al. 2019), so a mapped normal shades
   exactly as the analytic tilted normal (Cycles softens diffuse closures with Chiang et al. 2019's term
   instead: the two differ only where light grazes the geometric surface);
@@ -44,6 +45,7 @@ from ...scene.material import ALPHA_MODES, Material
 from .glossy_filter import filtered_roughness
 from .lobe_sampling import principled_sampling_rates
 from ..material_textures import color_height, data_image
+from .linked_height import linked
 
 
 def rgb(value: Any) -> dict[str, Any]:
@@ -239,10 +241,13 @@ def bsdf_dict(material: Material, owner: str, *, vertex_colors: bool = False, uv
                                           invert_green=material.normal_y_down)}
     if material.displacement_texture is not None and material.displacement_scale != 0:
         height = material.displacement_texture
-        if material.displacement_from_color:
-            height = color_height(height, owner, "displacement_texture")
+        if material.displacement_from_color:  # a color (scalar) linked straight to the output: Cycles' N-dot
+            height = linked(data_texture(color_height(height, owner, "displacement_texture"), owner,
+                                         "displacement_texture"))
+        else:
+            height = data_texture(height, owner, "displacement_texture")
         bsdf = {"type": "bumpmap", "bsdf": bsdf, "scale": float(material.displacement_scale),
-                "use_shadowing_function": False, "arbitrary": data_texture(height, owner, "displacement_texture")}
+                "use_shadowing_function": False, "arbitrary": height}
     if material.transmission == 0 and not (blender and bsdf_is_plugin(bsdf)):
         # Mitsuba's opaque BSDFs are one-sided; Blender (and real meshes with mixed windings) need both sides.
         bsdf = {"type": "twosided", "material": bsdf}
