@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import InputError
+from ..scene.material import TEXTURE_SLOTS
 from .bpy_standin import Image
 from .session import SESSION
 from .types import Material, MeshObject
@@ -68,11 +69,12 @@ def _emits(material: Material) -> bool:
 
 
 def _has_png_image(material: Material) -> bool:
+    """Whether an image node of ``material``'s tree shows a .png (BlenderProc tests ``'.png' in image.name``):
+    every image input (:data:`~hybridgen.scene.material.TEXTURE_SLOTS`) and the infused images; not dust's, whose
+    nodes sit in a node group BlenderProc's loop does not enter."""
     mat = material.blender_obj
-    paths = [getattr(mat, slot) for slot in ("base_color_texture", "roughness_texture", "metallic_texture",
-                                             "alpha_texture", "normal_texture", "specular_texture",
-                                             "emission_texture")]
-    return any(isinstance(path, str) and ".png" in Path(path).name for path in paths)
+    paths = [getattr(mat, slot) for slot in TEXTURE_SLOTS] + [layer.texture for layer in mat.base_color_layers]
+    return any(isinstance(path, (str, Path)) and ".png" in Path(path).name for path in paths)
 
 
 def change_to_texture_less_render(use_alpha_channel: bool) -> None:

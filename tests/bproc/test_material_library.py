@@ -58,6 +58,21 @@ def test_texture_less_render(bproc, tmp_path) -> None:  # noqa: F811
     assert textured.get_materials()[0].blender_obj.base_color_texture is None
 
 
+def test_texture_less_render_finds_a_png_in_any_image_node(bproc, tmp_path) -> None:  # noqa: F811
+    """BlenderProc copies TextureLess for a material with a .png in any image node: a displacement map or an
+    infused image counts as a base color does; a .jpg does not."""
+    Image.new("RGBA", (4, 4), (10, 20, 30, 128)).save(tmp_path / "bumps.png")
+    Image.new("RGB", (4, 4), (10, 20, 30)).save(tmp_path / "wood.jpg")
+    bumped, infused, jpg = (bproc.object.create_primitive("CUBE") for _ in range(3))
+    bumped.new_material("bumped").blender_obj.displacement_texture = str(tmp_path / "bumps.png")
+    infused.new_material("infused").infuse_texture(bproc.loader.load_texture(str(tmp_path / "bumps.png"))[0], "set")
+    jpg.new_material("jpg").set_principled_shader_value("Base Color", bproc.loader.load_texture(
+        str(tmp_path / "wood.jpg"))[0].image)
+    bproc.material.change_to_texture_less_render(use_alpha_channel=True)
+    names = [obj.get_materials()[0].get_name() for obj in (bumped, infused, jpg)]
+    assert names == ["TextureLess.001", "TextureLess.002", "TextureLess"]
+
+
 def test_scale_uv_coordinates(bproc) -> None:  # noqa: F811
     plane = bproc.object.create_primitive("PLANE")
     twin = plane.duplicate()
