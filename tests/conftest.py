@@ -1,7 +1,9 @@
 """Shared fixtures. The GL context is the real EGL one (llvmpipe here); without it the render tests fail
-with the setup message rather than pass silently."""
+with the setup message rather than pass silently. BlenderProc runs keep the Standard view in every test, whether
+or not Blender's color tables are installed (tests/render/test_filmic_view.py reads them itself)."""
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Callable, Iterator
 
@@ -12,6 +14,7 @@ import hybridgen as hg
 from hybridgen.cli import main as cli_main
 
 REPO = Path(__file__).resolve().parents[1]
+os.environ["HYBRIDGEN_BLENDER_COLORMANAGEMENT"] = ""  # hybridgen/render/filmic_view.py: no tables, Standard view
 
 
 @pytest.fixture(scope="session")

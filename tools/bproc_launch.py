@@ -10,7 +10,7 @@ PYTHONPATH, ``USE_EXTERNAL_BPY_MODULE=1``) and needs nothing of hybridgen; ``hyb
 ``bproc.renderer.render()``, just before it renders, so they win over the script's own settings:
 
 - ``--samples N``, ``--noise-threshold X`` (0: no adaptive sampling), ``--no-denoiser``: a converged reference;
-- ``--view-transform NAME`` (BlenderProc only; hybridgen always renders Blender's ``Standard`` view);
+- ``--view-transform NAME``: both engines' view (``Standard`` for pixel comparisons of linear light);
 - ``--add-labels``: the outputs the script did not enable among depth (``activate_antialiasing=False``, unless
   it asked for distance), normals and instance segmentation mapped by ``instance`` and ``name``
   (``instance_segmaps`` and ``instance_attribute_maps``), for pixel and per-object comparisons;
@@ -222,7 +222,7 @@ def apply_overrides(engine: Any, ns: argparse.Namespace, spent: dict[str, float]
             renderer.set_noise_threshold(ns.noise_threshold)
         if ns.no_denoiser:
             renderer.set_denoiser(None)
-        if ns.view_transform is not None and ns.engine == "blenderproc":
+        if ns.view_transform is not None:
             renderer.set_output_format(view_transform=ns.view_transform)
         if ns.add_labels:
             add_labels(renderer, engine.enabled_outputs())

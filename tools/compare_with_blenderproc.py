@@ -8,8 +8,8 @@ own output folder. Both engines run the unchanged script from the same extracted
 blenderproc_reference.py; make its venv first with ``tools/blenderproc_reference.py setup``) through
 tools/bproc_launch.py, with ``BLENDER_PROC_RANDOM_SEED=1`` and, on both, two additions: the label outputs the script
 does not enable itself among depth, normals and instance segmentation by ``instance`` and ``name`` (the pixels, ids
-and per-object regions compared; the layout row then lists these keys too), and BlenderProc's view transform set to
-``Standard`` (hybridgen's colors are the Standard sRGB view; BlenderProc 2.8 defaults to Filmic).
+and per-object regions compared; the layout row then lists these keys too), and both engines' view transform set to
+``Standard`` (BlenderProc 2.8 defaults to Filmic, which tools/filmic_vs_blender.py compares on its own).
 
 Rows (units: m, degrees, pixels):
 

@@ -8,10 +8,13 @@ Per output kind (``SESSION.renderer.outputs``) and the color key:
   along each pixel's ray.
 - ``normals``: float32 (H, W, 3), Blender camera axes (x right, y up, z backwards), ``0.5 n + 0.5``; 0.5 on the
   background.
-- ``diffuse``: uint8 (H, W, 3) sRGB of Cycles' Diffuse Color pass (hybridgen's ``diffuse_color`` pass at pixel
-  centres; Cycles averages a pixel's samples); 0 on the background, as in Cycles.
+- ``diffuse``: uint8 (H, W, 3) of Cycles' Diffuse Color pass (hybridgen's ``diffuse_color`` pass at pixel
+  centres; Cycles averages a pixel's samples) through the colors' view transform, as Blender writes it (measured:
+  Filmic changes BlenderProc's diffuse PNG as it changes the colors); 0 on the background, as in Cycles.
 - ``segmentation``: :func:`hybridgen.bproc.segmentation.map_frame`'s keys.
-- colors: uint8 (H, W, 3) sRGB (Standard view); ``color_depth`` 16: uint16 of the linear float16 render; file
+- colors: uint8 (H, W, 3) through the view transform (:mod:`hybridgen.bproc.view_transform`: Filmic, BlenderProc's
+  default, from Blender's tables where installed, else Standard sRGB); ``color_depth`` 16: uint16 of the linear
+  float16 render through the same view; file
   format JPEG: the 8-bit image after a JPEG round trip at ``jpg_quality`` (what BlenderProc loads back from its
   ``.jpg``; Blender and hybridgen both keep full chroma above quality 90). With ``alpha`` (Cycles' transparent
   film) a fourth channel: full where a surface covers the pixel centre, 0 where the camera ray meets only the
@@ -31,6 +34,7 @@ import numpy as np
 from ..scene.frames import blender_to_opencv
 from .segmentation import map_frame
 from .session import SESSION
+from .view_transform import STANDARD, ColorEncoding
 
 BACKGROUND_DEPTH = 1e10
 """Cycles' Z pass where a pixel sees no surface (m)."""
@@ -44,12 +48,10 @@ def _with_alpha(colors: np.ndarray, background: np.ndarray) -> np.ndarray:
     return rgba
 
 
-def _colors(values: dict[str, Any]) -> np.ndarray:
+def _colors(values: dict[str, Any], encoding: ColorEncoding) -> np.ndarray:
     settings = SESSION.renderer
     if settings.color_depth == 16 and "colors_hdr" in values:
-        from ..render.tonemap import to_srgb16
-
-        return to_srgb16(np.asarray(values["colors_hdr"], dtype=np.float32)[..., :3])
+        return encoding.to_uint16(np.asarray(values["colors_hdr"], dtype=np.float32)[..., :3])
     colors = np.asarray(values["colors"], dtype=np.uint8)[..., :3]
     if settings.file_format == "JPEG":
         from PIL import Image
@@ -61,10 +63,9 @@ def _colors(values: dict[str, Any]) -> np.ndarray:
 
 
 def _convert_eye(values: dict[str, Any], table: np.ndarray, cam2world: np.ndarray, meshes: Sequence[Any],
-                 ray_lengths: np.ndarray, alpha: bool) -> dict[str, Any]:
+                 ray_lengths: np.ndarray, alpha: bool, encoding: ColorEncoding) -> dict[str, Any]:
     """One eye's values -> BlenderProc's values by output kind (``colors``: the color image)."""
     from ..io.hdf5_blenderproc import encode_normals
-    from ..render.tonemap import to_srgb8
 
     outputs = SESSION.renderer.outputs
     converted: dict[str, Any] = {}
@@ -83,11 +84,11 @@ def _convert_eye(values: dict[str, Any], table: np.ndarray, cam2world: np.ndarra
             normals[background] = 0.5
             converted[kind] = normals
         elif kind == "diffuse":
-            converted[kind] = to_srgb8(np.asarray(values["diffuse_color"])[..., :3])
+            converted[kind] = encoding.to_uint8(np.asarray(values["diffuse_color"])[..., :3])  # as the colors
         elif kind == "segmentation":
             converted[kind] = map_frame(instances, options["map_by"], options["default_values"], meshes)
     if "colors" in values:
-        converted["colors"] = _colors(values)
+        converted["colors"] = _colors(values, encoding)
         if alpha:
             converted["colors"] = _with_alpha(converted["colors"], background)
     return converted
@@ -113,10 +114,12 @@ def _merge_eyes(left: dict[str, Any], right: dict[str, Any]) -> dict[str, Any]:
 
 
 def convert_frame(values: dict[str, Any], table: np.ndarray, cam2world: np.ndarray, meshes: Sequence[Any],
-                  ray_lengths: np.ndarray, stereo: bool, alpha: bool = False) -> dict[str, Any]:
+                  ray_lengths: np.ndarray, stereo: bool, alpha: bool = False,
+                  encoding: ColorEncoding = STANDARD) -> dict[str, Any]:
     """One frame's values (stereo: each with a leading axis of 2) -> BlenderProc's values by output kind;
-    ``alpha``: RGBA colors (transparent film)."""
+    ``alpha``: RGBA colors (transparent film); ``encoding``: the view transform of 16-bit colors (8-bit colors come
+    encoded by the color producer)."""
     if not stereo:
-        return _convert_eye(values, table, cam2world, meshes, ray_lengths, alpha)
+        return _convert_eye(values, table, cam2world, meshes, ray_lengths, alpha, encoding)
     eyes = [{key: value[eye] for key, value in values.items()} for eye in (0, 1)]
-    return _merge_eyes(*(_convert_eye(eye, table, cam2world, meshes, ray_lengths, alpha) for eye in eyes))
+    return _merge_eyes(*(_convert_eye(eye, table, cam2world, meshes, ray_lengths, alpha, encoding) for eye in eyes))

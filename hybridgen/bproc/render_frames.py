@@ -9,8 +9,9 @@ color with :func:`hybridgen.render_color`, labels alone with :func:`hybridgen.re
 The result is ``{key: [one value per frame]}`` with BlenderProc's keys, dtypes, axes and encodings, in the order
 the outputs were enabled and ``colors`` (the ``output_key``) last:
 
-- ``colors``: uint8 (H, W, 3), sRGB (hybridgen's Standard view; BlenderProc 2.8's default is Filmic: a
-  notice says so), uint16 with ``set_output_format(color_depth=16)``, JPEG-round-tripped with ``file_format``
+- ``colors``: uint8 (H, W, 3) through the view transform (BlenderProc 2.8's default Filmic, from Blender's own
+  tables where installed, else the Standard view with a notice: :mod:`hybridgen.bproc.view_transform`), uint16
+  with ``set_output_format(color_depth=16)``, JPEG-round-tripped with ``file_format``
   JPEG; (H, W, 4) with a transparent film (alpha from the instance map at pixel centres).
 - ``depth``: float32 (H, W), m along the optical axis; background 1e10 (Cycles' Z pass), or with antialiasing
   the mist range (10000 m) as depth.
@@ -44,6 +45,7 @@ from .frame_outputs import convert_frame
 from .session import SESSION, current_intrinsics
 from .types import Light, MeshObject
 from .types.unsupported import fail
+from .view_transform import STANDARD, ColorEncoding, color_encoding
 
 MAX_SAMPLES_ENV = "HYBRIDGEN_BPROC_MAX_SAMPLES"
 """Environment variable capping the color samples per pixel of every render (tools/check_blenderproc_scripts.py
@@ -219,8 +221,8 @@ def _scene(frames: list[int], meshes: list[MeshObject]) -> tuple[Any, np.ndarray
     return scene, table
 
 
-def _render_group(frames: list[int], meshes: list[MeshObject], color: bool,
-                  alpha: bool) -> list[tuple[dict[str, Any], np.ndarray]]:
+def _render_group(frames: list[int], meshes: list[MeshObject], color: bool, alpha: bool,
+                  encoding: ColorEncoding = STANDARD) -> list[tuple[dict[str, Any], np.ndarray]]:
     import hybridgen as hg
 
     settings = SESSION.renderer
@@ -246,7 +248,7 @@ def _render_group(frames: list[int], meshes: list[MeshObject], color: bool,
                             guide_factor=GUIDE_FACTOR, texture_min_samples=min(TEXTURE_SAMPLES * automatic, samples))
         scene.camera.depth_of_field = _depth_of_field(frames[0])
         hg.render_color(scene, [sink], trace, labels=request, seed=0, denoise=settings.denoiser is not None,
-                        hdr=settings.color_depth == 16, stereo_baseline=_stereo_baseline())
+                        hdr=settings.color_depth == 16, stereo_baseline=_stereo_baseline(), encode=encoding.to_uint8)
     else:
         hg.render_labels(scene, [sink], request, stereo_baseline=_stereo_baseline())
     return [(values, table) for values in sink.frames]
@@ -263,18 +265,15 @@ def render_frames(output_key: str | None, load_keys: set[str] | None, return_dat
     if not meshes:
         raise InputError("There are no mesh-objects to render, please load an object before invoking the renderer.")
     keys = set(DEFAULT_LOAD_KEYS if load_keys is None else load_keys) | ({output_key} if output_key else set())
-    view = SESSION.renderer.view_transform
-    if output_key is not None and view != "Standard":
-        from ..config.notices import notice
-
-        notice(f"colors use the Standard sRGB view; BlenderProc renders with Blender's '{view}' view transform "
-               "(its look tables are not reproduced): set_output_format(view_transform='Standard') matches exactly")
-    rendered = [pair for group in _groups(frames) for pair in _render_group(group, meshes, output_key is not None, alpha)]
+    shown = output_key is not None or "diffuse" in SESSION.renderer.outputs  # images Blender writes through the view
+    encoding = color_encoding(SESSION.renderer.view_transform) if shown else STANDARD
+    rendered = [pair for group in _groups(frames)
+                for pair in _render_group(group, meshes, output_key is not None, alpha, encoding)]
     ray_lengths = current_intrinsics().pixel_ray_lengths()
     data: dict[str, list[Any]] = {}
     for frame, (values, table) in zip(frames, rendered):
         converted = convert_frame(values, table, SESSION.camera.pose.at(frame), meshes, ray_lengths,
-                                  SESSION.camera.stereo, alpha)
+                                  SESSION.camera.stereo, alpha, encoding)
         for kind, options in SESSION.renderer.outputs.items():
             if kind == "segmentation":
                 if "segmap" in keys:

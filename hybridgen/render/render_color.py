@@ -41,14 +41,19 @@ class ColorProducer:
     normals (filtered like the color's pixels, :mod:`hybridgen.render.denoise_guides`), before it is
     encoded; ``keep_raw`` also stores the image before denoising as ``colors_raw``
     (sRGB uint8, encoded like ``colors``). ``sample_counts`` stores the samples each pixel received
-    (uint32, ``sample_counts``; constant unless adaptive sampling is on).
+    (uint32, ``sample_counts``; constant unless adaptive sampling is on). ``encode`` turns linear RGB into the
+    8-bit ``colors`` (and ``colors_raw``): the Standard sRGB view (:func:`~hybridgen.render.tonemap.to_srgb8`)
+    unless given (BlenderProc runs: Blender's Filmic view, :mod:`hybridgen.render.filmic_view`); it runs on the
+    encoding thread, beside the next keypoint's sampling.
     """
 
     def __init__(self, scene: Scene, settings: PathTraceSettings, *, seed: int = 0, variant: str | None = None,
                  hdr: bool = False, denoise: bool = False, view: PathTraceView | None = None,
                  keep_raw: bool = False, sample_counts: bool = False, raster: SceneRaster | None = None,
-                 first: tuple[int, np.ndarray] | None = None) -> None:
+                 first: tuple[int, np.ndarray] | None = None,
+                 encode: Callable[[np.ndarray], np.ndarray] | None = None) -> None:
         self.scene, self.settings, self.seed, self.hdr, self.denoise = scene, settings, int(seed), hdr, denoise
+        self.encode = encode or to_srgb8
         self.keep_raw, self.sample_counts = keep_raw and denoise, sample_counts
         self._guides: DenoiseGuides | None = None
         self._worker: GuideWorker | None = None
@@ -130,7 +135,7 @@ class ColorProducer:
         pooled = pool.image() if pool is not None and pool.started else None
         values: dict[str, Any] = {}
         if self.keep_raw:
-            values["colors_raw"] = to_srgb8(linear)
+            values["colors_raw"] = self.encode(linear)
         if self.sample_counts:
             values["sample_counts"] = counts
         if guides is None and self._guides is not None:  # drawn here, on the GL context's thread, and filtered
@@ -187,7 +192,7 @@ class ColorProducer:
             denoised = oidn_denoise(linear, *guides.get())
             linear = mix_raw_on_edges(denoised, linear, guides.strength(), self.settings.edge_raw_weight, pooled) \
                 if self.settings.edge_raw_weight > 0 else denoised
-        values["colors"] = to_srgb8(linear)
+        values["colors"] = self.encode(linear)
         if self.hdr:
             values["colors_hdr"] = linear.astype(np.float16)
         return values
@@ -222,9 +227,10 @@ def render_color(scene: Scene, sinks: Iterable[FrameSink], settings: PathTraceSe
                  labels: LabelRequest | None = None, seed: int = 0, variant: str | None = None,
                  hdr: bool = False, denoise: bool = False, stereo_baseline: float | None = None,
                  default_category_id: int | None = None, progress: ProgressFactory | None = None,
-                 indices: Sequence[int] | None = None, keep_raw: bool = False, sample_counts: bool = False) -> int:
+                 indices: Sequence[int] | None = None, keep_raw: bool = False, sample_counts: bool = False,
+                 encode: Callable[[np.ndarray], np.ndarray] | None = None) -> int:
     """Color (and ``labels`` if given) of every keypoint, as left/right pairs when ``stereo_baseline`` (m).
-    ``keep_raw`` and ``sample_counts`` as in :class:`ColorProducer`. Stops with one line when a base-color texture a
+    ``keep_raw``, ``sample_counts`` and ``encode`` as in :class:`ColorProducer`. Stops with one line when a base-color texture a
     mesh names is missing (:func:`hybridgen.io.texture_needs.require_base_colors`; ``--lenient``: a notice)."""
     require_base_colors(scene.objects)
     sinks = list(sinks)
@@ -241,7 +247,7 @@ def render_color(scene: Scene, sinks: Iterable[FrameSink], settings: PathTraceSe
             stereo_baseline is None and not varies_per_keypoint(scene) else None  # are drawn while Mitsuba starts
         producers.insert(0, ColorProducer(scene, settings or PathTraceSettings(), seed=seed, variant=variant,
                                           hdr=hdr, denoise=denoise, keep_raw=keep_raw, sample_counts=sample_counts,
-                                          raster=raster, first=first))
+                                          raster=raster, first=first, encode=encode))
         if stereo_baseline is not None:
             producers = [StereoProducer(producers, stereo_baseline, scene)]
         return run_keypoints(scene, sinks, producers, progress=progress, what="color", indices=indices)

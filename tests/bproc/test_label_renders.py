@@ -76,8 +76,12 @@ def test_stereo_pairs_have_blenders_parallel_disparity(gl_context, bproc) -> Non
 
 
 def test_output_formats_of_colors(bproc) -> None:  # noqa: F811
-    from hybridgen.bproc.frame_outputs import _colors
+    from hybridgen.bproc.frame_outputs import _colors as encoded
+    from hybridgen.bproc.view_transform import STANDARD
     from hybridgen.render.tonemap import to_srgb8, to_srgb16
+
+    def _colors(values: dict) -> np.ndarray:
+        return encoded(values, STANDARD)
 
     import io
 
@@ -100,7 +104,7 @@ def test_output_formats_of_colors(bproc) -> None:  # noqa: F811
     sixteen = _colors(values)
     assert sixteen.dtype == np.uint16
     assert np.array_equal(sixteen, to_srgb16(linear.astype(np.float16).astype(np.float32)))
-    bproc.renderer.set_output_format(view_transform="Filmic")  # rendered as Standard with a notice
+    bproc.renderer.set_output_format(view_transform="Filmic")  # tests/render/test_filmic_view.py
     with pytest.raises(Exception, match="not supported"):
         bproc.renderer.set_output_format(view_transform="False Color")
 
