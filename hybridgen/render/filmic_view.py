@@ -47,7 +47,8 @@ FLT_MIN = float(np.finfo(np.float32).tiny)
 def _candidates(environment: bool) -> list[Path]:
     """Where a ``colormanagement`` folder may be: the environment variable (when ``environment`` and it is set: only
     there), a ``bpy`` of this interpreter or of the blend extra's Python (``HYBRIDGEN_BPY_PYTHON``, the
-    repository's ``.venv-bpy``), a system Blender."""
+    repository's ``.venv-bpy``), of the repository's ``.venv-blenderproc`` (tools/blenderproc_reference.py), a
+    system Blender."""
     from ..io.blend_loader import BPY_PYTHON_ENV, DEFAULT_BPY_PYTHON
 
     if environment and COLORMANAGEMENT_ENV in os.environ:
@@ -57,6 +58,7 @@ def _candidates(environment: bool) -> list[Path]:
     prefixes = [Path(sys.prefix)]
     bpy_python = Path(os.environ.get(BPY_PYTHON_ENV) or DEFAULT_BPY_PYTHON)
     prefixes.append(bpy_python.parent.parent)
+    prefixes.append(DEFAULT_BPY_PYTHON.parents[2] / ".venv-blenderproc")  # the tools' real BlenderProc (bpy 4.2)
     for prefix in prefixes:
         pattern = str(prefix / "lib" / "python3*" / "site-packages" / "bpy" / "*" / "datafiles" / "colormanagement")
         found += [Path(p) for p in sorted(glob.glob(pattern), reverse=True)]
