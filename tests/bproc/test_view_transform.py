@@ -27,19 +27,25 @@ def _plane_under_sun(bproc) -> None:  # noqa: F811
 def test_colors_go_through_the_filmic_tables(bproc, monkeypatch, tmp_path, notice_lines) -> None:  # noqa: F811
     """Without tables: the Standard view and one notice naming `make bpy-venv`. With tables (an identity cube and a
     linear curve: the view is the clipped log shaper itself) the 8- and 16-bit colors are the view's codes of the
-    linear image, far from the Standard view's."""
+    linear image, far from the Standard view's; the diffuse output is encoded the same way."""
     from hybridgen.bproc.view_transform import _FILMIC
 
     _plane_under_sun(bproc)
+    bproc.renderer.enable_diffuse_color_output()
     bproc.renderer.set_output_format(color_depth=16)
-    linear = srgb_decode(np.asarray(bproc.renderer.render()["colors"][0], np.float64) / 65535.0)
+    standard = bproc.renderer.render()
+    linear = srgb_decode(np.asarray(standard["colors"][0], np.float64) / 65535.0)
+    diffuse = srgb_decode(np.asarray(standard["diffuse"][0], np.float64) / 255.0)
     assert any("'Filmic' view" in line and "make bpy-venv" in line for line in notice_lines)
     view = FilmicView.from_folder(identity_tables(tmp_path, np.linspace(0.0, 1.0, 4096)))
     monkeypatch.setenv("HYBRIDGEN_BLENDER_COLORMANAGEMENT", str(tmp_path))
     _FILMIC.clear()
     bproc.renderer.set_output_format(color_depth=8)
-    filmic8 = np.asarray(bproc.renderer.render()["colors"][0]).astype(int)
+    filmic = bproc.renderer.render()
+    filmic8 = np.asarray(filmic["colors"][0]).astype(int)
     assert np.abs(filmic8 - view.to_uint8(linear).astype(int)).max() <= 1
+    # the diffuse output goes through the view too (its Standard codes decoded: within the 8-bit steps)
+    assert np.abs(np.asarray(filmic["diffuse"][0]).astype(int) - view.to_uint8(diffuse).astype(int)).max() <= 2
     assert np.abs(filmic8 - to_srgb8(linear).astype(int)).mean() > 10
     bproc.renderer.set_output_format(color_depth=16)
     filmic16 = np.asarray(bproc.renderer.render()["colors"][0]).astype(int)
