@@ -11,7 +11,8 @@ output folder, ``BLENDER_PROC_RANDOM_SEED=1``, in ABBA order (tools/harness.py),
 are compiled to bytecode (as a pip install does; see :func:`compile_bytecode`). Wall seconds are spawn to exit;
 CPU seconds are the process's user + system.
 
-Quality: frame 0's ``colors`` (uint8 sRGB, what users get: hybridgen's Standard view, BlenderProc's Filmic) of the
+Quality: frame 0's ``colors`` (uint8, what users get: BlenderProc's default Filmic view in both engines - hybridgen's
+from Blender's tables, found here in ``.venv-blenderproc``; Standard where none are installed) of the
 first timed run against that engine's reference: the same script rendered by the same engine through
 tools/bproc_launch.py with ``--samples N --noise-threshold 0 --no-denoiser --frames 1`` (fixed N spp, no adaptive
 stop, no denoiser; the first frame only). References are cached under ``$HYBRIDGEN_BLENDERPROC_CACHE/references``
