@@ -12,7 +12,7 @@ Per output kind (``SESSION.renderer.outputs``) and the color key:
   centres; Cycles averages a pixel's samples) through the colors' view transform, as Blender writes it (measured:
   Filmic changes BlenderProc's diffuse PNG as it changes the colors); 0 on the background, as in Cycles.
 - ``segmentation``: :func:`hybridgen.bproc.segmentation.map_frame`'s keys.
-- colors: uint8 (H, W, 3) through the view transform (:mod:`hybridgen.bproc.view_transform`: Filmic, BlenderProc's
+- colors: uint8 (H, W, 3) through the view transform (:mod:`hybridgen.render.view_transform`: Filmic, BlenderProc's
   default, from Blender's tables where installed, else Standard sRGB); ``color_depth`` 16: uint16 of the linear
   float16 render through the same view; file
   format JPEG: the 8-bit image after a JPEG round trip at ``jpg_quality`` (what BlenderProc loads back from its
@@ -34,7 +34,7 @@ import numpy as np
 from ..scene.frames import blender_to_opencv
 from .segmentation import map_frame
 from .session import SESSION
-from .view_transform import STANDARD, ColorEncoding
+from ..render.view_transform import STANDARD, ColorEncoding
 
 BACKGROUND_DEPTH = 1e10
 """Cycles' Z pass where a pixel sees no surface (m)."""

@@ -10,7 +10,7 @@ The result is ``{key: [one value per frame]}`` with BlenderProc's keys, dtypes, 
 the outputs were enabled and ``colors`` (the ``output_key``) last:
 
 - ``colors``: uint8 (H, W, 3) through the view transform (BlenderProc 2.8's default Filmic, from Blender's own
-  tables where installed, else the Standard view with a notice: :mod:`hybridgen.bproc.view_transform`), uint16
+  tables where installed, else the Standard view with a notice: :mod:`hybridgen.render.view_transform`), uint16
   with ``set_output_format(color_depth=16)``, JPEG-round-tripped with ``file_format``
   JPEG; (H, W, 4) with a transparent film (alpha from the instance map at pixel centres).
 - ``depth``: float32 (H, W), m along the optical axis; background 1e10 (Cycles' Z pass), or with antialiasing
@@ -45,7 +45,7 @@ from .frame_outputs import convert_frame
 from .session import SESSION, current_intrinsics
 from .types import Light, MeshObject
 from .types.unsupported import fail
-from .view_transform import STANDARD, ColorEncoding, color_encoding
+from ..render.view_transform import STANDARD, ColorEncoding, color_encoding
 
 MAX_SAMPLES_ENV = "HYBRIDGEN_BPROC_MAX_SAMPLES"
 """Environment variable capping the color samples per pixel of every render (tools/check_blenderproc_scripts.py

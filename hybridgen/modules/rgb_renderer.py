@@ -10,6 +10,7 @@ from ..render.passes import color_keys
 from ..render.pathtrace.mitsuba_variant import choose_variant
 from ..render.pathtrace.path_trace import PathTraceSettings
 from ..render.render_color import render_color
+from ..render.view_transform import color_encoding
 from ..run.context import RunContext
 from .base import Module, Role
 from .label_params import label_params, label_request, stored_keys
@@ -74,6 +75,10 @@ class RgbRenderer(Module):
               "(null: max_bounces); below max_bounces needs a JIT Mitsuba variant", check=_optional_non_negative),
         Param("resolution_x", "int|null", None, "px", "overrides the camera width (K scaled)"),
         Param("resolution_y", "int|null", None, "px", "overrides the camera height (K scaled)"),
+        Param("view_transform", "str", "Standard", choices=("Standard", "Filmic"),
+              doc="how colors (and colors_raw) encode linear light: Standard (the sRGB curve) or Filmic (Blender's "
+              "Filmic view, from Blender's own tables where a Blender or bpy is installed, else Standard with a "
+              "notice; BlenderProc 1.x configs default to it, as their Blender 2.93 scenes did)"),
         Param("output_hdr", "bool", False, doc="also write linear colors_hdr (float16)"),
         Param("denoise", "bool", True, doc="Open Image Denoise (pyoidn) guided by the raster albedo and normals; "
               "colors_hdr is the denoised image too; false: the raw estimate"),
@@ -121,4 +126,4 @@ class RgbRenderer(Module):
             sample_counts=cfg["output_sample_counts"],
             stereo_baseline=cfg["interocular_distance"] if cfg["stereo"] else None,
             default_category_id=context.default_category_id, progress=context.progress,
-            indices=context.keypoint_indices())
+            indices=context.keypoint_indices(), encode=color_encoding(cfg["view_transform"]).to_uint8)

@@ -77,7 +77,7 @@ def test_stereo_pairs_have_blenders_parallel_disparity(gl_context, bproc) -> Non
 
 def test_output_formats_of_colors(bproc) -> None:  # noqa: F811
     from hybridgen.bproc.frame_outputs import _colors as encoded
-    from hybridgen.bproc.view_transform import STANDARD
+    from hybridgen.render.view_transform import STANDARD
     from hybridgen.render.tonemap import to_srgb8, to_srgb16
 
     def _colors(values: dict) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""A BlenderProc run's colors through the view transform (hybridgen/bproc/view_transform.py): Filmic, BlenderProc's
+"""A BlenderProc run's colors through the view transform (hybridgen/render/view_transform.py): Filmic, BlenderProc's
 default, from Blender's tables when they are found (here: tables written by the test), else Standard and a notice
 saying how to get them."""
 from __future__ import annotations
@@ -28,7 +28,7 @@ def test_colors_go_through_the_filmic_tables(bproc, monkeypatch, tmp_path, notic
     """Without tables: the Standard view and one notice naming `make bpy-venv`. With tables (an identity cube and a
     linear curve: the view is the clipped log shaper itself) the 8- and 16-bit colors are the view's codes of the
     linear image, far from the Standard view's; the diffuse output is encoded the same way."""
-    from hybridgen.bproc.view_transform import _FILMIC
+    from hybridgen.render.view_transform import _FILMIC
 
     _plane_under_sun(bproc)
     bproc.renderer.enable_diffuse_color_output()

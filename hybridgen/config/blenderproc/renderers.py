@@ -59,8 +59,14 @@ every lobe): no glossy or transmission bounce, so metals and mirrors reflect onl
 dark - what a BlenderProc config renders in BlenderProc."""
 
 
+BLENDERPROC_VIEW = {"view_transform": "Filmic"}
+"""BlenderProc 1.x never sets Blender's view transform, and Blender 2.93's scenes default to Filmic: its colors are
+Filmic (hybridgen/render/view_transform.py; Blender 4.2's tables, whose 33^3 cube is the 65^3 one of 2.93
+downsampled - not measured against 2.93 here)."""
+
+
 def rgb(config: dict[str, Any], note: Note) -> list[tuple[str, dict[str, Any]]]:
-    cfg = {**BLENDERPROC_LOBE_BOUNCES, **config}
+    cfg = {**BLENDERPROC_LOBE_BOUNCES, **BLENDERPROC_VIEW, **config}
     _output_keys(cfg, note, "colors")
     _renderer_common(cfg, note)
     if "render_diffuse_color" in cfg:  # Blender's Diffuse Color pass: hybridgen's diffuse_color, not the base color

@@ -1,6 +1,8 @@
-"""The view transform of a BlenderProc run's ``colors`` and ``diffuse`` images (``set_output_format(view_transform=...)``;
-BlenderProc 2.8's default is Filmic; Blender writes both through it): how :mod:`hybridgen.bproc.render_frames`
-encodes linear RGB into 8- and 16-bit codes.
+"""The view transform that turns linear RGB into 8- and 16-bit image codes: a BlenderProc 2 run's ``colors`` and
+``diffuse`` images (``set_output_format(view_transform=...)``; BlenderProc 2.8's default is Filmic and Blender writes
+both through it, :mod:`hybridgen.bproc.render_frames`) and ``renderer.RgbRenderer``'s ``colors`` (its
+``view_transform``: Standard for hybridgen's configs, Filmic for BlenderProc 1.x ones, whose Blender 2.93 scenes
+defaulted to it).
 
 - ``Standard``: the sRGB curve (:mod:`hybridgen.render.tonemap`), exact.
 - ``Filmic``: Blender's Filmic view computed from Blender's own tables (:mod:`hybridgen.render.filmic_view`), found in
@@ -18,8 +20,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..render.filmic_view import COLORMANAGEMENT_ENV, FilmicView, find_colormanagement
-from ..render.tonemap import to_srgb16, to_srgb8
+from .filmic_view import COLORMANAGEMENT_ENV, FilmicView, find_colormanagement
+from .tonemap import to_srgb16, to_srgb8
 
 
 @dataclass
