@@ -57,7 +57,8 @@ mutate: setup-test
 
 # .blend files (loader.BlendLoader, hybridgen.io.blend_loader) are read by Blender's bpy 4.2 in a venv of its own:
 # it needs Python 3.11 and NumPy < 2 (about 1 GB; never a `make test` dependency). HYBRIDGEN_BPY_PYTHON names
-# another Python that has bpy.
+# another Python that has bpy. Its color tables also give BlenderProc runs Blender's Filmic view
+# (hybridgen/render/filmic_view.py).
 BPY_PYTHON ?= python3.11
 bpy-venv:
 	$(BPY_PYTHON) -m venv .venv-bpy
