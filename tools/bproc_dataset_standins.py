@@ -31,7 +31,7 @@ TOOLS = Path(__file__).resolve().parent
 REPO = TOOLS.parent
 sys.path.insert(0, str(TOOLS))
 
-from check_blenderproc_configs import BOP_NAME, _box_obj, amass_standin, dataset_standins  # noqa: E402
+from check_blenderproc_configs import BOP_NAME, _box_obj, amass_standin, dataset_standins, hdr_standin  # noqa: E402
 
 OBJECT_BLEND = "object.blend"
 HAVEN_MODEL = "ArmChair_01_2k.blend"
@@ -119,19 +119,6 @@ def _shapenet(work: Path, text: str) -> None:
                                                      "numInstances": 1} for s in synsets]))
 
 
-def _hdr(path: Path, width: int = 32, height: int = 16) -> None:
-    """A flat (not run-length encoded) Radiance RGBE image: a sky-to-ground gradient."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    rows = []
-    for y in range(height):
-        value = 2.0 - 1.6 * y / (height - 1)
-        mantissa, exponent = (value / 2.0, 129) if value >= 1.0 else (value, 128)
-        pixel = bytes([int(mantissa * 256 * 0.8), int(mantissa * 256 * 0.9), int(mantissa * 255), exponent])
-        rows.append(pixel * width)
-    header = f"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {height} +X {width}\n".encode()
-    path.write_bytes(header + b"".join(rows))
-
-
 def _matterport(work: Path) -> None:
     """A Z-up house OBJ (one object): a closed 6 x 5 x 2.6 m room (floor, four walls, ceiling) with a table top;
     textured."""
@@ -208,7 +195,7 @@ def make_dataset_standins(work: Path, text: str, root: Path) -> None:
                                      ("frame_id", "0"))}
         amass_standin("loader.AMASSLoader " + " ".join(f'"{k}": "{v}"' for k, v in keys.items()), work)
     if "haven" in text:
-        _hdr(work / "haven" / "hdris" / "standin_sky" / "standin_sky_2k.hdr")
+        hdr_standin(work / "haven" / "hdris" / "standin_sky" / "standin_sky_2k.hdr")
     if "load_matterport3d" in text:
         _matterport(work)
     if "load_blend" in text:

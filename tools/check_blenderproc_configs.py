@@ -159,6 +159,8 @@ def standin_args(config: Path, work: Path, output: Path) -> list[str]:
             value = work / "texture.png"
         elif "output" in lower:
             value = output
+        elif "blend" in lower and (work / "scene.blend").is_file():  # tools/make_blend_fixture.py's scene
+            value = work / "scene.blend"
         elif "obj" in lower or "scene" in lower or "mesh" in lower or "model" in lower or "file" in lower and \
                 "cam" not in lower:
             value = work / "scene.obj"
@@ -232,6 +234,19 @@ def _box_obj(path: Path, size: tuple[float, float, float], mtl: bool = False) ->
         path.with_suffix(".mtl").write_text("newmtl body\nKd 0.6 0.5 0.4\n")
 
 
+def hdr_standin(path: Path, width: int = 32, height: int = 16) -> None:
+    """A flat (not run-length encoded) Radiance RGBE image: a sky-to-ground gradient."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    rows = []
+    for y in range(height):
+        value = 2.0 - 1.6 * y / (height - 1)
+        mantissa, exponent = (value / 2.0, 129) if value >= 1.0 else (value, 128)
+        pixel = bytes([int(mantissa * 256 * 0.8), int(mantissa * 256 * 0.9), int(mantissa * 255), exponent])
+        rows.append(pixel * width)
+    header = f"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {height} +X {width}\n".encode()
+    path.write_bytes(header + b"".join(rows))
+
+
 def _args_of(text: str, key: str) -> list[int]:
     return [int(i) for i in re.findall(rf'"{key}"\s*:\s*"<args:(\d+)>"', text)]
 
@@ -302,6 +317,13 @@ def dataset_standins(text: str, work: Path) -> dict[int, str]:
             Image.new("RGB", (8, 8), (120, 100, 80)).save(textures / folder / f"{folder}_0.jpg")
         out.update({i: str(room) for i in _args_of(text, "file_path")})
         out.update({i: str(textures) for i in _args_of(text, "texture_folder")})
+    if "loader.HavenEnvironmentLoader" in text:  # <data_path>/hdris/<name>/<name>_2k.hdr
+        hdr_standin(work / "haven" / "hdris" / "standin_sky" / "standin_sky_2k.hdr")
+        out.update({i: str(work / "haven") for i in _args_of(text, "data_path")})
+    blend = work / "scene.blend"  # what loader.BlendLoader's path names: a .blend, where one could be written
+    if blend.is_file():
+        out.update({int(i): str(blend) for i in re.findall(
+            r'"loader\.BlendLoader"\s*,\s*"config"\s*:\s*\{[^{}]*?"path"\s*:\s*"<args:(\d+)>"', text)})
     out.update(room_dataset_standins(text, work))
     out.update(amass_standin(text, work))
     if "loader.RockEssentialsRockLoader" in text or "constructor.RockEssentialsGroundConstructor" in text:
@@ -492,6 +514,24 @@ def make_standins(work: Path) -> None:
         Image.new("RGB", (16, 16), color).save(work / "cc_textures" / asset / f"{asset}_2K_Color.jpg")
     # location + Blender Euler rotation per line: two views of the origin from 6 m
     (work / "camera_positions").write_text("0 -6 3 1.1 0 0\n4 -4 3 1.1 0 0.785\n")
+    _blend_standin(work / "scene.blend")
+
+
+def _blend_standin(path: Path) -> None:
+    """A small .blend scene (tools/make_blend_fixture.py, written by Blender) for a config's ``<path_to_blend_file>``
+    where the bpy venv exists; without it such a config gets the OBJ and the loader says, in one line, how to get
+    bpy."""
+    import subprocess
+
+    from hybridgen.errors import SystemSetupError
+    from hybridgen.io.blend_loader import bpy_python
+
+    try:
+        python = bpy_python()
+    except SystemSetupError:
+        return
+    subprocess.run([str(python), str(Path(__file__).with_name("make_blend_fixture.py")), str(path)], check=True,
+                   capture_output=True)
 
 
 def check(config: Path, root: Path, run: bool, work: Path, output: Path, use_example_inputs: bool = False) -> Outcome:
