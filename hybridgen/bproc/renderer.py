@@ -68,8 +68,8 @@ def set_output_format(file_format: str | None = None, color_depth: int | None = 
     """What ``colors`` holds: ``file_format`` PNG (exact) or JPEG (the image after a JPEG round trip at
     ``jpg_quality``, as BlenderProc loads its ``.jpg`` back); ``color_depth`` 8 (uint8) or 16 (uint16, PNG only);
     ``view_transform`` Standard, Filmic (computed from Blender's own tables where a Blender or ``bpy`` is installed,
-    else Standard with a notice) or AgX (Standard with a notice; :mod:`hybridgen.render.view_transform`). ``enable_transparency`` (Cycles'
-    transparent film): a PNG's colors get an alpha channel, 0 (and RGB 0) where the camera sees the world, which
+    else Standard with a notice) or AgX (Standard with a notice; :mod:`hybridgen.render.view_transform`).
+    ``enable_transparency`` (Cycles' transparent film): a PNG's colors get an alpha channel, 0 (and RGB 0) where the camera sees the world, which
     still lights the scene (:mod:`hybridgen.bproc.frame_outputs`)."""
     settings = SESSION.renderer
     if enable_transparency is not None:

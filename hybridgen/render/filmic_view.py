@@ -174,7 +174,8 @@ class FilmicView:
     def display(self, linear: np.ndarray) -> np.ndarray:
         """Display values in [0, 1] of scene-linear RGB (..., 3)."""
         low, high = self.curve_domain
-        position = (np.clip(self.log_encoding(linear), low, high) - low) * np.float32((len(self.curve) - 1) / (high - low))
+        scale = np.float32((len(self.curve) - 1) / (high - low))
+        position = (np.clip(self.log_encoding(linear), low, high) - low) * scale
         lower = np.minimum(position.astype(np.intp), len(self.curve) - 2)
         fraction = position - lower
         return self.curve[lower] * (1.0 - fraction) + self.curve[lower + 1] * fraction

@@ -56,6 +56,8 @@ class ColorEncoding:
 
 STANDARD = ColorEncoding("Standard", to_srgb8, to_srgb16)
 _FILMIC: dict[str, LazyFilmic] = {}  # per tables folder, for the process
+_MATCH = ("the Standard view in both matches exactly (a script's set_output_format(view_transform='Standard'), a "
+          "config renderer's view_transform: Standard)")
 
 
 def color_encoding(view: str) -> ColorEncoding:
@@ -70,11 +72,10 @@ def color_encoding(view: str) -> ColorEncoding:
         if folder is not None:
             lazy = _FILMIC.setdefault(str(folder), LazyFilmic(folder))
             return ColorEncoding("Filmic", lazy.to_uint8, lazy.to_uint16)
-        notice("colors (and diffuse) use the Standard sRGB view: BlenderProc renders with Blender's 'Filmic' view, which hybridgen "
-               "computes from Blender's own color tables, not found: run `make bpy-venv` (or install Blender) or "
-               f"set {COLORMANAGEMENT_ENV} to a Blender datafiles/colormanagement folder; "
-               "set_output_format(view_transform='Standard') matches exactly")
+        notice("colors (and diffuse) use the Standard sRGB view: BlenderProc renders with Blender's 'Filmic' view, "
+               "which hybridgen computes from Blender's own color tables, not found: run `make bpy-venv` (or install "
+               f"Blender) or set {COLORMANAGEMENT_ENV} to a Blender datafiles/colormanagement folder; {_MATCH}")
         return STANDARD
-    notice(f"colors (and diffuse) use the Standard sRGB view; BlenderProc renders with Blender's '{view}' view transform, which "
-           "hybridgen does not reproduce: set_output_format(view_transform='Standard') matches exactly")
+    notice(f"colors (and diffuse) use the Standard sRGB view; BlenderProc renders with Blender's '{view}' view "
+           f"transform, which hybridgen does not reproduce; {_MATCH}")
     return STANDARD
