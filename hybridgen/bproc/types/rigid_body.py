@@ -6,8 +6,9 @@ computes it), ``collision_margin`` in m, ``friction`` Bullet's Coulomb coefficie
 velocity lost per second. Collision shapes: ``CONVEX_HULL``, ``MESH`` (passive: Bullet's static triangle mesh;
 active: every triangle collides, as Blender's GImpact shape - :mod:`hybridgen.physics.mesh_body`), ``BOX`` (the
 object's bound box), and ``COMPOUND`` after :meth:`RigidBodyMixin.build_convex_decomposition_collision_shape` (a
-convex decomposition by CoACD, where BlenderProc runs V-HACD: the parts differ, the idea is the same). ``SPHERE``, ``CAPSULE``,
-``CYLINDER`` and ``CONE`` raise one line when simulated.
+convex decomposition by CoACD, where BlenderProc runs V-HACD: the parts differ, the idea is the same). ``SPHERE``,
+``CAPSULE``, ``CYLINDER`` and ``CONE`` are Blender's primitives sized from the object's dimensions, simulated as their
+convex hulls (:data:`hybridgen.bproc.physics.PRIMITIVE_SHAPES`).
 """
 from __future__ import annotations
 
