@@ -66,6 +66,8 @@ box with its origin at its bottom face rests, as a capsule, cylinder or cone, wi
 0.4 x 1.2 x 0.6 m one, as a sphere, 0.3 m above it. hybridgen simulates each as the convex hull of its surface
 (:data:`PRIMITIVE_SEGMENTS` around), where Bullet has exact primitives: a rolling sphere rolls on facets."""
 PRIMITIVE_SEGMENTS = 32
+MIN_EXTENT = 1e-4
+"""m: the least radius and height of a primitive shape (an object flat along an axis)."""
 
 
 def primitive_hull(shape: str, mesh: SceneMesh) -> Any:
@@ -77,9 +79,10 @@ def primitive_hull(shape: str, mesh: SceneMesh) -> Any:
     centre = _surface_centroid(mesh)
     ring = np.linspace(0.0, 2.0 * np.pi, PRIMITIVE_SEGMENTS, endpoint=False)
     circle = np.stack([np.cos(ring), np.sin(ring)], axis=1)
-    radius, height = max(dims[0], dims[1]) / 2.0, dims[2]
+    # a flat object (a plane) gets a shape MIN_EXTENT thick instead of a degenerate one
+    radius, height = max(max(dims[0], dims[1]) / 2.0, MIN_EXTENT), max(float(dims[2]), MIN_EXTENT)
     if shape == "SPHERE":
-        points = _ball(float(dims.max()) / 2.0, circle)
+        points = _ball(max(float(dims.max()) / 2.0, MIN_EXTENT), circle)
     elif shape == "CAPSULE":
         half = max(height / 2.0 - radius, 0.0)
         cap = _ball(radius, circle)
@@ -92,12 +95,11 @@ def primitive_hull(shape: str, mesh: SceneMesh) -> Any:
 
 
 def _ball(radius: float, circle: np.ndarray) -> np.ndarray:
-    """Points of a sphere of ``radius`` around the origin on 16 latitude rings of ``circle``, none at the poles: the
-    hull's bottom and top are small flat caps, so a ball or capsule dropped straight stays upright as Bullet's exact
-    shape does."""
+    """Points of a sphere of ``radius`` around the origin on 16 latitude rings of ``circle``, none at the poles (the
+    hull's bottom and top are small flat caps)."""
     latitudes = np.linspace(-np.pi / 2, np.pi / 2, 17)[:-1] + np.pi / 32
     return np.concatenate([np.column_stack([circle * np.cos(lat), np.full(len(circle), np.sin(lat))])
-                           for lat in latitudes]) * max(radius, 1e-9)
+                           for lat in latitudes]) * radius
 
 
 def _surface_centroid(mesh: SceneMesh) -> np.ndarray:

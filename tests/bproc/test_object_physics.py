@@ -93,3 +93,6 @@ def test_a_tall_capsule_spans_the_box_height() -> None:
     np.testing.assert_allclose(high, [0.3, 0.3, 1.0], atol=0.01)
     low, high = primitive_hull("SPHERE", box).bounds  # radius max(dims) / 2 around the surface centroid
     np.testing.assert_allclose(low, [-0.5, -0.5, 0.0], atol=0.01)
+    plane = MeshObject("plane", corners[::2], np.array([[0, 1, 3], [0, 3, 2]]))  # flat: z = 0
+    disk = primitive_hull("CYLINDER", plane)  # a thin disk, not a degenerate hull
+    assert disk.is_watertight and disk.extents[2] == pytest.approx(1e-4) and disk.extents[1] == pytest.approx(0.6)
