@@ -12,26 +12,12 @@ from hybridgen.modules.rgb_renderer import RgbRenderer
 from hybridgen.render.filmic_view import FilmicView
 from tests.config.test_blenderproc_lobe_bounces import _rgb_config
 from tests.filmic_tables import identity_tables
+from tests.render.test_color_oracles import EMITTER_CONFIG, RADIANCE, SRGB8
 
-CONFIG = """
-global: {all: {output_dir: "<args:0>"}}
-modules:
-  - name: main.Initializer
-    config: {world_strength: 0.0}
-  - name: loader.PrimitiveLoader
-    config: {shape: plane, size: 20, name: panel, category_id: 1, color: [0.3, 0.6, 0.9]}
-  - name: lighting.SurfaceLighting
-    config: {selector: {conditions: {name: panel}}, emission_color: [0.25, 0.05, 0.001], emission_strength: 2.0,
-             visible_to_camera: true}
-  - name: camera.CameraLoader
-    config:
-      intrinsics: {resolution_x: 8, resolution_y: 6, fov: 0.5}
-      cam_poses:
-        - {source_frame: [X, -Y, -Z], cam2world_matrix: [[1, 0, 0, 0], [0, -1, 0, 0], [0, 0, -1, 1], [0, 0, 0, 1]]}
-  - name: renderer.RgbRenderer
-    config: {samples: 4, max_bounces: 0, output_hdr: true, denoise: false, view_transform: %s}
-  - name: writer.Hdf5Writer
-"""
+RENDERER = "config: {samples: 4, max_bounces: 0, output_hdr: true, denoise: false}"
+assert RENDERER in EMITTER_CONFIG
+CONFIG = EMITTER_CONFIG.replace(RENDERER, RENDERER[:-1] + ", view_transform: %s}")
+"""test_color_oracles' emissive panel seen from both sides, with the renderer's view_transform given."""
 
 
 @pytest.mark.parametrize("form", ["v1.12", "v1.0"])
@@ -43,7 +29,7 @@ def test_blenderproc_configs_render_filmic_unless_set(tmp_path, form) -> None:
 
 
 def test_filmic_colors_are_the_views_codes_of_the_linear_render(tmp_path, monkeypatch, gl_context) -> None:
-    """Emission (0.5, 0.1, 0.002) seen directly: Standard gives its sRGB codes, Filmic the view's codes of it."""
+    """Emission (0.5, 0.01, 0.002) seen directly: Standard gives its sRGB codes, Filmic the view's codes of it."""
     view = FilmicView.from_folder(identity_tables(tmp_path / "tables", np.sqrt(np.linspace(0.0, 1.0, 4096))))
     monkeypatch.setenv("HYBRIDGEN_BLENDER_COLORMANAGEMENT", str(tmp_path / "tables"))
     colors = {}
@@ -53,9 +39,9 @@ def test_filmic_colors_are_the_views_codes_of_the_linear_render(tmp_path, monkey
         hg.run_config(config, [str(tmp_path / name)])
         with h5py.File(tmp_path / name / "data.hdf5") as f:
             colors[name], hdr = f["colors"][()], f["colors_hdr"][()].astype(np.float32)
-    np.testing.assert_allclose(hdr, np.broadcast_to((0.5, 0.1, 0.002), hdr.shape), rtol=2e-3)
-    np.testing.assert_array_equal(colors["Standard"], np.broadcast_to(np.array((188, 89, 7), np.uint8),
+    np.testing.assert_allclose(hdr, np.broadcast_to(RADIANCE, hdr.shape), rtol=2e-3)
+    np.testing.assert_array_equal(colors["Standard"], np.broadcast_to(np.array(SRGB8, np.uint8),
                                                                       colors["Standard"].shape))
-    expected = view.to_uint8(np.array([[(0.5, 0.1, 0.002)]], np.float32))[0, 0]
+    expected = view.to_uint8(np.array([[RADIANCE]], np.float32))[0, 0]
     assert np.abs(colors["Filmic"].astype(int) - expected.astype(int)).max() <= 1
-    assert np.abs(expected.astype(int) - (188, 89, 7)).max() > 20
+    assert np.abs(expected.astype(int) - SRGB8).max() > 20
